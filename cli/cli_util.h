@@ -1,0 +1,30 @@
+// Small helpers shared by the subcommands: timing, memory, paths, JSON numbers.
+#pragma once
+
+#include <chrono>
+#include <string>
+
+namespace qem::cli {
+
+/// Monotonic seconds since construction (steady_clock, as the bench harness requires).
+class Stopwatch {
+ public:
+  Stopwatch() : start_(std::chrono::steady_clock::now()) {}
+  double seconds() const {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
+
+ private:
+  std::chrono::steady_clock::time_point start_;
+};
+
+/// Peak resident set size of this process in MB (VmHWM), or 0 if unknown.
+double peak_rss_mb();
+
+/// True if both paths name the same existing file (so writing one would destroy the other).
+bool same_file(const std::string& a, const std::string& b);
+
+/// A number for a JSON document: shortest round-trip form, `null` for NaN/inf.
+std::string json_number(double x);
+
+}  // namespace qem::cli

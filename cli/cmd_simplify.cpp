@@ -1,0 +1,154 @@
+// `qem simplify INPUT OUTPUT [options]`: GH97 simplification of a mesh file.
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <string>
+
+#include "cli_util.h"
+#include "command.h"
+#include "qem/error.h"
+#include "qem/io.h"
+#include "qem/simplify.h"
+
+namespace qem::cli {
+namespace {
+
+struct SimplifyArgs {
+  std::string input, output;
+  std::size_t faces = 0, vertices = 0;
+  double ratio = 0;
+  double max_error = -1, max_error_rel = -1;
+  double threshold = 0, threshold_rel = 0;
+  std::string weighting = "area", placement = "optimal", inversion = "forbid";
+  double boundary_weight = 1000;
+  double max_turn = 75;
+  bool lock_border = false, allow_non_manifold = false;
+  bool weld = false, no_weld = false, ascii = false;
+  bool json = false, quiet = false, force = false;
+};
+
+int run_simplify(const SimplifyArgs& a) {
+  if (a.faces == 0 && a.ratio == 0 && a.vertices == 0 && a.max_error < 0 && a.max_error_rel < 0)
+    throw Error("give a target: --faces, --ratio, --vertices, --max-error or --max-error-rel");
+  if (a.ratio < 0 || a.ratio > 1) throw Error("--ratio must be in (0, 1]");
+  if (same_file(a.input, a.output) && !a.force)
+    throw Error("refusing to overwrite the input '" + a.input + "' with the output (use --force)");
+
+  SimplifyOptions opt;
+  opt.target_faces = a.faces;
+  opt.target_ratio = a.ratio;
+  opt.target_vertices = a.vertices;
+  if (a.max_error >= 0) opt.max_error = a.max_error;
+  if (a.max_error_rel >= 0) opt.max_error = a.max_error_rel, opt.max_error_is_relative = true;
+  if (a.threshold_rel > 0) opt.threshold = a.threshold_rel, opt.threshold_is_relative = true;
+  else opt.threshold = a.threshold;
+  static const std::map<std::string, Weighting> weightings{
+      {"area", Weighting::Area}, {"uniform", Weighting::Uniform}, {"angle", Weighting::Angle}};
+  static const std::map<std::string, Placement> placements{{"optimal", Placement::Optimal},
+                                                           {"segment", Placement::Segment},
+                                                           {"midpoint", Placement::Midpoint},
+                                                           {"endpoints", Placement::Endpoints}};
+  static const std::map<std::string, InversionPolicy> inversions{
+      {"forbid", InversionPolicy::Forbid}, {"penalize", InversionPolicy::Penalize}, {"off", InversionPolicy::Ignore}};
+  opt.weighting = weightings.at(a.weighting);
+  opt.placement = placements.at(a.placement);
+  opt.inversion = inversions.at(a.inversion);
+  opt.boundary_weight = a.boundary_weight;
+  opt.max_normal_turn_degrees = a.max_turn;
+  opt.lock_border = a.lock_border;
+  opt.preserve_topology = !a.allow_non_manifold;
+
+  const bool show_progress = !a.quiet && !a.json && ::isatty(STDERR_FILENO);
+  if (show_progress)
+    opt.progress = [](double f) {
+      std::fprintf(stderr, "\rqem: simplifying %5.1f%%", 100 * f);
+      std::fflush(stderr);
+      return true;
+    };
+
+  Stopwatch total;
+  LoadOptions load;
+  if (a.weld) load.weld = Weld::On;
+  if (a.no_weld) load.weld = Weld::Off;
+  LoadReport report;
+  Stopwatch t_load;
+  Mesh mesh = load_mesh(a.input, load, &report);
+  const double load_s = t_load.seconds();
+
+  Stopwatch t_simplify;
+  SimplifyResult r = simplify(mesh, opt);
+  const double simplify_s = t_simplify.seconds();
+  if (show_progress) std::fprintf(stderr, "\n");
+
+  Stopwatch t_write;
+  SaveOptions save;
+  save.binary = !a.ascii;
+  save_mesh(a.output, r.mesh, save);
+  const double write_s = t_write.seconds();
+
+  if (a.json) {
+    std::printf(
+        "{\"tool\":\"qem\",\"in_faces\":%zu,\"target_faces\":%zu,\"out_faces\":%zu,\"out_vertices\":%zu,"
+        "\"load_s\":%s,\"simplify_s\":%s,\"write_s\":%s,\"total_s\":%s,\"peak_rss_mb\":%s,\"max_error\":%s,"
+        "\"max_error_rel\":%s,\"contractions\":%zu,\"virtual_pairs\":%zu,\"stop\":\"%s\"}\n",
+        mesh.face_count(), a.faces, r.mesh.face_count(), r.mesh.vertex_count(), json_number(load_s).c_str(),
+        json_number(simplify_s).c_str(), json_number(write_s).c_str(), json_number(total.seconds()).c_str(),
+        json_number(peak_rss_mb()).c_str(), json_number(r.max_error).c_str(),
+        json_number(r.max_error_relative).c_str(), r.contractions, r.virtual_pairs, to_string(r.stop_reason));
+  }
+  if (!a.quiet)
+    std::fprintf(stderr, "qem: %zu -> %zu faces, %zu vertices, max error %.4g (%.3g of diagonal), %.3f s; %s\n",
+                 r.input_faces, r.mesh.face_count(), r.mesh.vertex_count(), r.max_error, r.max_error_relative,
+                 total.seconds(), r.stop_detail.c_str());
+  return 0;
+}
+
+const bool registered = register_command(10, [](CLI::App& app) {
+  auto args = std::make_shared<SimplifyArgs>();
+  CLI::App* sub = app.add_subcommand("simplify", "Simplify a mesh by quadric-error pair contraction (GH97)");
+  sub->add_option("input", args->input, "Input mesh (.obj .ply .stl .off)")->required();
+  sub->add_option("output", args->output, "Output mesh; format by extension (.obj .ply .stl .off)")->required();
+  auto* g = sub->add_option_group("target", "Stop criteria (any combination; the first reached wins)");
+  g->add_option("--faces,-f", args->faces, "Stop at or below this many faces");
+  g->add_option("--ratio,-r", args->ratio, "Stop at or below this fraction of the input faces");
+  g->add_option("--vertices", args->vertices, "Stop at or below this many vertices");
+  g->add_option("--max-error", args->max_error,
+                "Never make a contraction whose error exceeds this distance (model units): the error is "
+                "sqrt(Q(v)/weight), the weighted RMS distance of the new vertex to the planes it represents");
+  g->add_option("--max-error-rel", args->max_error_rel, "As --max-error, relative to the bounding-box diagonal");
+  sub->add_option("--threshold,-t", args->threshold,
+                  "Pair threshold t of GH97 3.2 (model units): vertices closer than t are valid pairs, so "
+                  "separate parts can join (0 = edges only)");
+  sub->add_option("--threshold-rel", args->threshold_rel, "As --threshold, relative to the bounding-box diagonal");
+  sub->add_option("--weighting", args->weighting, "Plane weighting: area (HG99), uniform (GH97), angle")
+      ->check(CLI::IsMember({"area", "uniform", "angle"}))
+      ->capture_default_str();
+  sub->add_option("--placement", args->placement,
+                  "Where the new vertex goes: optimal (then segment, then endpoints), segment, midpoint, endpoints")
+      ->check(CLI::IsMember({"optimal", "segment", "midpoint", "endpoints"}))
+      ->capture_default_str();
+  sub->add_option("--boundary-weight", args->boundary_weight,
+                  "Penalty weight of the boundary constraint planes (GH97 6); 0 = off")
+      ->capture_default_str();
+  sub->add_flag("--lock-border", args->lock_border, "Boundary vertices never move");
+  sub->add_option("--inversion", args->inversion,
+                  "Contractions that flip a face: forbid, penalize, or off (GH97 6)")
+      ->check(CLI::IsMember({"forbid", "penalize", "off"}))
+      ->capture_default_str();
+  sub->add_option("--max-turn", args->max_turn, "A face normal turning by more than this (degrees, < 90) is a flip")
+      ->capture_default_str();
+  sub->add_flag("--allow-non-manifold", args->allow_non_manifold,
+                "Do not check the link condition: edge collapses may create non-manifold edges");
+  sub->add_flag("--weld", args->weld, "Merge exactly coincident vertices on load (default for STL)");
+  sub->add_flag("--no-weld", args->no_weld, "Never weld on load, not even STL");
+  sub->add_flag("--ascii", args->ascii, "Write PLY / STL as text instead of binary");
+  sub->add_flag("--json", args->json, "Print one JSON line with counts, timings, memory and error on stdout");
+  sub->add_flag("--quiet,-q", args->quiet, "No progress and no summary on stderr");
+  sub->add_flag("--force", args->force, "Allow the output to overwrite the input file");
+  return [args] { return run_simplify(*args); };
+});
+
+}  // namespace
+}  // namespace qem::cli

@@ -1,0 +1,130 @@
+// `qem view`: shows meshes in a local web page (three.js, bundled in web/dist): one mesh, an LOD
+// chain walked by a slider, or an original/simplified pair side by side; an error heat map when a
+// mesh has a per-vertex `distance` property. `--export DIR` writes the same page to a folder.
+#include <atomic>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "command.h"
+#include "qem/error.h"
+#include "qem/io.h"
+#include "qem/measure.h"
+#include "view/http_server.h"
+#include "view/lod_manifest.h"
+#include "view/scene.h"
+#include "view/web_assets.h"
+
+namespace qem::cli {
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+extern "C" void on_signal(int) { g_stop.store(true); }
+
+struct ViewArgs {
+  std::vector<std::string> inputs;
+  bool chain = false, compare = false;
+  int port = 8765;
+  std::string export_dir, title;
+  bool measure = true;
+  std::size_t samples = 200000;
+};
+
+view::ViewScene build_scene(const ViewArgs& a) {
+  if (a.chain && a.compare) throw Error("qem view: --chain and --compare exclude each other");
+  view::ViewScene scene;
+  std::vector<view::ManifestLevel> entries;
+  if (a.inputs.size() == 1 && view::is_manifest_path(a.inputs[0])) {
+    entries = view::read_lod_manifest(a.inputs[0]);
+    scene.mode = a.compare ? view::ViewMode::Compare : view::ViewMode::Chain;
+  } else {
+    for (const std::string& p : a.inputs) {
+      if (view::is_manifest_path(p)) throw Error(p + ": an LOD manifest must be the only input");
+      entries.push_back({p, 0, 0, NAN});
+    }
+    scene.mode = a.compare            ? view::ViewMode::Compare
+                 : entries.size() > 1 ? view::ViewMode::Chain
+                                      : view::ViewMode::Single;
+  }
+  LoadOptions lo;
+  lo.keep_vertex_properties = true;  // the `distance` heat map
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    const view::ManifestLevel& e = entries[i];
+    view::ViewLevel level;
+    level.name = std::filesystem::path(e.path).filename().string();
+    level.mesh = load_mesh(e.path, lo);
+    level.error = e.error;
+    if (e.faces && e.faces != level.mesh.face_count())
+      throw Error(a.inputs[0] + ": level " + std::to_string(i) + " lists " + std::to_string(e.faces) +
+                  " faces but " + e.path + " has " + std::to_string(level.mesh.face_count()));
+    if (e.vertices && e.vertices != level.mesh.vertex_count())
+      throw Error(a.inputs[0] + ": level " + std::to_string(i) + " lists " + std::to_string(e.vertices) +
+                  " vertices but " + e.path + " has " + std::to_string(level.mesh.vertex_count()));
+    scene.levels.push_back(std::move(level));
+  }
+  // Levels without a given error get the symmetric Hausdorff distance to the first (finest) level,
+  // measured by surface sampling (GH97 §6.1); the first level is the reference, error 0.
+  if (a.measure && scene.levels.size() > 1) {
+    MeasureOptions mo;
+    mo.samples = a.samples;
+    for (std::size_t i = 0; i < scene.levels.size(); ++i) {
+      view::ViewLevel& l = scene.levels[i];
+      if (!std::isnan(l.error)) continue;
+      l.error = i == 0 ? 0.0 : measure(scene.levels[0].mesh, l.mesh, mo).hausdorff;
+    }
+  }
+  scene.title = a.title.empty() ? scene.levels[0].name : a.title;
+  return scene;
+}
+
+int run_view(const ViewArgs& a) {
+  view::ViewScene scene = build_scene(a);
+  view::FileSet files = view::read_tree(view::find_web_assets());
+  for (auto& [path, bytes] : view::scene_files(scene)) files[path] = std::move(bytes);
+  if (!a.export_dir.empty()) {
+    view::write_tree(a.export_dir, files);
+    std::printf("qem view: wrote %zu files to %s (serve the folder over HTTP to view it)\n", files.size(),
+                a.export_dir.c_str());
+    return 0;
+  }
+  if (a.port < 0 || a.port > 65535) throw Error("qem view: --port must be 0..65535");
+  view::HttpServer server(std::move(files), static_cast<std::uint16_t>(a.port));
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  std::printf("qem view: %zu level%s at %s (Ctrl-C to stop)\n", scene.levels.size(),
+              scene.levels.size() == 1 ? "" : "s", server.url().c_str());
+  std::fflush(stdout);
+  server.serve(g_stop);
+  return 0;
+}
+
+const bool registered = register_command(80, [](CLI::App& app) -> std::function<int()> {
+  auto args = std::make_shared<ViewArgs>();
+  CLI::App* cmd =
+      app.add_subcommand("view", "Show meshes in a local web page (three.js): LOD slider, compare, heat map");
+  cmd->add_option("meshes", args->inputs,
+                  "Mesh files (OBJ, PLY, STL, OFF), or one LOD manifest (.json) listing the levels")
+      ->required();
+  cmd->add_flag(
+      "--chain", args->chain,
+      "The meshes are an LOD chain, finest first: a slider walks them (the default for several meshes)");
+  cmd->add_flag("--compare", args->compare,
+                "Two meshes (original, simplified) side by side with linked cameras");
+  cmd->add_option("--port", args->port, "Port on 127.0.0.1 to serve the page on (0 = any free port)")
+      ->capture_default_str();
+  cmd->add_option("--export", args->export_dir,
+                  "Write the page (index.html, app.js, data/) to this folder instead of serving it");
+  cmd->add_option("--title", args->title, "Page title (default: the first mesh's file name)");
+  cmd->add_flag("!--no-measure", args->measure,
+                "Do not measure each level's Hausdorff distance to the first level when no error is given");
+  cmd->add_option("--samples", args->samples, "Surface samples for that measurement")->capture_default_str();
+  return [args] { return run_view(*args); };
+});
+
+}  // namespace
+
+}  // namespace qem::cli

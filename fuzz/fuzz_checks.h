@@ -1,0 +1,169 @@
+// What the fuzzers check, shared with tests/fuzz_regressions_test.cpp so that a crash input found by
+// a fuzzer replays as a plain unit test (built with any compiler, no libFuzzer needed).
+//
+//  - check_mesh: the guarantees of io.h on a parsed mesh (valid indices, finite coordinates, one
+//    property value per vertex).
+//  - decode_simplify_case: turns arbitrary bytes into a small mesh plus SimplifyOptions. Our own
+//    byte reader rather than libFuzzer's FuzzedDataProvider, so the decoding is identical in the
+//    fuzzer and in the GCC-built regression tests.
+//  - check_simplify_result: the guarantees of simplify.h on the output.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <string>
+
+#include "qem/mesh.h"
+#include "qem/simplify.h"
+
+namespace qem::fuzz {
+
+/// "" when `m` keeps the reader's promises, else what is wrong.
+inline std::string check_mesh(const Mesh& m) {
+  if (m.positions.size() % 3 != 0) return "positions.size() is not a multiple of 3";
+  if (m.indices.size() % 3 != 0) return "indices.size() is not a multiple of 3";
+  const std::size_t nv = m.vertex_count();
+  for (std::size_t i = 0; i < m.indices.size(); ++i)
+    if (m.indices[i] >= nv)
+      return "face " + std::to_string(i / 3) + " index " + std::to_string(m.indices[i]) +
+             " >= " + std::to_string(nv) + " vertices";
+  for (std::size_t i = 0; i < m.positions.size(); ++i)
+    if (!std::isfinite(m.positions[i])) return "vertex " + std::to_string(i / 3) + " is not finite";
+  for (const VertexProperty& p : m.vertex_properties)
+    if (p.values.size() != nv)
+      return "property " + p.name + " has " + std::to_string(p.values.size()) + " values for " +
+             std::to_string(nv) + " vertices";
+  return "";
+}
+
+/// Reads little pieces of an input; past the end it yields zeros, so every input decodes.
+class ByteReader {
+ public:
+  ByteReader(const std::uint8_t* data, std::size_t size) : data_(data), size_(size) {}
+  std::uint8_t byte() { return pos_ < size_ ? data_[pos_++] : 0; }
+  std::uint16_t u16() { return std::uint16_t(byte() | (std::uint16_t(byte()) << 8)); }
+  std::uint64_t u64() {
+    std::uint64_t v = 0;
+    for (int k = 0; k < 8; ++k) v |= std::uint64_t(byte()) << (8 * k);
+    return v;
+  }
+  bool flag() { return byte() & 1; }
+  /// A uniform-ish value in [lo, hi].
+  double in_range(double lo, double hi) { return lo + (hi - lo) * (u16() / 65535.0); }
+  bool empty() const { return pos_ >= size_; }
+
+ private:
+  const std::uint8_t* data_;
+  std::size_t size_;
+  std::size_t pos_ = 0;
+};
+
+struct SimplifyCase {
+  Mesh mesh;
+  SimplifyOptions options;
+};
+
+/// A coordinate in one of three flavours: a coarse lattice (coincident, collinear and coplanar
+/// points are likely, the degenerate cases of GH97 §4), a fine one, or raw finite doubles whose
+/// magnitude is capped so that quadric products (fourth powers) cannot overflow.
+inline double decode_coordinate(ByteReader& in, int flavour) {
+  switch (flavour) {
+    case 0:
+      return (int(in.byte() % 9) - 4) * 0.5;
+    case 1:
+      return in.in_range(-1000, 1000);
+    default: {
+      std::uint64_t bits = in.u64();
+      double x;
+      std::memcpy(&x, &bits, sizeof x);
+      if (!std::isfinite(x) || std::fabs(x) > 1e15) x = std::fmod(double(bits >> 11), 2e6) - 1e6;
+      return x;
+    }
+  }
+}
+
+inline SimplifyCase decode_simplify_case(const std::uint8_t* data, std::size_t size) {
+  ByteReader in(data, size);
+  SimplifyCase c;
+  // --- options first, so that a short input still varies them ------------------------------------
+  SimplifyOptions& o = c.options;
+  const std::uint8_t targets = in.byte();
+  const std::uint8_t nf_hint = in.byte();
+  if (targets & 1) o.target_faces = in.byte() % (nf_hint % 128 + 2);
+  if (targets & 2) o.target_ratio = in.byte() / 255.0;
+  if (targets & 4) o.target_vertices = in.byte() % 40;
+  if (targets & 8) {
+    o.max_error = in.in_range(0, 2);
+    o.max_error_is_relative = in.flag();
+  }
+  if (!(targets & 15)) o.target_ratio = 0.5;  // something to do
+  o.weighting = static_cast<Weighting>(in.byte() % 3);
+  o.placement = static_cast<Placement>(in.byte() % 4);
+  const std::uint8_t misc = in.byte();
+  if (misc & 1) {
+    o.threshold = in.in_range(0, 1.5);
+    o.threshold_is_relative = misc & 2;
+  }
+  static const double kBoundaryWeights[] = {0, 1, 1000, 1e8};
+  o.boundary_weight = kBoundaryWeights[(misc >> 2) & 3];
+  o.lock_border = misc & 16;
+  o.preserve_topology = misc & 32;
+  o.inversion = static_cast<InversionPolicy>(in.byte() % 3);
+  o.max_normal_turn_degrees = in.in_range(1, 89.9);
+  // Now and then an invalid option: simplify must throw qem::Error, not misbehave.
+  if ((misc & 0xC0) == 0xC0) {
+    switch (in.byte() % 4) {
+      case 0:
+        o.target_ratio = -0.5;
+        break;
+      case 1:
+        o.max_normal_turn_degrees = 120;
+        break;
+      case 2:
+        o.threshold = -1;
+        break;
+      default:
+        o.max_error = std::numeric_limits<double>::quiet_NaN();
+        break;
+    }
+  }
+
+  // --- the mesh: up to 64 vertices and 127 faces, all indices in range ----------------------------
+  const int flavour = in.byte() % 3;
+  const std::size_t nv = 3 + in.byte() % 62;
+  for (std::size_t v = 0; v < nv; ++v)
+    for (int k = 0; k < 3; ++k) c.mesh.positions.push_back(decode_coordinate(in, flavour));
+  const std::size_t nf = nf_hint % 128;
+  for (std::size_t f = 0; f < nf && !in.empty(); ++f) {
+    // Mostly faces near the previous one, so the faces share edges and form surfaces.
+    std::uint32_t base = std::uint32_t(in.byte() % nv);
+    std::uint8_t spread = in.byte();
+    for (int k = 0; k < 3; ++k)
+      c.mesh.indices.push_back(std::uint32_t((base + (spread & 0x80 ? in.byte() : in.byte() % 4)) % nv));
+  }
+  return c;
+}
+
+/// "" when the result keeps simplify.h's promises, else what is wrong.
+inline std::string check_simplify_result(const SimplifyCase& c, const SimplifyResult& r) {
+  std::string mesh_problem = check_mesh(r.mesh);
+  if (!mesh_problem.empty()) return "output: " + mesh_problem;
+  const Mesh& m = r.mesh;
+  if (m.face_count() > c.mesh.face_count()) return "more output faces than input faces";
+  std::vector<std::uint8_t> used(m.vertex_count(), 0);
+  for (std::size_t f = 0; f < m.face_count(); ++f) {
+    const std::uint32_t* t = &m.indices[3 * f];
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
+      return "output face " + std::to_string(f) + " has a repeated index";
+    used[t[0]] = used[t[1]] = used[t[2]] = 1;
+  }
+  for (std::size_t v = 0; v < used.size(); ++v)
+    if (!used[v]) return "output vertex " + std::to_string(v) + " is unreferenced";
+  if (!(r.max_error >= 0)) return "max_error is negative or NaN";
+  return "";
+}
+
+}  // namespace qem::fuzz

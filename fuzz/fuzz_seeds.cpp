@@ -1,0 +1,228 @@
+// fuzz_seeds OUTDIR: writes the seed corpora and dictionaries the fuzzers start from, all made in
+// code (no copied files): small meshes serialised by qem's own writers in every format and variant,
+// plus hand-written files that use the format features the writers never emit (polygons, comments,
+// negative OBJ indices, PLY extra properties and big-endian data, COFF colours...).
+//
+//   OUTDIR/{obj,ply,stl,off,simplify}/seed_*   one file per seed
+//   OUTDIR/{obj,ply,stl,off}.dict              libFuzzer dictionaries (-dict=)
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "qem/io.h"
+#include "qem/mesh.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+void write_file(const fs::path& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out.write(bytes.data(), std::streamsize(bytes.size()));
+  if (!out) {
+    std::fprintf(stderr, "fuzz_seeds: cannot write %s\n", path.string().c_str());
+    std::exit(1);
+  }
+}
+
+qem::Mesh tetrahedron() {
+  qem::Mesh m;
+  m.positions = {1, 1, 1, 1, -1, -1, -1, 1, -1, -1, -1, 1};
+  m.indices = {0, 1, 2, 0, 3, 1, 0, 2, 3, 1, 3, 2};
+  return m;
+}
+
+qem::Mesh cube() {
+  qem::Mesh m;
+  m.positions = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1};
+  m.indices = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4,
+               1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7};
+  return m;
+}
+
+/// A wavy n x n grid with one scalar property per vertex (for the PLY property paths).
+qem::Mesh grid(int n) {
+  qem::Mesh m;
+  qem::VertexProperty k{"quality", {}};
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      double x = double(i) / n, y = double(j) / n;
+      m.positions.insert(m.positions.end(), {x, y, 0.1 * std::sin(6 * x) * std::cos(5 * y)});
+      k.values.push_back(x - y);
+    }
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      std::uint32_t a = std::uint32_t(j * (n + 1) + i), b = a + 1, c = a + std::uint32_t(n) + 2, d = c - 1;
+      m.indices.insert(m.indices.end(), {a, b, c, a, c, d});
+    }
+  m.vertex_properties.push_back(std::move(k));
+  return m;
+}
+
+/// One degenerate face, one unreferenced vertex, awkward coordinates.
+qem::Mesh odd() {
+  qem::Mesh m;
+  m.positions = {0, 0, 0, 1e-300, 0, 0, 0, 1e300, 0, -0.0, 0.1, 3.25, 7, 7, 7};
+  m.indices = {0, 1, 2, 0, 0, 3, 1, 2, 3};
+  return m;
+}
+
+void serialised_seeds(const fs::path& out) {
+  struct Named {
+    const char* name;
+    qem::Mesh mesh;
+  };
+  const std::vector<Named> meshes = {{"tetrahedron", tetrahedron()},
+                                     {"cube", cube()},
+                                     {"grid", grid(3)},
+                                     {"odd", odd()},
+                                     {"empty", qem::Mesh{}}};
+  struct Format {
+    qem::FileFormat format;
+    const char* dir;
+    bool has_binary;
+  };
+  const Format formats[] = {{qem::FileFormat::Obj, "obj", false},
+                            {qem::FileFormat::Ply, "ply", true},
+                            {qem::FileFormat::Stl, "stl", true},
+                            {qem::FileFormat::Off, "off", false}};
+  for (const Format& f : formats)
+    for (const Named& m : meshes)
+      for (bool binary : {false, true}) {
+        if (binary && !f.has_binary) continue;
+        std::string file = std::string("seed_") + m.name + (binary ? "_binary" : "_ascii");
+        write_file(out / f.dir / file, qem::serialize_mesh(m.mesh, f.format, binary));
+      }
+}
+
+/// Big-endian binary PLY with an extra property, uchar counts and a quad, built byte by byte.
+std::string ply_big_endian() {
+  std::string s =
+      "ply\nformat binary_big_endian 1.0\ncomment made by fuzz_seeds\nelement vertex 4\n"
+      "property float x\nproperty float y\nproperty float z\nproperty uchar red\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  auto be32 = [&s](std::uint32_t v) {
+    for (int k = 3; k >= 0; --k) s += char((v >> (8 * k)) & 0xff);
+  };
+  auto f32 = [&be32](float x) {
+    std::uint32_t bits;
+    std::memcpy(&bits, &x, 4);
+    be32(bits);
+  };
+  const float p[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  for (const auto& v : p) {
+    for (float x : v) f32(x);
+    s += char(200);
+  }
+  s += char(4);
+  for (std::uint32_t i = 0; i < 4; ++i) be32(i);
+  return s;
+}
+
+void handwritten_seeds(const fs::path& out) {
+  write_file(out / "obj" / "hand_polygons",
+             "# polygons, slashes, negative indices, groups, a line continuation\n"
+             "mtllib x.mtl\no thing\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 0.5 1 0.2 0.4 0.6\n"
+             "vt 0 0\nvt 1 0\nvn 0 0 1\ng top\nusemtl red\ns off\n"
+             "f 1/1/1 2/2/1 3//1 4\nf -5 -4 \\\n -1\nf 2 3 5\nl 1 2\n");
+  write_file(out / "obj" / "hand_crlf", "v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 3\r\n");
+  write_file(out / "ply" / "hand_ascii_props",
+             "ply\nformat ascii 1.0\nelement vertex 4\nproperty double x\nproperty double y\n"
+             "property double z\nproperty float confidence\nproperty float intensity\n"
+             "element face 2\nproperty list uchar uint vertex_indices\nproperty uchar red\n"
+             "element edge 1\nproperty int vertex1\nproperty int vertex2\nend_header\n"
+             "0 0 0 1 0.5\n1 0 0 1 0.5\n1 1 0 0.5 1\n0 1 0 0.25 0\n3 0 1 2 7\n4 0 1 2 3 9\n0 1\n");
+  write_file(out / "ply" / "hand_big_endian", ply_big_endian());
+  write_file(
+      out / "stl" / "hand_ascii",
+      "solid part\n  facet normal 0 0 1\n    outer loop\n      vertex 0 0 0\n      vertex 1 0 0\n"
+      "      vertex 0 1 0\n    endloop\n  endfacet\n  facet normal 0 0 -1\n    outer loop\n"
+      "      vertex 0 0 0\n      vertex 0 1 0\n      vertex 1 0 0\n    endloop\n  endfacet\nendsolid part\n");
+  write_file(out / "off" / "hand_coff",
+             "COFF\n# colours and a quad\n4 2 0\n0 0 0 255 0 0 255\n1 0 0 0 255 0 255\n"
+             "1 1 0 0 0 255 255\n0 1 0 9 9 9 255\n3 0 1 2\n4 0 1 2 3 1 0 0\n");
+  write_file(out / "off" / "hand_oneline", "OFF 3 1 0\n0 0 0 1 0 0 0 1 0 3 0 1 2\n");
+}
+
+void simplify_seeds(const fs::path& out) {
+  // The simplify fuzzer decodes any bytes into a case, so varied random bytes are valid seeds.
+  std::mt19937 rng(20240601);
+  const std::size_t sizes[] = {16, 64, 200, 400, 700, 1000, 1500, 2000};
+  int n = 0;
+  for (std::size_t size : sizes)
+    for (int rep = 0; rep < 3; ++rep) {
+      std::string bytes(size, '\0');
+      for (char& c : bytes) c = char(rng() & 0xff);
+      write_file(out / "simplify" / ("seed_random_" + std::to_string(n++)), bytes);
+    }
+}
+
+void dictionaries(const fs::path& out) {
+  auto dict = [&out](const char* name, const std::vector<std::string>& words) {
+    std::string s;
+    for (std::size_t i = 0; i < words.size(); ++i) s += "kw" + std::to_string(i) + "=\"" + words[i] + "\"\n";
+    write_file(out / name, s);
+  };
+  dict("obj.dict", {"v ", "vt ", "vn ", "f ", "/", "//", "-1", "#", "\\\\\\x0a", "g ", "o ", "usemtl ",
+                    "mtllib ", "1e308", "nan", "inf", "\\x0d\\x0a"});
+  dict("ply.dict", {"ply\\x0a",
+                    "format ",
+                    "ascii 1.0",
+                    "binary_little_endian 1.0",
+                    "binary_big_endian 1.0",
+                    "element ",
+                    "vertex ",
+                    "face ",
+                    "property ",
+                    "list ",
+                    "uchar ",
+                    "int ",
+                    "uint ",
+                    "float ",
+                    "double ",
+                    "short ",
+                    "char ",
+                    "ushort ",
+                    "int8 ",
+                    "uint8 ",
+                    "int16 ",
+                    "uint32 ",
+                    "float32 ",
+                    "float64 ",
+                    "vertex_indices",
+                    "vertex_index",
+                    "end_header\\x0a",
+                    "comment ",
+                    "obj_info ",
+                    "x",
+                    "y",
+                    "z",
+                    "\\xff\\xff\\xff\\xff"});
+  dict("stl.dict", {"solid ", "facet normal ", "outer loop", "vertex ", "endloop", "endfacet", "endsolid",
+                    "\\x00\\x00\\x00\\x00", "\\xff\\xff\\xff\\x7f"});
+  dict("off.dict",
+       {"OFF", "COFF", "NOFF", "CNOFF", "STOFF", "4OFF", "nOFF", "#", "3 ", "4 ", "-1", "1e308", "nan"});
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 2) {
+    std::fprintf(stderr, "usage: fuzz_seeds OUTDIR\n");
+    return 2;
+  }
+  const fs::path out = argv[1];
+  for (const char* dir : {"obj", "ply", "stl", "off", "simplify"}) fs::create_directories(out / dir);
+  serialised_seeds(out);
+  handwritten_seeds(out);
+  simplify_seeds(out);
+  dictionaries(out);
+  return 0;
+}

@@ -1,0 +1,9 @@
+// The whole public API of qem in one include.
+#pragma once
+
+#include "qem/error.h"
+#include "qem/io.h"
+#include "qem/measure.h"
+#include "qem/mesh.h"
+#include "qem/mesh_info.h"
+#include "qem/simplify.h"

@@ -1,0 +1,91 @@
+// Surface simplification by iterative pair contraction with quadric error metrics
+// (Garland & Heckbert 1997, "GH97"; area weighting from Heckbert & Garland 1999, "HG99").
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <string>
+
+#include "qem/mesh.h"
+
+namespace qem {
+
+/// How face planes are weighted when vertex quadrics are accumulated.
+enum class Weighting {
+  Area,     ///< by triangle area (HG99 §2): the quadric integrates squared distance over the surface
+  Uniform,  ///< every plane counts once (GH97 §5)
+  Angle,    ///< by the triangle's corner angle at the vertex
+};
+
+/// Where a contracted pair's new vertex goes (GH97 §4).
+enum class Placement {
+  Optimal,    ///< minimise the quadric (3x3 solve); fall back to Segment, then Endpoints+midpoint
+  Segment,    ///< the best point on the segment v1-v2
+  Midpoint,   ///< always the midpoint
+  Endpoints,  ///< the better endpoint or the midpoint ("fixed placement" of GH97 Fig. 6)
+};
+
+/// What happens to a contraction that would flip a neighbouring face (GH97 §6).
+enum class InversionPolicy { Forbid, Penalize, Ignore };
+
+/// Why simplification stopped.
+enum class StopReason {
+  TargetReached,    ///< a face / vertex count target was met
+  ErrorLimit,       ///< every remaining contraction exceeds max_error
+  NoValidPair,      ///< no contraction is allowed (locked borders, topology, inversion) before the target
+  AlreadyBelowTarget,
+  Cancelled,
+};
+const char* to_string(StopReason reason);
+const char* to_string(Weighting w);
+const char* to_string(Placement p);
+
+struct SimplifyOptions {
+  // --- stop criteria: any combination, the first reached wins -----------------------------------
+  std::size_t target_faces = 0;     ///< stop at or below this many faces (0 = no face target)
+  double target_ratio = 0;          ///< stop at or below ratio * input faces (0 = unused)
+  std::size_t target_vertices = 0;  ///< stop at or below this many vertices (0 = unused)
+  /// Largest allowed contraction error, in distance units: sqrt(Q(v) / weight of Q), i.e. the
+  /// weighted RMS distance from the new vertex to the planes it represents. +inf = no limit.
+  double max_error = std::numeric_limits<double>::infinity();
+  bool max_error_is_relative = false;  ///< max_error is a fraction of the bounding-box diagonal
+
+  // --- the algorithm --------------------------------------------------------------------------
+  Weighting weighting = Weighting::Area;
+  Placement placement = Placement::Optimal;
+  /// Pair threshold t of GH97 §3.2: vertices closer than t are valid pairs too (0 = edges only).
+  double threshold = 0;
+  bool threshold_is_relative = false;  ///< threshold is a fraction of the bounding-box diagonal
+  /// Penalty weight of the boundary constraint planes (GH97 §6); 0 disables them.
+  double boundary_weight = 1000;
+  bool lock_border = false;  ///< boundary vertices never move
+  InversionPolicy inversion = InversionPolicy::Forbid;
+  /// A face that turns by more than this (degrees) counts as an inversion; must be < 90.
+  double max_normal_turn_degrees = 75;
+  /// Refuse edge collapses that break the link condition (non-manifold edges, duplicate faces).
+  bool preserve_topology = true;
+
+  /// Called every so often with the fraction done (0..1); return false to cancel.
+  std::function<bool(double)> progress;
+};
+
+struct SimplifyResult {
+  Mesh mesh;                        ///< the approximation; unreferenced vertices dropped
+  std::size_t input_faces = 0;      ///< after dropping degenerate input faces
+  std::size_t input_vertices = 0;   ///< referenced vertices of the input
+  std::size_t contractions = 0;
+  std::size_t virtual_pairs = 0;    ///< non-edge pairs found with the threshold t
+  double max_error = 0;             ///< largest contraction error performed (distance units)
+  double max_error_relative = 0;    ///< the same over the bounding-box diagonal
+  StopReason stop_reason = StopReason::TargetReached;
+  std::string stop_detail;          ///< human-readable explanation of the stop
+};
+
+/// Simplifies a mesh. Input positions are never normalised in the output: vertices that did not
+/// move keep their exact input coordinates. Deterministic: the same input and options give the
+/// same output. Throws qem::Error on invalid options or indices.
+SimplifyResult simplify(MeshView input, const SimplifyOptions& options);
+
+}  // namespace qem

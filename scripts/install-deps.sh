@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# Installs everything qem needs to build and test on Debian 12 (run as root, or with sudo).
+set -euo pipefail
+SUDO=""
+if [ "$(id -u)" != 0 ]; then SUDO=sudo; fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update
+# build: compiler, CMake; libraries: Eigen (3x3 / eigen solves), CLI11 (command line),
+# fast_float (number parsing in the text readers); tests: GoogleTest, Google Benchmark;
+# clang + libclang-rt for the libFuzzer targets.
+$SUDO apt-get install -y --no-install-recommends \
+  build-essential cmake g++ python3 \
+  libeigen3-dev libcli11-dev libfast-float-dev \
+  libgtest-dev libgmock-dev libbenchmark-dev \
+  clang libclang-rt-14-dev

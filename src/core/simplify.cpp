@@ -1,0 +1,694 @@
+// Iterative pair contraction (GH97 §4), the heart of qem.
+//
+// Pipeline (each step one function below):
+//   prepare_input        validate, drop degenerate and duplicate faces, normalise the frame
+//   build_adjacency      per-vertex face lists
+//   compute_quadrics     GH97 §5 fundamental quadrics, weighted (HG99 §2), + boundary planes (GH97 §6)
+//   select_pairs         GH97 §3.2: edges + pairs closer than t
+//   cost every pair, heap them, then repeatedly: pop the cheapest, check it (topology, inversion,
+//   error limit), contract it, re-cost the pairs of the new vertex.
+//
+// Everything runs in a normalised frame (centred, bounding-box diagonal 1), so every tolerance is
+// relative and the result does not depend on the model's position or scale; vertices that never
+// move are written back with their exact input coordinates.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "core/indexed_heap.h"
+#include "core/placement.h"
+#include "core/quadric.h"
+#include "core/valid_pairs.h"
+#include "core/vertex_lists.h"
+#include "qem/error.h"
+#include "qem/simplify.h"
+
+namespace qem {
+
+const char* to_string(StopReason reason) {
+  switch (reason) {
+    case StopReason::TargetReached: return "target reached";
+    case StopReason::ErrorLimit: return "error limit reached";
+    case StopReason::NoValidPair: return "no valid contraction left";
+    case StopReason::AlreadyBelowTarget: return "input already at or below target";
+    case StopReason::Cancelled: return "cancelled";
+  }
+  return "?";
+}
+const char* to_string(Weighting w) {
+  switch (w) {
+    case Weighting::Area: return "area";
+    case Weighting::Uniform: return "uniform";
+    case Weighting::Angle: return "angle";
+  }
+  return "?";
+}
+const char* to_string(Placement p) {
+  switch (p) {
+    case Placement::Optimal: return "optimal";
+    case Placement::Segment: return "segment";
+    case Placement::Midpoint: return "midpoint";
+    case Placement::Endpoints: return "endpoints";
+  }
+  return "?";
+}
+
+namespace {
+
+using namespace core;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+enum PairState : std::uint8_t {
+  kInHeap,   // candidate, keyed in the heap
+  kBlocked,  // rejected at its last check (topology, inversion, error limit); retried when its
+             // neighbourhood changes
+  kLocked,   // can never be contracted (both ends on a locked border)
+  kDead,     // contracted, or merged into a duplicate
+};
+
+class Simplifier {
+ public:
+  Simplifier(MeshView input, const SimplifyOptions& options) : in_(input), opt_(options), heap_(cost_) {}
+
+  SimplifyResult run();
+
+ private:
+  // --- setup --------------------------------------------------------------------------------
+  void prepare_input();
+  void build_adjacency();
+  void compute_quadrics();
+  void select_pairs();
+  void resolve_targets();
+
+  // --- the contraction loop ------------------------------------------------------------------
+  void cost_pair(std::uint32_t p);
+  bool is_edge_and_link_ok(std::uint32_t a, std::uint32_t b, bool& is_edge);
+  bool flips(std::uint32_t a, std::uint32_t b, const Vec3& target);
+  bool placement_for(std::uint32_t p, Quadric& q, Placed& placed);
+  void contract(std::uint32_t p, const Quadric& q, const Vec3& target);
+  void block(std::uint32_t p);
+  void unblock_around(std::uint32_t v);
+  bool done() const { return faces_alive_ <= target_faces_ || vertices_alive_ <= target_vertices_; }
+  double normalized_error(double q_error, double weight) const {
+    return weight > 0 ? std::sqrt(q_error / weight) : std::sqrt(q_error);
+  }
+  void kill_face(std::uint32_t f) {
+    face_alive_[f] = 0;
+    --faces_alive_;
+  }
+  bool face_has(std::uint32_t f, std::uint32_t v) const {
+    const std::uint32_t* t = &tri_[3 * std::size_t(f)];
+    return t[0] == v || t[1] == v || t[2] == v;
+  }
+  Vec3 face_normal(const std::uint32_t* t, std::uint32_t moved, const Vec3& to) const {
+    const Vec3& p0 = t[0] == moved ? to : pos_[t[0]];
+    const Vec3& p1 = t[1] == moved ? to : pos_[t[1]];
+    const Vec3& p2 = t[2] == moved ? to : pos_[t[2]];
+    return cross(p1 - p0, p2 - p0);
+  }
+  SimplifyResult build_output();
+
+  MeshView in_;
+  const SimplifyOptions& opt_;
+
+  // Normalised frame: p_work = (p_in - center_) / scale_.
+  Vec3 center_;
+  double scale_ = 1;
+
+  std::vector<Vec3> pos_;
+  std::vector<Quadric> quadric_;
+  std::vector<std::uint8_t> vertex_alive_, boundary_, moved_, has_blocked_;
+  std::vector<std::uint32_t> tri_;  // 3 per working face
+  std::vector<std::uint32_t> face_source_;  // input face index of each working face
+  std::vector<std::uint8_t> face_alive_;
+  VertexLists vertex_faces_, vertex_pairs_;
+
+  std::vector<std::uint32_t> pair_v_;  // 2 per pair
+  std::vector<std::uint8_t> pair_state_;
+  std::vector<std::uint8_t> pair_virtual_;  // 1 = created by the threshold t, not an edge
+  std::vector<double> cost_;
+  IndexedHeap heap_;
+
+  // Stamps for set membership without clearing (one array, fresh stamp per query).
+  std::vector<std::uint32_t> mark_;
+  std::uint32_t stamp_ = 0;
+  std::vector<std::uint32_t> scratch_, scratch2_;
+
+  std::size_t faces_alive_ = 0, vertices_alive_ = 0;
+  std::size_t target_faces_ = 0, target_vertices_ = 0;
+  double max_error_norm_ = kInf;   // error limit in the normalised frame
+  double cos_max_turn_ = 0;
+  std::size_t dropped_degenerate_ = 0, dropped_duplicate_ = 0;
+  std::size_t blocked_by_error_ = 0, blocked_by_topology_ = 0, blocked_by_inversion_ = 0;
+  std::size_t virtual_pairs_ = 0;
+
+  SimplifyResult result_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Setup
+// ---------------------------------------------------------------------------------------------
+
+void Simplifier::prepare_input() {
+  const std::size_t nv = in_.vertex_count(), nf = in_.face_count();
+  if (in_.positions.size() % 3 != 0) throw Error("positions must hold 3 numbers per vertex");
+  if (in_.indices.size() % 3 != 0) throw Error("indices must hold 3 numbers per triangle");
+  for (std::size_t i = 0; i < in_.positions.size(); ++i)
+    if (!std::isfinite(in_.positions[i]))
+      throw Error("vertex " + std::to_string(i / 3) + " has a non-finite coordinate");
+  for (std::size_t i = 0; i < in_.indices.size(); ++i)
+    if (in_.indices[i] >= nv)
+      throw Error("face " + std::to_string(i / 3) + " refers to vertex " + std::to_string(in_.indices[i]) +
+                  ", but there are only " + std::to_string(nv) + " vertices");
+
+  // Degenerate faces (a repeated corner) carry no plane and no area: drop them. Duplicate faces
+  // (same three vertices, either orientation) would count their plane twice and survive as
+  // duplicates in the output: keep the first.
+  std::vector<std::pair<std::array<std::uint32_t, 3>, std::uint32_t>> sorted;
+  sorted.reserve(nf);
+  for (std::uint32_t f = 0; f < nf; ++f) {
+    std::array<std::uint32_t, 3> t{in_.indices[3 * f], in_.indices[3 * f + 1], in_.indices[3 * f + 2]};
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
+      ++dropped_degenerate_;
+      continue;
+    }
+    std::sort(t.begin(), t.end());
+    sorted.push_back({t, f});
+  }
+  std::sort(sorted.begin(), sorted.end());
+  std::vector<std::uint8_t> keep(nf, 0);
+  for (std::size_t i = 0; i < sorted.size(); ++i) {
+    if (i > 0 && sorted[i].first == sorted[i - 1].first) {
+      ++dropped_duplicate_;
+      continue;
+    }
+    keep[sorted[i].second] = 1;
+  }
+  for (std::uint32_t f = 0; f < nf; ++f) {
+    if (!keep[f]) continue;
+    tri_.insert(tri_.end(), {in_.indices[3 * f], in_.indices[3 * f + 1], in_.indices[3 * f + 2]});
+    face_source_.push_back(f);
+  }
+  faces_alive_ = face_source_.size();
+  face_alive_.assign(faces_alive_, 1);
+
+  vertex_alive_.assign(nv, 0);
+  for (std::uint32_t v : tri_) vertex_alive_[v] = 1;
+  vertices_alive_ = 0;
+  for (std::uint8_t a : vertex_alive_) vertices_alive_ += a;
+
+  // Normalised frame from the referenced vertices' bounding box.
+  double lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
+  for (std::size_t v = 0; v < nv; ++v) {
+    if (!vertex_alive_[v]) continue;
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], in_.positions[3 * v + k]);
+      hi[k] = std::max(hi[k], in_.positions[3 * v + k]);
+    }
+  }
+  if (vertices_alive_ > 0) {
+    center_ = {(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2};
+    Vec3 extent{hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+    scale_ = length(extent);
+    if (!(scale_ > 0) || !std::isfinite(scale_)) scale_ = 1;
+  }
+  pos_.resize(nv);
+  for (std::size_t v = 0; v < nv; ++v)
+    pos_[v] = Vec3(in_.positions[3 * v], in_.positions[3 * v + 1], in_.positions[3 * v + 2]) - center_;
+  for (Vec3& p : pos_) p = p * (1.0 / scale_);
+
+  moved_.assign(nv, 0);
+  boundary_.assign(nv, 0);
+  has_blocked_.assign(nv, 0);
+  mark_.assign(nv, 0);
+  result_.input_faces = faces_alive_;
+  result_.input_vertices = vertices_alive_;
+}
+
+void Simplifier::build_adjacency() {
+  std::vector<std::uint32_t> count(pos_.size(), 0);
+  for (std::uint32_t v : tri_) ++count[v];
+  vertex_faces_.layout(count);
+  for (std::uint32_t f = 0; f < face_source_.size(); ++f)
+    for (int k = 0; k < 3; ++k) vertex_faces_.push_initial(tri_[3 * f + k], f);
+}
+
+void Simplifier::compute_quadrics() {
+  quadric_.assign(pos_.size(), Quadric{});
+  for (std::uint32_t f = 0; f < face_source_.size(); ++f) {
+    const std::uint32_t* t = &tri_[3 * std::size_t(f)];
+    Vec3 n = cross(pos_[t[1]] - pos_[t[0]], pos_[t[2]] - pos_[t[0]]);
+    double len = length(n);
+    if (!(len > 0)) continue;  // zero-area face: no plane (GH97 §5 needs a unit normal)
+    n = n * (1.0 / len);
+    double d = -dot(n, pos_[t[0]]);
+    switch (opt_.weighting) {
+      case Weighting::Area: {  // HG99 §2: the quadric integrates squared distance over the area
+        Quadric q = Quadric::plane(n, d, len / 2);
+        for (int k = 0; k < 3; ++k) quadric_[t[k]] += q;
+        break;
+      }
+      case Weighting::Uniform: {  // GH97 §5
+        Quadric q = Quadric::plane(n, d, 1);
+        for (int k = 0; k < 3; ++k) quadric_[t[k]] += q;
+        break;
+      }
+      case Weighting::Angle:  // each corner weighs its plane by its own angle
+        for (int k = 0; k < 3; ++k) {
+          Vec3 e1 = pos_[t[(k + 1) % 3]] - pos_[t[k]], e2 = pos_[t[(k + 2) % 3]] - pos_[t[k]];
+          double angle = std::atan2(length(cross(e1, e2)), dot(e1, e2));
+          quadric_[t[k]] += Quadric::plane(n, d, angle);
+        }
+        break;
+    }
+  }
+}
+
+void Simplifier::select_pairs() {
+  std::vector<Edge> edges = unique_edges(tri_);
+
+  // Boundary edges (one incident face): mark their vertices, and add GH97 §6's constraint plane
+  // through the edge, perpendicular to its face, weighted by the penalty. The weight grows with
+  // the squared edge length so that it stays in proportion to the area-weighted face quadrics at
+  // every resolution and scale.
+  for (const Edge& e : edges) {
+    if (e.faces != 1) continue;
+    boundary_[e.lo] = boundary_[e.hi] = 1;
+    if (!(opt_.boundary_weight > 0)) continue;
+    std::uint32_t face = 0;
+    for (std::uint32_t f : vertex_faces_[e.lo])
+      if (face_has(f, e.hi)) face = f;
+    const std::uint32_t* t = &tri_[3 * std::size_t(face)];
+    Vec3 n = cross(pos_[t[1]] - pos_[t[0]], pos_[t[2]] - pos_[t[0]]);
+    Vec3 edge = pos_[e.hi] - pos_[e.lo];
+    Vec3 m = cross(edge, n);
+    double len = length(m);
+    if (!(len > 0)) continue;
+    m = m * (1.0 / len);
+    double w = opt_.boundary_weight * (opt_.weighting == Weighting::Area ? dot(edge, edge) : 1.0);
+    Quadric q = Quadric::plane(m, -dot(m, pos_[e.lo]), w);
+    q.weight = 0;  // a constraint, not surface: it must not dilute the reported mean distance
+    quadric_[e.lo] += q;
+    quadric_[e.hi] += q;
+  }
+
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> virtual_pairs;
+  if (opt_.threshold > 0) {
+    double t = opt_.threshold_is_relative ? opt_.threshold : opt_.threshold / scale_;
+    std::vector<std::uint32_t> candidates;
+    for (std::uint32_t v = 0; v < pos_.size(); ++v)
+      if (vertex_alive_[v]) candidates.push_back(v);
+    virtual_pairs = close_pairs(pos_, candidates, t, edges, std::max<std::size_t>(4 * candidates.size(), 1000));
+  }
+  virtual_pairs_ = virtual_pairs.size();
+
+  const std::size_t np = edges.size() + virtual_pairs.size();
+  if (np >= 0xffffffffu) throw Error("too many pairs for 32-bit pair ids");
+  pair_v_.resize(2 * np);
+  pair_virtual_.assign(np, 0);
+  for (std::size_t i = 0; i < edges.size(); ++i) pair_v_[2 * i] = edges[i].lo, pair_v_[2 * i + 1] = edges[i].hi;
+  for (std::size_t i = 0; i < virtual_pairs.size(); ++i) {
+    std::size_t p = edges.size() + i;
+    pair_v_[2 * p] = virtual_pairs[i].first, pair_v_[2 * p + 1] = virtual_pairs[i].second;
+    pair_virtual_[p] = 1;
+  }
+  std::vector<std::uint32_t> count(pos_.size(), 0);
+  for (std::uint32_t v : pair_v_) ++count[v];
+  vertex_pairs_.layout(count);
+  for (std::uint32_t p = 0; p < np; ++p) {
+    vertex_pairs_.push_initial(pair_v_[2 * p], p);
+    vertex_pairs_.push_initial(pair_v_[2 * p + 1], p);
+  }
+  pair_state_.assign(np, kInHeap);
+  cost_.assign(np, 0);
+}
+
+void Simplifier::resolve_targets() {
+  const std::size_t nf = faces_alive_;
+  bool any = false;
+  target_faces_ = 0;
+  if (opt_.target_faces > 0) target_faces_ = opt_.target_faces, any = true;
+  if (opt_.target_ratio > 0) {
+    if (!(opt_.target_ratio <= 1)) throw Error("target ratio must be in (0, 1]");
+    std::size_t t = std::size_t(std::floor(opt_.target_ratio * double(nf)));
+    target_faces_ = any ? std::max(target_faces_, t) : t;
+    any = true;
+  }
+  target_vertices_ = 0;
+  if (opt_.target_vertices > 0) target_vertices_ = opt_.target_vertices, any = true;
+  if (std::isfinite(opt_.max_error)) {
+    if (opt_.max_error < 0) throw Error("max error must not be negative");
+    max_error_norm_ = opt_.max_error_is_relative ? opt_.max_error : opt_.max_error / scale_;
+    any = true;
+  }
+  if (!any) throw Error("no stop criterion: give a face, ratio, vertex or error target");
+  if (opt_.max_normal_turn_degrees <= 0 || opt_.max_normal_turn_degrees >= 90)
+    throw Error("the inversion angle limit must be in (0, 90) degrees");
+  if (opt_.threshold < 0) throw Error("threshold must not be negative");
+  if (opt_.boundary_weight < 0) throw Error("boundary weight must not be negative");
+  cos_max_turn_ = std::cos(opt_.max_normal_turn_degrees * 3.14159265358979323846 / 180.0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Costs and checks
+// ---------------------------------------------------------------------------------------------
+
+// The quadric and placement of pair p, honouring --lock-border. False if the pair can never move.
+bool Simplifier::placement_for(std::uint32_t p, Quadric& q, Placed& placed) {
+  std::uint32_t a = pair_v_[2 * p], b = pair_v_[2 * p + 1];
+  q = quadric_[a] + quadric_[b];
+  if (opt_.lock_border && (boundary_[a] || boundary_[b])) {
+    if (boundary_[a] && boundary_[b]) return false;
+    const Vec3& fixed = boundary_[a] ? pos_[a] : pos_[b];
+    placed = {fixed, q.evaluate(fixed)};
+    return true;
+  }
+  placed = place(q, pos_[a], pos_[b], opt_.placement);
+  return true;
+}
+
+void Simplifier::cost_pair(std::uint32_t p) {
+  Quadric q;
+  Placed placed;
+  if (!placement_for(p, q, placed)) {
+    pair_state_[p] = kLocked;
+    heap_.remove(p);
+    return;
+  }
+  double c = placed.error;
+  if (opt_.inversion == InversionPolicy::Penalize &&
+      flips(pair_v_[2 * p], pair_v_[2 * p + 1], placed.position))
+    c += q.weight > 0 ? q.weight : 1;  // as if moved by a whole diagonal: after every clean one
+  cost_[p] = c;
+  pair_state_[p] = kInHeap;
+  heap_.update(p);
+}
+
+// GH97 §6 "preventing mesh inversion": a face around a or b (that survives the contraction) whose
+// normal turns by more than the limit, or that would lose its area, forbids the contraction.
+bool Simplifier::flips(std::uint32_t a, std::uint32_t b, const Vec3& target) {
+  for (std::uint32_t end = 0; end < 2; ++end) {
+    std::uint32_t v = end == 0 ? a : b, other = end == 0 ? b : a;
+    for (std::uint32_t f : vertex_faces_[v]) {
+      if (!face_alive_[f] || face_has(f, other)) continue;
+      const std::uint32_t* t = &tri_[3 * std::size_t(f)];
+      Vec3 before = face_normal(t, v, pos_[v]);
+      Vec3 after = face_normal(t, v, target);
+      double lb = dot(before, before), la = dot(after, after);
+      if (!(lb > 0)) continue;  // a face that was already flat cannot flip
+      if (!(la > 1e-24 * lb)) return true;
+      double d = dot(before, after);
+      if (d <= 0 || d * d < cos_max_turn_ * cos_max_turn_ * la * lb) return true;
+    }
+  }
+  return false;
+}
+
+// Whether (a, b) is an edge, and if so whether collapsing it keeps the surface's topology
+// (the link condition of Dey et al.; the check GH97 leaves to the implementer): the vertices
+// adjacent to both a and b must be exactly the opposite corners of the faces on edge ab, the
+// collapse must not stack two faces onto the same three vertices, and an interior edge whose two
+// ends both lie on a border must not pinch the border.
+bool Simplifier::is_edge_and_link_ok(std::uint32_t a, std::uint32_t b, bool& is_edge) {
+  const std::uint32_t s_nbr = ++stamp_, s_opp = ++stamp_, s_common = ++stamp_;
+  std::size_t shared = 0, opposite = 0;
+  for (std::uint32_t f : vertex_faces_[a]) {
+    if (!face_alive_[f]) continue;
+    const std::uint32_t* t = &tri_[3 * std::size_t(f)];
+    if (face_has(f, b)) {
+      ++shared;
+      for (int k = 0; k < 3; ++k)
+        if (t[k] != a && t[k] != b && mark_[t[k]] != s_opp) mark_[t[k]] = s_opp, ++opposite;
+    } else {
+      for (int k = 0; k < 3; ++k)
+        if (t[k] != a && mark_[t[k]] != s_opp) mark_[t[k]] = s_nbr;
+    }
+  }
+  is_edge = shared > 0;
+  if (!is_edge || !opt_.preserve_topology) return true;
+  if (shared == 2 && boundary_[a] && boundary_[b]) return false;  // would pinch the border
+  // Neighbours of b that are also neighbours of a but not opposite corners break the link condition.
+  std::size_t common_opposite = 0;
+  for (std::uint32_t f : vertex_faces_[b]) {
+    if (!face_alive_[f] || face_has(f, a)) continue;
+    const std::uint32_t* t = &tri_[3 * std::size_t(f)];
+    int opp_corners = 0;
+    for (int k = 0; k < 3; ++k) {
+      std::uint32_t x = t[k];
+      if (x == b) continue;
+      if (mark_[x] == s_nbr) return false;
+      if (mark_[x] == s_opp || mark_[x] == s_common) {
+        ++opp_corners;
+        if (mark_[x] == s_opp) mark_[x] = s_common, ++common_opposite;
+      }
+    }
+    // A face (b, x, y) with x, y both opposite corners: if a also has a face (a, x, y), the
+    // collapse would stack two faces on the same vertices (the tetrahedron case).
+    if (opp_corners == 2) {
+      std::uint32_t x = t[0] == b ? t[1] : t[0], y = t[2] == b ? t[1] : t[2];
+      for (std::uint32_t g : vertex_faces_[a])
+        if (face_alive_[g] && face_has(g, x) && face_has(g, y)) return false;
+    }
+  }
+  (void)common_opposite;
+  return true;
+}
+
+void Simplifier::block(std::uint32_t p) {
+  pair_state_[p] = kBlocked;
+  has_blocked_[pair_v_[2 * p]] = has_blocked_[pair_v_[2 * p + 1]] = 1;
+}
+
+// The neighbourhood of v changed: pairs of v's neighbours that were rejected get another chance.
+void Simplifier::unblock_around(std::uint32_t v) {
+  for (std::uint32_t p : vertex_pairs_[v]) {
+    if (pair_state_[p] == kDead) continue;
+    std::uint32_t o = pair_v_[2 * p] == v ? pair_v_[2 * p + 1] : pair_v_[2 * p];
+    if (!has_blocked_[o]) continue;
+    has_blocked_[o] = 0;
+    for (std::uint32_t q : vertex_pairs_[o])
+      if (pair_state_[q] == kBlocked) cost_pair(q);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Contraction (GH97 §4 step 5): (a, b) -> a at `target`.
+// ---------------------------------------------------------------------------------------------
+
+void Simplifier::contract(std::uint32_t p, const Quadric& q, const Vec3& target) {
+  const std::uint32_t a = pair_v_[2 * p], b = pair_v_[2 * p + 1];
+  pos_[a] = target;
+  quadric_[a] = q;
+  boundary_[a] |= boundary_[b];
+  moved_[a] = 1;
+  vertex_alive_[b] = 0;
+  --vertices_alive_;
+
+  // Faces: those containing both ends degenerate and die; b's others now use a. Where the
+  // topology check did not run (virtual pairs, or --no-preserve-topology), a face can land on the
+  // same three vertices as one of a's: it dies too, so the output never has duplicate faces.
+  const bool may_duplicate = pair_virtual_[p] || !opt_.preserve_topology;
+  scratch_.clear();
+  for (std::uint32_t f : vertex_faces_[a]) {
+    if (!face_alive_[f]) continue;
+    if (face_has(f, b)) {
+      kill_face(f);
+      continue;
+    }
+    scratch_.push_back(f);
+  }
+  const std::size_t own = scratch_.size();
+  for (std::uint32_t f : vertex_faces_[b]) {
+    if (!face_alive_[f]) continue;
+    std::uint32_t* t = &tri_[3 * std::size_t(f)];
+    for (int k = 0; k < 3; ++k)
+      if (t[k] == b) t[k] = a;
+    if (may_duplicate) {
+      bool duplicate = false;
+      for (std::size_t i = 0; i < own && !duplicate; ++i) {
+        const std::uint32_t g = scratch_[i];
+        duplicate = face_has(g, t[0]) && face_has(g, t[1]) && face_has(g, t[2]);
+      }
+      if (duplicate) {
+        kill_face(f);
+        continue;
+      }
+    }
+    scratch_.push_back(f);
+  }
+  vertex_faces_.assign(a, scratch_.data(), scratch_.size());
+  vertex_faces_.clear(b);
+
+  // Pairs: GH97 §4 "pair sets merge": b's pairs now start at a; the contracted pair and any pair
+  // that now duplicates another (same two vertices) are removed.
+  pair_state_[p] = kDead;
+  heap_.remove(p);
+  const std::uint32_t s = ++stamp_;
+  mark_[a] = s;
+  scratch2_.clear();
+  for (int end = 0; end < 2; ++end) {
+    for (std::uint32_t r : vertex_pairs_[end == 0 ? a : b]) {
+      if (pair_state_[r] == kDead) continue;
+      std::uint32_t* v = &pair_v_[2 * std::size_t(r)];
+      if (v[0] == b) v[0] = a;
+      if (v[1] == b) v[1] = a;
+      std::uint32_t o = v[0] == a ? v[1] : v[0];
+      if (mark_[o] == s) {  // duplicate of a pair already kept (or a degenerate (a, a) pair)
+        pair_state_[r] = kDead;
+        heap_.remove(r);
+        continue;
+      }
+      mark_[o] = s;
+      if (v[0] > v[1]) std::swap(v[0], v[1]);
+      scratch2_.push_back(r);
+    }
+  }
+  vertex_pairs_.assign(a, scratch2_.data(), scratch2_.size());
+  vertex_pairs_.clear(b);
+
+  // GH97 §4 step 5: update the costs of all valid pairs involving the new vertex.
+  for (std::uint32_t r : vertex_pairs_[a])
+    if (pair_state_[r] != kLocked) cost_pair(r);
+  unblock_around(a);
+}
+
+// ---------------------------------------------------------------------------------------------
+
+SimplifyResult Simplifier::run() {
+  prepare_input();
+  resolve_targets();
+  if (done()) {
+    result_.stop_reason = StopReason::AlreadyBelowTarget;
+    result_.stop_detail = "the input already meets the target";
+    return build_output();
+  }
+  build_adjacency();
+  compute_quadrics();
+  select_pairs();
+  result_.virtual_pairs = virtual_pairs_;
+
+  // Initial costs and the heap (GH97 §4 steps 3-4).
+  {
+    std::vector<std::uint32_t> ids;
+    ids.reserve(pair_state_.size());
+    heap_.reset(pair_state_.size());
+    for (std::uint32_t p = 0; p < pair_state_.size(); ++p) {
+      Quadric q;
+      Placed placed;
+      if (!placement_for(p, q, placed)) {
+        pair_state_[p] = kLocked;
+        continue;
+      }
+      double c = placed.error;
+      if (opt_.inversion == InversionPolicy::Penalize && flips(pair_v_[2 * p], pair_v_[2 * p + 1], placed.position))
+        c += q.weight > 0 ? q.weight : 1;
+      cost_[p] = c;
+      ids.push_back(p);
+    }
+    heap_.build(ids);
+  }
+
+  const std::size_t start_faces = faces_alive_;
+  const std::size_t span = start_faces > target_faces_ ? start_faces - target_faces_ : 1;
+  std::size_t next_progress = 0;
+  double max_error_norm_done = 0;
+  result_.stop_reason = StopReason::TargetReached;
+
+  while (!done()) {
+    if (heap_.empty()) {
+      result_.stop_reason = blocked_by_error_ > 0 ? StopReason::ErrorLimit : StopReason::NoValidPair;
+      break;
+    }
+    if (opt_.progress && result_.contractions >= next_progress) {
+      next_progress = result_.contractions + 4096;
+      if (!opt_.progress(double(start_faces - faces_alive_) / double(span))) {
+        result_.stop_reason = StopReason::Cancelled;
+        break;
+      }
+    }
+    const std::uint32_t p = heap_.pop();
+    const std::uint32_t a = pair_v_[2 * p], b = pair_v_[2 * p + 1];
+
+    bool is_edge = false;
+    if (!is_edge_and_link_ok(a, b, is_edge)) {
+      ++blocked_by_topology_;
+      block(p);
+      continue;
+    }
+    if (!is_edge && !pair_virtual_[p]) {
+      // An edge pair whose faces all died: at t = 0 only edges are valid pairs (GH97 §3.2).
+      pair_state_[p] = kDead;
+      continue;
+    }
+    Quadric q;
+    Placed placed;
+    placement_for(p, q, placed);
+    if (opt_.inversion == InversionPolicy::Forbid && flips(a, b, placed.position)) {
+      ++blocked_by_inversion_;
+      block(p);
+      continue;
+    }
+    double err = normalized_error(placed.error, q.weight);
+    if (err > max_error_norm_) {
+      ++blocked_by_error_;
+      block(p);
+      continue;
+    }
+    max_error_norm_done = std::max(max_error_norm_done, err);
+    contract(p, q, placed.position);
+    ++result_.contractions;
+  }
+  if (opt_.progress && result_.stop_reason != StopReason::Cancelled) opt_.progress(1.0);
+
+  result_.max_error_relative = max_error_norm_done;
+  result_.max_error = max_error_norm_done * scale_;
+  switch (result_.stop_reason) {
+    case StopReason::TargetReached: result_.stop_detail = "target reached"; break;
+    case StopReason::ErrorLimit:
+      result_.stop_detail = "every remaining contraction exceeds the error limit";
+      break;
+    case StopReason::NoValidPair:
+      result_.stop_detail = "no valid contraction left (" + std::to_string(blocked_by_topology_) +
+                            " rejected for topology, " + std::to_string(blocked_by_inversion_) +
+                            " for face inversion" + (opt_.lock_border ? ", border locked" : "") + ")";
+      break;
+    default: result_.stop_detail = to_string(result_.stop_reason);
+  }
+  return build_output();
+}
+
+SimplifyResult Simplifier::build_output() {
+  // Unreferenced vertices are dropped; survivors keep their input order, faces too.
+  const std::size_t nv = pos_.size();
+  std::vector<std::uint32_t> remap(nv, 0xffffffffu);
+  std::vector<std::uint8_t> used(nv, 0);
+  for (std::uint32_t f = 0; f < face_alive_.size(); ++f)
+    if (face_alive_[f])
+      for (int k = 0; k < 3; ++k) used[tri_[3 * f + k]] = 1;
+  Mesh& out = result_.mesh;
+  for (std::uint32_t v = 0; v < nv; ++v) {
+    if (!used[v]) continue;
+    remap[v] = std::uint32_t(out.positions.size() / 3);
+    if (moved_[v]) {
+      const Vec3 p = pos_[v] * scale_ + center_;
+      out.positions.insert(out.positions.end(), {p.x, p.y, p.z});
+    } else {
+      out.positions.insert(out.positions.end(), in_.positions.begin() + 3 * v, in_.positions.begin() + 3 * v + 3);
+    }
+  }
+  for (std::uint32_t f = 0; f < face_alive_.size(); ++f)
+    if (face_alive_[f])
+      for (int k = 0; k < 3; ++k) out.indices.push_back(remap[tri_[3 * f + k]]);
+  return std::move(result_);
+}
+
+}  // namespace
+
+SimplifyResult simplify(MeshView input, const SimplifyOptions& options) {
+  Simplifier s(input, options);
+  return s.run();
+}
+
+}  // namespace qem

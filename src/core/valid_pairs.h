@@ -1,0 +1,28 @@
+// Valid pairs of GH97 §3.2: every edge, plus every pair of vertices closer than the threshold t.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/quadric.h"
+
+namespace qem::core {
+
+/// An undirected edge (lo < hi) and how many faces use it.
+struct Edge {
+  std::uint32_t lo, hi;
+  std::uint32_t faces;
+};
+
+/// The unique edges of a triangle list (3 indices per face), sorted by (lo, hi).
+std::vector<Edge> unique_edges(const std::vector<std::uint32_t>& triangles);
+
+/// Pairs (i < j) of `candidates` with |p_i - p_j| < t that are not edges, found with a uniform
+/// grid of cell size t (never O(n^2) unless the points crowd into few cells). Sorted, unique.
+/// Throws qem::Error if more than `max_pairs` pairs are found: t is too large for the model.
+std::vector<std::pair<std::uint32_t, std::uint32_t>> close_pairs(const std::vector<Vec3>& positions,
+                                                                 const std::vector<std::uint32_t>& candidates,
+                                                                 double t, const std::vector<Edge>& edges,
+                                                                 std::size_t max_pairs);
+
+}  // namespace qem::core

@@ -1,0 +1,131 @@
+// Error helpers, whole-file reading, number parsing and formatting shared by every format.
+#include "io/io_common.h"
+
+#include <fast_float/fast_float.h>
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <charconv>
+#include <cstring>
+
+namespace qem::io {
+
+void fail(const std::string& name, const std::string& what) { throw Error(name + ": " + what); }
+
+void fail_line(const std::string& name, std::size_t line, const std::string& what) {
+  throw Error(name + ", line " + std::to_string(line) + ": " + what);
+}
+
+void fail_element(const std::string& name, std::string_view element, std::size_t index, const std::string& what) {
+  throw Error(name + ", " + std::string(element) + " " + std::to_string(index) + ": " + what);
+}
+
+FileData::FileData(const std::string& path) {
+  int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw Error(path + ": cannot open for reading: " + std::strerror(errno));
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) {
+    int err = errno;
+    ::close(fd);
+    throw Error(path + ": cannot read: " + std::strerror(err));
+  }
+  if (S_ISDIR(st.st_mode)) {
+    ::close(fd);
+    throw Error(path + ": cannot read: is a directory");
+  }
+  if (S_ISREG(st.st_mode) && st.st_size > 0) {
+    // Private read-only mapping: the pages come straight from the page cache (MAP_POPULATE maps
+    // them up front), which costs far less than copying into fresh, zero-filled memory.
+    void* m = ::mmap(nullptr, static_cast<std::size_t>(st.st_size), PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+    if (m != MAP_FAILED) {
+      map_ = m;
+      data_ = static_cast<const char*>(m);
+      size_ = static_cast<std::size_t>(st.st_size);
+      ::close(fd);
+      return;
+    }
+  }
+  // Pipes, special files, or mapping refused: read until end of file.
+  char chunk[1 << 16];
+  for (;;) {
+    ssize_t n = ::read(fd, chunk, sizeof chunk);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      int err = errno;
+      ::close(fd);
+      throw Error(path + ": read failed: " + std::strerror(err));
+    }
+    if (n == 0) break;
+    buffer_.append(chunk, static_cast<std::size_t>(n));
+  }
+  ::close(fd);
+  data_ = buffer_.data();
+  size_ = buffer_.size();
+}
+
+FileData::~FileData() {
+  if (map_) ::munmap(map_, size_);
+}
+
+bool TextCursor::try_number(double& value) {
+  const char* b = p_;
+  if (b < end_ && *b == '+') ++b;  // fast_float 3.x rejects a leading '+', which some writers emit
+  auto r = fast_float::from_chars(b, end_, value);
+  if (r.ec != std::errc() || (r.ptr < end_ && !is_delim(*r.ptr))) return false;
+  p_ = r.ptr;
+  return true;
+}
+
+bool TextCursor::try_integer(long long& value, bool allow_slash) {
+  const char* b = p_;
+  if (b < end_ && *b == '+') ++b;
+  auto r = std::from_chars(b, end_, value);
+  if (r.ec != std::errc()) return false;
+  if (r.ptr < end_ && !is_delim(*r.ptr) && !(allow_slash && *r.ptr == '/')) return false;
+  p_ = r.ptr;
+  return true;
+}
+
+void TextCursor::fail_expected(const char* what) const {
+  std::string got;
+  for (const char* q = p_; q < end_ && got.size() < 20 && *q != '\n' && *q != '\r'; ++q)
+    got += (static_cast<unsigned char>(*q) >= 32 && static_cast<unsigned char>(*q) < 127) ? *q : '?';
+  fail(std::string("expected ") + what + (got.empty() ? std::string(", found end of line") : ", found '" + got + "'"));
+}
+
+void append_number(std::string& out, double v) {
+  char buf[32];
+  auto r = std::to_chars(buf, buf + sizeof buf, v);
+  out.append(buf, r.ptr);
+}
+
+void append_number(std::string& out, float v) {
+  char buf[32];
+  auto r = std::to_chars(buf, buf + sizeof buf, v);
+  out.append(buf, r.ptr);
+}
+
+void append_uint(std::string& out, std::uint64_t v) {
+  char buf[24];
+  auto r = std::to_chars(buf, buf + sizeof buf, v);
+  out.append(buf, r.ptr);
+}
+
+void check_mesh_for_writing(const Mesh& mesh) {
+  if (mesh.positions.size() % 3 != 0) throw Error("cannot write mesh: positions are not a multiple of 3");
+  if (mesh.indices.size() % 3 != 0) throw Error("cannot write mesh: indices are not a multiple of 3");
+  std::size_t nv = mesh.vertex_count();
+  for (std::size_t i = 0; i < mesh.indices.size(); ++i)
+    if (mesh.indices[i] >= nv)
+      throw Error("cannot write mesh: face " + std::to_string(i / 3) + " uses vertex " +
+                  std::to_string(mesh.indices[i]) + " of " + std::to_string(nv));
+  for (const VertexProperty& p : mesh.vertex_properties)
+    if (p.values.size() != nv)
+      throw Error("cannot write mesh: vertex property '" + p.name + "' has " + std::to_string(p.values.size()) +
+                  " values for " + std::to_string(nv) + " vertices");
+}
+
+}  // namespace qem::io

@@ -1,0 +1,678 @@
+// Stanford PLY: ascii, binary_little_endian and binary_big_endian bodies; every scalar type and its
+// sized alias; extra properties and elements skipped; faces from a `vertex_indices` /
+// `vertex_index` list (fan-triangulated) or from `tristrips` (-1 restarts a strip).
+//
+// Every count in the header is checked against the bytes that remain before anything is reserved,
+// so a header that lies cannot make the reader allocate memory the file does not back. The common
+// binary layouts (fixed-size vertex rows, faces "uchar count + int indices") run through tight
+// memcpy loops.
+#include <algorithm>
+#include <bit>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "io/io_common.h"
+
+namespace qem::io {
+
+namespace {
+
+enum class Type : std::uint8_t { I8, U8, I16, U16, I32, U32, F32, F64 };
+
+bool parse_type(std::string_view s, Type& t) {
+  static constexpr struct {
+    std::string_view name;
+    Type type;
+  } kTypes[] = {{"char", Type::I8},     {"int8", Type::I8},    {"uchar", Type::U8},    {"uint8", Type::U8},
+                {"short", Type::I16},   {"int16", Type::I16},  {"ushort", Type::U16},  {"uint16", Type::U16},
+                {"int", Type::I32},     {"int32", Type::I32},  {"uint", Type::U32},    {"uint32", Type::U32},
+                {"float", Type::F32},   {"float32", Type::F32}, {"double", Type::F64}, {"float64", Type::F64}};
+  for (const auto& k : kTypes)
+    if (k.name == s) {
+      t = k.type;
+      return true;
+    }
+  return false;
+}
+
+constexpr std::size_t type_size(Type t) {
+  switch (t) {
+    case Type::I8:
+    case Type::U8: return 1;
+    case Type::I16:
+    case Type::U16: return 2;
+    case Type::I32:
+    case Type::U32:
+    case Type::F32: return 4;
+    case Type::F64: return 8;
+  }
+  return 0;
+}
+
+constexpr bool is_integral(Type t) { return t != Type::F32 && t != Type::F64; }
+
+struct Property {
+  std::string name;
+  Type type = Type::F32;
+  bool is_list = false;
+  Type count_type = Type::U8;
+};
+
+struct Element {
+  std::string name;
+  std::uint64_t count = 0;
+  std::size_t header_line = 0;
+  std::vector<Property> props;
+  bool fixed_size() const {
+    return std::none_of(props.begin(), props.end(), [](const Property& p) { return p.is_list; });
+  }
+  /// Bytes of the smallest possible binary row (lists empty).
+  std::uint64_t min_binary_row() const {
+    std::uint64_t n = 0;
+    for (const Property& p : props) n += type_size(p.is_list ? p.count_type : p.type);
+    return n;
+  }
+};
+
+enum class Encoding { Ascii, Little, Big };
+
+struct Header {
+  Encoding encoding = Encoding::Ascii;
+  std::vector<Element> elements;
+  std::size_t body_offset = 0;
+  std::size_t lines = 0;  ///< header lines, so ASCII body line numbers continue from here
+};
+
+// --- header --------------------------------------------------------------------------------------
+
+Header parse_header(std::string_view bytes, const std::string& name) {
+  Header h;
+  TextCursor in(bytes, name, 0, false);
+  in.skip_blank();
+  if (in.word() != "ply") in.fail("not a PLY file (first line must be 'ply')");
+  in.next_line();
+  bool have_format = false;
+  for (;;) {
+    if (in.at_end()) in.fail("header has no end_header line");
+    in.skip_blank();
+    std::string_view kw = in.word();
+    if (kw == "end_header") {
+      in.skip_blank();
+      if (!in.at_line_end()) in.fail("unexpected text after end_header");
+      // The body starts right after this line's newline: not after any further whitespace (a
+      // binary body may begin with byte 0x0A).
+      in.next_line();
+      break;
+    }
+    if (kw == "format") {
+      in.skip_blank();
+      std::string_view f = in.word();
+      if (f == "ascii") h.encoding = Encoding::Ascii;
+      else if (f == "binary_little_endian") h.encoding = Encoding::Little;
+      else if (f == "binary_big_endian") h.encoding = Encoding::Big;
+      else in.fail("unknown PLY format '" + std::string(f) + "'");
+      have_format = true;
+    } else if (kw == "element") {
+      Element e;
+      in.skip_blank();
+      e.name = std::string(in.word());
+      if (e.name.empty()) in.fail("element without a name");
+      in.skip_blank();
+      long long n;
+      if (!in.try_integer(n, false) || n < 0) in.fail_expected("a non-negative element count");
+      e.count = static_cast<std::uint64_t>(n);
+      e.header_line = in.line();
+      h.elements.push_back(std::move(e));
+    } else if (kw == "property") {
+      if (h.elements.empty()) in.fail("property before any element");
+      Property p;
+      in.skip_blank();
+      std::string_view t = in.word();
+      if (t == "list") {
+        p.is_list = true;
+        in.skip_blank();
+        std::string_view ct = in.word();
+        if (!parse_type(ct, p.count_type)) in.fail("unknown PLY type '" + std::string(ct) + "'");
+        if (!is_integral(p.count_type)) in.fail("list count type must be an integer type");
+        in.skip_blank();
+        t = in.word();
+      }
+      if (!parse_type(t, p.type)) in.fail("unknown PLY type '" + std::string(t) + "'");
+      in.skip_blank();
+      p.name = std::string(in.word());
+      if (p.name.empty()) in.fail("property without a name");
+      h.elements.back().props.push_back(std::move(p));
+    } else if (kw == "comment" || kw == "obj_info" || kw.empty()) {
+      // ignored
+    } else {
+      in.fail("unknown PLY header keyword '" + std::string(kw.substr(0, 32)) + "'");
+    }
+    in.next_line();
+  }
+  if (!have_format) fail(name, "PLY header has no format line");
+  h.body_offset = static_cast<std::size_t>(in.pos() - bytes.data());
+  h.lines = in.line();
+  return h;
+}
+
+// --- binary scalar access ------------------------------------------------------------------------
+
+template <class T>
+inline T load(const unsigned char* p, bool swap) {
+  T v;
+  if constexpr (sizeof(T) == 1) {
+    std::memcpy(&v, p, 1);
+  } else {
+    unsigned char b[sizeof(T)];
+    std::memcpy(b, p, sizeof(T));
+    if (swap) std::reverse(b, b + sizeof(T));
+    std::memcpy(&v, b, sizeof(T));
+  }
+  return v;
+}
+
+inline double load_as_double(const unsigned char* p, Type t, bool swap) {
+  switch (t) {
+    case Type::I8: return load<std::int8_t>(p, swap);
+    case Type::U8: return load<std::uint8_t>(p, swap);
+    case Type::I16: return load<std::int16_t>(p, swap);
+    case Type::U16: return load<std::uint16_t>(p, swap);
+    case Type::I32: return load<std::int32_t>(p, swap);
+    case Type::U32: return load<std::uint32_t>(p, swap);
+    case Type::F32: return load<float>(p, swap);
+    case Type::F64: return load<double>(p, swap);
+  }
+  return 0;
+}
+
+/// Integer value of a count or an index; float types must hold a whole number.
+inline bool load_as_int(const unsigned char* p, Type t, bool swap, long long& out) {
+  switch (t) {
+    case Type::I8: out = load<std::int8_t>(p, swap); return true;
+    case Type::U8: out = load<std::uint8_t>(p, swap); return true;
+    case Type::I16: out = load<std::int16_t>(p, swap); return true;
+    case Type::U16: out = load<std::uint16_t>(p, swap); return true;
+    case Type::I32: out = load<std::int32_t>(p, swap); return true;
+    case Type::U32: out = load<std::uint32_t>(p, swap); return true;
+    case Type::F32:
+    case Type::F64: {
+      double d = load_as_double(p, t, swap);
+      if (!(d >= -9.2e18 && d <= 9.2e18) || d != static_cast<double>(static_cast<long long>(d))) return false;
+      out = static_cast<long long>(d);
+      return true;
+    }
+  }
+  return false;
+}
+
+// --- the body reader -----------------------------------------------------------------------------
+
+/// Reads one value at a time from either an ASCII or a binary body, with bounds checks; errors name
+/// the element and its index (binary) or the line (ASCII).
+class BodyReader {
+ public:
+  BodyReader(std::string_view body, const Header& h, const std::string& name)
+      : text_(body, name, 0, false, h.lines),
+        p_(reinterpret_cast<const unsigned char*>(body.data())),
+        end_(p_ + body.size()),
+        name_(name),
+        ascii_(h.encoding == Encoding::Ascii),
+        swap_((h.encoding == Encoding::Big) == (std::endian::native == std::endian::little)) {}
+
+  bool ascii() const { return ascii_; }
+  bool swap() const { return swap_; }
+  std::uint64_t remaining() const {
+    return ascii_ ? static_cast<std::uint64_t>(text_end() - text_.pos()) : static_cast<std::uint64_t>(end_ - p_);
+  }
+  const unsigned char* ptr() const { return p_; }
+  void advance(std::size_t n) { p_ += n; }
+
+  void set_context(const Element* e, std::uint64_t index) {
+    elem_ = e;
+    index_ = index;
+  }
+  [[noreturn]] void fail(const std::string& what) const {
+    if (ascii_) text_.fail(what);
+    fail_element(name_, elem_ ? elem_->name : std::string_view("element"), index_, what);
+  }
+
+  double real(Type t) {
+    if (ascii_) {
+      if (!text_.skip_space()) fail("unexpected end of file (the header declares more data)");
+      double v;
+      if (!text_.try_number(v)) fail_expected_number();
+      return v;
+    }
+    need(type_size(t));
+    double v = load_as_double(p_, t, swap_);
+    p_ += type_size(t);
+    return v;
+  }
+  long long integer(Type t) {
+    long long v = 0;
+    if (ascii_) {
+      if (!text_.skip_space()) fail("unexpected end of file (the header declares more data)");
+      if (!text_.try_integer(v, false)) {
+        double d;
+        if (!text_.try_number(d) || d != static_cast<double>(static_cast<long long>(d)))
+          fail_expected_number();
+        v = static_cast<long long>(d);
+      }
+      return v;
+    }
+    need(type_size(t));
+    if (!load_as_int(p_, t, swap_, v)) fail("expected an integer value");
+    p_ += type_size(t);
+    return v;
+  }
+  void skip(Type t) {
+    if (ascii_) {
+      real(t);
+      return;
+    }
+    need(type_size(t));
+    p_ += type_size(t);
+  }
+  /// Checks that `n` more bytes exist (binary).
+  void need(std::uint64_t n) const {
+    if (static_cast<std::uint64_t>(end_ - p_) < n) fail("file is truncated (the header declares more data)");
+  }
+  /// A list count: non-negative and small enough to be backed by the remaining data.
+  std::size_t list_count(const Property& p) {
+    long long c = integer(p.count_type);
+    if (c < 0) fail("negative list count " + std::to_string(c) + " for '" + p.name + "'");
+    std::uint64_t min_bytes = ascii_ ? 2 : type_size(p.type);
+    if (!fits(static_cast<std::uint64_t>(c), min_bytes, remaining() + 1))
+      fail("list count " + std::to_string(c) + " for '" + p.name + "' exceeds the data left in the file");
+    return static_cast<std::size_t>(c);
+  }
+  void skip_property(const Property& p) {
+    if (!p.is_list) return skip(p.type);
+    std::size_t c = list_count(p);
+    if (!ascii_) {
+      need(c * type_size(p.type));
+      p_ += c * type_size(p.type);
+    } else {
+      for (std::size_t j = 0; j < c; ++j) skip(p.type);
+    }
+  }
+
+ private:
+  const char* text_end() const { return reinterpret_cast<const char*>(end_); }
+  [[noreturn]] void fail_expected_number() const {
+    std::string what = "expected a number";
+    if (elem_) what += " in " + elem_->name + " " + std::to_string(index_);
+    text_.fail_expected(what.c_str());
+  }
+
+  TextCursor text_;
+  const unsigned char* p_;
+  const unsigned char* end_;
+  const std::string& name_;
+  bool ascii_;
+  bool swap_;
+  const Element* elem_ = nullptr;
+  std::uint64_t index_ = 0;
+};
+
+bool is_index_list(const Property& p) { return p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index"); }
+
+/// Reads the vertex element: x, y, z (and, if asked, every other scalar property).
+void read_vertices(BodyReader& in, const Element& e, Mesh& mesh, const LoadOptions& options, LoadReport& report) {
+  int ix = -1, iy = -1, iz = -1;
+  for (std::size_t k = 0; k < e.props.size(); ++k) {
+    const Property& p = e.props[k];
+    if (p.is_list) continue;
+    if (p.name == "x") ix = static_cast<int>(k);
+    else if (p.name == "y") iy = static_cast<int>(k);
+    else if (p.name == "z") iz = static_cast<int>(k);
+  }
+  if (ix < 0 || iy < 0 || iz < 0) in.fail("vertex element has no x, y, z properties");
+  report.double_precision = e.props[ix].type == Type::F64;
+
+  const std::uint64_t min_row = in.ascii() ? 2 * e.props.size() : e.min_binary_row();
+  if (!fits(e.count, min_row, in.remaining() + 1))
+    in.fail("header declares " + std::to_string(e.count) + " vertices but the file is too short for them");
+  const std::size_t n = static_cast<std::size_t>(e.count);
+  mesh.positions.resize(3 * n);
+  std::vector<int> prop_slot(e.props.size(), -1);  // index into mesh.vertex_properties
+  if (options.keep_vertex_properties)
+    for (std::size_t k = 0; k < e.props.size(); ++k) {
+      const Property& p = e.props[k];
+      if (p.is_list || static_cast<int>(k) == ix || static_cast<int>(k) == iy || static_cast<int>(k) == iz) continue;
+      prop_slot[k] = static_cast<int>(mesh.vertex_properties.size());
+      mesh.vertex_properties.push_back({p.name, std::vector<double>(n)});
+    }
+  double* pos = mesh.positions.data();
+
+  if (!in.ascii() && e.fixed_size()) {
+    // Fixed-size rows: one bounds check for the whole element, then straight loads.
+    const std::size_t stride = static_cast<std::size_t>(e.min_binary_row());
+    in.need(stride * n);
+    std::size_t off[3] = {0, 0, 0};
+    std::size_t o = 0;
+    std::vector<std::size_t> offsets(e.props.size());
+    for (std::size_t k = 0; k < e.props.size(); ++k) {
+      offsets[k] = o;
+      o += type_size(e.props[k].type);
+    }
+    off[0] = offsets[ix];
+    off[1] = offsets[iy];
+    off[2] = offsets[iz];
+    const unsigned char* row = in.ptr();
+    const Type tx = e.props[ix].type, ty = e.props[iy].type, tz = e.props[iz].type;
+    const bool swap = in.swap();
+    if (!swap && tx == Type::F32 && ty == Type::F32 && tz == Type::F32) {
+      for (std::size_t i = 0; i < n; ++i, row += stride) {
+        float x, y, z;
+        std::memcpy(&x, row + off[0], 4);
+        std::memcpy(&y, row + off[1], 4);
+        std::memcpy(&z, row + off[2], 4);
+        pos[3 * i] = x;
+        pos[3 * i + 1] = y;
+        pos[3 * i + 2] = z;
+      }
+    } else {
+      for (std::size_t i = 0; i < n; ++i, row += stride) {
+        pos[3 * i] = load_as_double(row + off[0], tx, swap);
+        pos[3 * i + 1] = load_as_double(row + off[1], ty, swap);
+        pos[3 * i + 2] = load_as_double(row + off[2], tz, swap);
+      }
+    }
+    if (options.keep_vertex_properties)
+      for (std::size_t k = 0; k < e.props.size(); ++k)
+        if (prop_slot[k] >= 0) {
+          double* dst = mesh.vertex_properties[prop_slot[k]].values.data();
+          const unsigned char* r = in.ptr() + offsets[k];
+          for (std::size_t i = 0; i < n; ++i, r += stride) dst[i] = load_as_double(r, e.props[k].type, swap);
+        }
+    for (std::size_t i = 0; i < n; ++i)
+      if (!finite3(pos[3 * i], pos[3 * i + 1], pos[3 * i + 2])) {
+        in.set_context(&e, i);
+        in.fail("vertex coordinate is not finite");
+      }
+    in.advance(stride * n);
+    return;
+  }
+
+  for (std::size_t i = 0; i < n; ++i) {
+    in.set_context(&e, i);
+    for (std::size_t k = 0; k < e.props.size(); ++k) {
+      const Property& p = e.props[k];
+      if (p.is_list) {
+        in.skip_property(p);
+        continue;
+      }
+      double v = in.real(p.type);
+      if (static_cast<int>(k) == ix) pos[3 * i] = v;
+      else if (static_cast<int>(k) == iy) pos[3 * i + 1] = v;
+      else if (static_cast<int>(k) == iz) pos[3 * i + 2] = v;
+      else if (prop_slot[k] >= 0) mesh.vertex_properties[prop_slot[k]].values[i] = v;
+    }
+    if (!finite3(pos[3 * i], pos[3 * i + 1], pos[3 * i + 2])) in.fail("vertex coordinate is not finite");
+  }
+}
+
+/// Fast path for the common binary face layout: fixed-size scalars around one index list whose
+/// count is 1 byte and whose items are 4-byte integers. Returns false (nothing consumed) otherwise.
+bool read_faces_fast(BodyReader& in, const Element& e, std::size_t list_prop, std::uint64_t nv, PolygonSink& sink) {
+  if (in.ascii() || e.props.size() > 16) return false;
+  for (std::size_t k = 0; k < e.props.size(); ++k)
+    if (k != list_prop && e.props[k].is_list) return false;
+  const Property& lp = e.props[list_prop];
+  if (type_size(lp.count_type) != 1 || (lp.type != Type::I32 && lp.type != Type::U32)) return false;
+  std::size_t pre = 0, post = 0;
+  for (std::size_t k = 0; k < e.props.size(); ++k)
+    if (k < list_prop) pre += type_size(e.props[k].type);
+    else if (k > list_prop) post += type_size(e.props[k].type);
+  const bool swap = in.swap();
+  const bool signed_count = lp.count_type == Type::I8;
+  const bool signed_index = lp.type == Type::I32;
+  const unsigned char* p = in.ptr();
+  const unsigned char* end = p + in.remaining();
+  std::uint32_t corners[256];
+  const std::size_t n = static_cast<std::size_t>(e.count);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (static_cast<std::size_t>(end - p) < pre + 1) {
+      in.set_context(&e, i);
+      in.fail("file is truncated (the header declares more faces)");
+    }
+    p += pre;
+    const int c = signed_count ? static_cast<int>(static_cast<std::int8_t>(*p)) : static_cast<int>(*p);
+    ++p;
+    if (c < 3) {
+      in.set_context(&e, i);
+      in.fail("face with " + std::to_string(c) + " vertices (at least 3 needed)");
+    }
+    const std::size_t bytes = 4 * static_cast<std::size_t>(c) + post;
+    if (static_cast<std::size_t>(end - p) < bytes) {
+      in.set_context(&e, i);
+      in.fail("file is truncated (the header declares more faces)");
+    }
+    std::memcpy(corners, p, 4 * static_cast<std::size_t>(c));
+    p += bytes;
+    bool bad = false;
+    for (int k = 0; k < c; ++k) {
+      if (swap) corners[k] = __builtin_bswap32(corners[k]);
+      bad |= corners[k] >= nv;  // a negative int32 becomes >= 2^31, which is out of range as well
+    }
+    if (bad) {
+      in.set_context(&e, i);
+      for (int k = 0; k < c; ++k)
+        if (corners[k] >= nv) {
+          long long v = signed_index ? static_cast<long long>(static_cast<std::int32_t>(corners[k])) : corners[k];
+          in.fail("vertex index " + std::to_string(v) + " out of range (" + std::to_string(nv) + " vertices)");
+        }
+    }
+    sink.add(corners, static_cast<std::size_t>(c));
+  }
+  in.advance(static_cast<std::size_t>(p - in.ptr()));
+  return true;
+}
+
+/// Reads a face element (vertex_indices list) or a tristrips element.
+void read_faces(BodyReader& in, const Element& e, std::uint64_t nv, bool strips, PolygonSink& sink) {
+  std::size_t list_prop = e.props.size();
+  for (std::size_t k = 0; k < e.props.size(); ++k)
+    if (is_index_list(e.props[k])) {
+      list_prop = k;
+      break;
+    }
+  if (list_prop == e.props.size()) {
+    in.set_context(&e, 0);
+    in.fail("element '" + e.name + "' has no vertex_indices list property");
+  }
+  const std::uint64_t min_row = in.ascii() ? 2 * e.props.size() : e.min_binary_row();
+  if (!fits(e.count, min_row, in.remaining() + 1))
+    in.fail("header declares " + std::to_string(e.count) + " " + e.name +
+            " elements but the file is too short for them");
+  if (!strips) {
+    sink.indices->reserve(sink.indices->size() + 3 * static_cast<std::size_t>(e.count));
+    if (read_faces_fast(in, e, list_prop, nv, sink)) return;
+  }
+
+  std::vector<std::uint32_t> corners;
+  const Property& lp = e.props[list_prop];
+  for (std::uint64_t i = 0; i < e.count; ++i) {
+    in.set_context(&e, i);
+    for (std::size_t k = 0; k < e.props.size(); ++k) {
+      if (k != list_prop) {
+        in.skip_property(e.props[k]);
+        continue;
+      }
+      std::size_t c = in.list_count(lp);
+      if (!strips && c < 3) in.fail("face with " + std::to_string(c) + " vertices (at least 3 needed)");
+      corners.clear();
+      for (std::size_t j = 0; j < c; ++j) {
+        long long v = in.integer(lp.type);
+        if (strips && v == -1) {
+          corners.push_back(0xFFFFFFFFu);
+          continue;
+        }
+        if (v < 0 || static_cast<std::uint64_t>(v) >= nv)
+          in.fail("vertex index " + std::to_string(v) + " out of range (" + std::to_string(nv) + " vertices)");
+        corners.push_back(static_cast<std::uint32_t>(v));
+      }
+      if (!strips) {
+        sink.add(corners.data(), corners.size());
+        continue;
+      }
+      // Triangle strip: triangle j uses corners j, j+1, j+2, every other one flipped so all keep
+      // the orientation of the first; -1 ends a strip and starts the next.
+      std::size_t start = 0;
+      for (std::size_t j = 0; j <= corners.size(); ++j) {
+        if (j < corners.size() && corners[j] != 0xFFFFFFFFu) continue;
+        for (std::size_t t = start; t + 2 < j; ++t) {
+          std::uint32_t a = corners[t], b = corners[t + 1], c3 = corners[t + 2];
+          if ((t - start) % 2 == 1) std::swap(a, b);
+          sink.indices->push_back(a);
+          sink.indices->push_back(b);
+          sink.indices->push_back(c3);
+        }
+        start = j + 1;
+      }
+    }
+  }
+}
+
+void skip_element(BodyReader& in, const Element& e) {
+  if (e.props.empty()) return;  // rows of nothing: no data, whatever the count says
+  const std::uint64_t min_row = in.ascii() ? 2 * e.props.size() : e.min_binary_row();
+  if (!fits(e.count, min_row, in.remaining() + 1))
+    in.fail("header declares " + std::to_string(e.count) + " " + e.name +
+            " elements but the file is too short for them");
+  if (!in.ascii() && e.fixed_size()) {
+    in.set_context(&e, 0);
+    in.need(e.count * min_row);  // no overflow: checked by fits() above
+    in.advance(static_cast<std::size_t>(e.count * min_row));
+    return;
+  }
+  for (std::uint64_t i = 0; i < e.count; ++i) {
+    in.set_context(&e, i);
+    for (const Property& p : e.props) in.skip_property(p);
+  }
+}
+
+}  // namespace
+
+Mesh parse_ply(std::string_view bytes, const std::string& name, const LoadOptions& options, LoadReport& report) {
+  if (bytes.empty()) fail(name, "empty file");
+  Header h = parse_header(bytes, name);
+  report.format = FileFormat::Ply;
+  report.binary = h.encoding != Encoding::Ascii;
+
+  const Element* vertex = nullptr;
+  for (const Element& e : h.elements)
+    if (e.name == "vertex") {
+      if (vertex) fail_line(name, e.header_line, "second vertex element");
+      vertex = &e;
+    }
+  if (!vertex) fail(name, "PLY header declares no vertex element");
+  if (vertex->count > 0xFFFFFFFFull) fail_line(name, vertex->header_line, "too many vertices for 32-bit indices");
+  const std::uint64_t nv = vertex->count;
+
+  Mesh mesh;
+  PolygonSink sink{&mesh.indices};
+  BodyReader in(bytes.substr(h.body_offset), h, name);
+  for (const Element& e : h.elements) {
+    in.set_context(&e, 0);
+    if (&e == vertex) read_vertices(in, e, mesh, options, report);
+    else if (e.name == "face") read_faces(in, e, nv, false, sink);
+    else if (e.name == "tristrips") read_faces(in, e, nv, true, sink);
+    else skip_element(in, e);
+  }
+  if (mesh.indices.empty()) fail(name, "no faces");
+  report.polygons_triangulated = sink.polygons;
+  return mesh;
+}
+
+// --- writer --------------------------------------------------------------------------------------
+
+namespace {
+
+template <class T>
+void put(std::string& out, T v) {
+  static_assert(std::endian::native == std::endian::little || std::endian::native == std::endian::big);
+  unsigned char b[sizeof(T)];
+  std::memcpy(b, &v, sizeof(T));
+  if constexpr (std::endian::native == std::endian::big) std::reverse(b, b + sizeof(T));
+  out.append(reinterpret_cast<const char*>(b), sizeof(T));
+}
+
+bool valid_property_name(const std::string& s) {
+  if (s.empty()) return false;
+  for (unsigned char c : s)
+    if (c <= 32 || c >= 127) return false;
+  return true;
+}
+
+}  // namespace
+
+std::string write_ply(const Mesh& mesh, bool binary, bool double_precision) {
+  const std::size_t nv = mesh.vertex_count(), nf = mesh.face_count();
+  for (const VertexProperty& p : mesh.vertex_properties)
+    if (!valid_property_name(p.name) || p.name == "x" || p.name == "y" || p.name == "z")
+      throw Error("cannot write PLY: invalid vertex property name '" + p.name + "'");
+  const char* type = double_precision ? "double" : "float";
+  std::string out;
+  out += "ply\nformat ";
+  out += binary ? "binary_little_endian" : "ascii";
+  out += " 1.0\ncomment written by qem\nelement vertex ";
+  append_uint(out, nv);
+  out += '\n';
+  for (const char* axis : {"x", "y", "z"}) out += std::string("property ") + type + " " + axis + "\n";
+  for (const VertexProperty& p : mesh.vertex_properties) out += std::string("property ") + type + " " + p.name + "\n";
+  out += "element face ";
+  append_uint(out, nf);
+  out += "\nproperty list uchar int vertex_indices\nend_header\n";
+
+  const std::size_t np = mesh.vertex_properties.size();
+  if (binary) {
+    out.reserve(out.size() + nv * (3 + np) * (double_precision ? 8 : 4) + nf * 13);
+    for (std::size_t i = 0; i < nv; ++i) {
+      for (int k = 0; k < 3; ++k) {
+        double v = mesh.positions[3 * i + k];
+        if (double_precision) put(out, v);
+        else put(out, static_cast<float>(v));
+      }
+      for (const VertexProperty& p : mesh.vertex_properties) {
+        if (double_precision) put(out, p.values[i]);
+        else put(out, static_cast<float>(p.values[i]));
+      }
+    }
+    for (std::size_t f = 0; f < nf; ++f) {
+      out += '\3';
+      for (int k = 0; k < 3; ++k) put(out, static_cast<std::int32_t>(mesh.indices[3 * f + k]));
+    }
+    return out;
+  }
+  auto number = [&](double v) {
+    if (double_precision) append_number(out, v);
+    else append_number(out, static_cast<float>(v));
+  };
+  for (std::size_t i = 0; i < nv; ++i) {
+    number(mesh.positions[3 * i]);
+    out += ' ';
+    number(mesh.positions[3 * i + 1]);
+    out += ' ';
+    number(mesh.positions[3 * i + 2]);
+    for (const VertexProperty& p : mesh.vertex_properties) {
+      out += ' ';
+      number(p.values[i]);
+    }
+    out += '\n';
+  }
+  for (std::size_t f = 0; f < nf; ++f) {
+    out += "3 ";
+    append_uint(out, mesh.indices[3 * f]);
+    out += ' ';
+    append_uint(out, mesh.indices[3 * f + 1]);
+    out += ' ';
+    append_uint(out, mesh.indices[3 * f + 2]);
+    out += '\n';
+  }
+  return out;
+}
+
+}  // namespace qem::io

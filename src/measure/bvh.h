@@ -1,0 +1,44 @@
+// Bounding volume hierarchy (axis-aligned boxes) over triangles, for exact closest-point queries.
+// Built top-down with a binned surface-area-heuristic split (Wald 2007, "On fast construction of
+// SAH-based bounding volume hierarchies"); nodes, boxes and triangles live in flat arrays, children
+// of a node are adjacent, and triangles are stored in leaf order so a leaf reads contiguous memory.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+namespace qem::measure_detail {
+
+class TriangleBvh {
+ public:
+  struct Hit {
+    double d2 = std::numeric_limits<double>::infinity();  ///< squared distance
+    std::uint32_t triangle = UINT32_MAX;                   ///< index into the build input
+    double point[3] = {0, 0, 0};                           ///< closest point
+  };
+
+  TriangleBvh() = default;
+  /// `corners`: 9 doubles per triangle (a.xyz b.xyz c.xyz).
+  explicit TriangleBvh(const std::vector<double>& corners);
+
+  /// The closest point of all triangles to `p`; none closer than sqrt(max_d2) -> Hit with d2 = inf.
+  Hit closest(const double p[3], double max_d2 = std::numeric_limits<double>::infinity()) const;
+
+  std::size_t triangle_count() const { return ids_.size(); }
+  std::size_t node_count() const { return nodes_.size(); }
+  bool empty() const { return ids_.empty(); }
+
+ private:
+  struct Node {
+    double lo[3], hi[3];
+    std::uint32_t first;  ///< leaf: first triangle; inner: left child (right child = first + 1)
+    std::uint32_t count;  ///< triangles in a leaf; 0 for an inner node
+  };
+  std::vector<Node> nodes_;
+  std::vector<double> tris_;        ///< 9 per triangle, in leaf order
+  std::vector<std::uint32_t> ids_;  ///< input index of each stored triangle
+};
+
+}  // namespace qem::measure_detail

@@ -1,0 +1,203 @@
+// Tests of `qem measure` (GH97 §6.1 metric): exact closed forms, BVH against brute force,
+// determinism across seeds and thread counts.
+#include "qem/measure.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "measure/bvh.h"
+#include "measure/point_triangle.h"
+#include "measure/rng.h"
+#include "measure/surface_sampling.h"
+#include "qem/error.h"
+#include "test_meshes.h"
+
+namespace qem {
+namespace {
+
+using measure_detail::closest_point_on_triangle;
+using measure_detail::Vec3;
+
+MeasureOptions with_samples(std::size_t n, unsigned threads = 1) {
+  MeasureOptions o;
+  o.samples = n;
+  o.threads = threads;
+  return o;
+}
+
+bool bit_equal(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+TEST(Measure, PointTriangleRegions) {
+  const Vec3 a{0, 0, 0}, b{1, 0, 0}, c{0, 1, 0};
+  auto cp = [&](Vec3 p) { return closest_point_on_triangle(p, a, b, c); };
+  Vec3 q = cp({0.25, 0.25, 2});  // above the interior: straight down
+  EXPECT_DOUBLE_EQ(q.x, 0.25);
+  EXPECT_DOUBLE_EQ(q.y, 0.25);
+  EXPECT_DOUBLE_EQ(q.z, 0);
+  q = cp({-1, -1, 1});  // vertex region of a
+  EXPECT_EQ(q.x, 0);
+  EXPECT_EQ(q.y, 0);
+  q = cp({0.5, -3, 0});  // edge ab
+  EXPECT_DOUBLE_EQ(q.x, 0.5);
+  EXPECT_DOUBLE_EQ(q.y, 0);
+  q = cp({1, 1, 0});  // edge bc, at its midpoint
+  EXPECT_DOUBLE_EQ(q.x, 0.5);
+  EXPECT_DOUBLE_EQ(q.y, 0.5);
+  q = cp({3, -1, 0});  // vertex region of b
+  EXPECT_EQ(q.x, 1);
+  EXPECT_EQ(q.y, 0);
+}
+
+TEST(Measure, BvhMatchesBruteForce) {
+  const Mesh sphere = test::icosphere(3);
+  const measure_detail::Surface s = measure_detail::make_surface(sphere, "sphere");
+  const measure_detail::TriangleBvh bvh(s.corners);
+  ASSERT_EQ(bvh.triangle_count(), sphere.face_count());
+  measure_detail::Rng rng(7);
+  for (int i = 0; i < 2000; ++i) {
+    const double p[3] = {3 * rng.uniform() - 1.5, 3 * rng.uniform() - 1.5, 3 * rng.uniform() - 1.5};
+    double best = INFINITY;
+    for (std::size_t t = 0; t < s.triangle_count(); ++t) {
+      const double* c = &s.corners[9 * t];
+      const Vec3 q = closest_point_on_triangle({p[0], p[1], p[2]}, {c[0], c[1], c[2]}, {c[3], c[4], c[5]},
+                                               {c[6], c[7], c[8]});
+      best = std::min(best, measure_detail::squared_distance({p[0], p[1], p[2]}, q));
+    }
+    const auto hit = bvh.closest(p);
+    ASSERT_EQ(hit.d2, best) << "query " << i;  // same primitive test: the minimum is bit-identical
+    const double dx = hit.point[0] - p[0], dy = hit.point[1] - p[1], dz = hit.point[2] - p[2];
+    EXPECT_NEAR(dx * dx + dy * dy + dz * dz, best, 1e-15);
+  }
+}
+
+TEST(Measure, SamplesAreUniformByArea) {
+  // Two triangles of areas 1/8 and 7/8 (split of the unit square at x = 1/4 on the bottom edge):
+  // the mean x of area-uniform samples is the square's centroid, 1/2, only if faces are picked by area.
+  Mesh m;
+  m.positions = {0, 0, 0, 0.25, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+  m.indices = {0, 1, 4, 1, 2, 3, 1, 3, 4};
+  const auto s = measure_detail::make_surface(m, "m");
+  EXPECT_DOUBLE_EQ(s.area, 1.0);
+  const std::vector<double> x = measure_detail::sample_surface(s, 200000, 3);
+  double mx = 0, my = 0, mxx = 0;
+  for (std::size_t i = 0; i < x.size(); i += 3) mx += x[i], my += x[i + 1], mxx += x[i] * x[i];
+  const double n = double(x.size() / 3);
+  EXPECT_NEAR(mx / n, 0.5, 3e-3);
+  EXPECT_NEAR(my / n, 0.5, 3e-3);
+  EXPECT_NEAR(mxx / n, 1.0 / 3.0, 3e-3);
+}
+
+TEST(Measure, IdenticalMeshesGiveZero) {
+  const Mesh m = test::icosphere(2);
+  const MeasureResult r = measure(m, m, with_samples(20000));
+  EXPECT_LT(r.E, 1e-28);
+  EXPECT_LT(r.hausdorff, 1e-13);
+  EXPECT_LT(r.mean, 1e-14);
+  EXPECT_EQ(r.samples_original, 10000u);  // equal areas: an even split
+  EXPECT_EQ(r.samples_approx, 10000u);
+  EXPECT_NEAR(r.bbox_diag, 2 * std::sqrt(3.0), 0.2);  // icosphere bbox is inside the sphere's cube
+}
+
+// Unit cube C vs the same cube shifted by d along x (C'). Per unit of area on C (6 faces):
+//  - face x=0: distance d everywhere                                   -> int d^2   = d^2
+//  - face x=1 lies inside C': distance to the nearest face of C' is min(d, y, 1-y, z, 1-z);
+//    with m = min(y, 1-y, z, 1-z) (area density of {m = s} is 4(1-2s)):
+//      int = d^2 (1-2d)^2 + int_0^d s^2 4(1-2s) ds = d^2 (1-2d)^2 + 4d^3/3 - 2d^4
+//  - the 4 side faces are shared with C' except a strip of width d at x<d: int_0^d (d-x)^2 = d^3/3 each
+// I = d^2 + d^2(1-2d)^2 + 4d^3/3 - 2d^4 + 4d^3/3, the same from C' to C by symmetry, and
+// E = 2I / (6 + 6) = I / 6 = 0.00314444 for d = 0.1 (bench README: closed form 0.0031444).
+// The mean distance: (d + d(1-2d)^2 + 2d^2 - 8d^3/3 + 2d^2) / 6 = 0.0335556.
+// Hausdorff: the corner (0,0,0) is d from C', and nothing is farther: exactly d.
+TEST(Measure, ShiftedCubeMatchesClosedForm) {
+  const double d = 0.1;
+  const double I = d * d + d * d * (1 - 2 * d) * (1 - 2 * d) + 4 * d * d * d / 3 - 2 * d * d * d * d +
+                   4 * d * d * d / 3;
+  const double E_exact = I / 6;
+  ASSERT_NEAR(E_exact, 0.0031444, 1e-7);
+  const double mean_exact = (d + d * (1 - 2 * d) * (1 - 2 * d) + 2 * d * d - 8 * d * d * d / 3 + 2 * d * d) / 6;
+  const Mesh c = test::cube();
+  const Mesh shifted = test::transformed(c, 1, d, 0, 0);
+  const MeasureResult r = measure(c, shifted, with_samples(400000, 2));
+  EXPECT_NEAR(r.E, E_exact, 0.01 * E_exact);
+  EXPECT_NEAR(r.mean, mean_exact, 0.01 * mean_exact);
+  EXPECT_NEAR(r.hausdorff, d, 1e-12);
+  EXPECT_NEAR(r.h_original_to_approx, d, 1e-12);
+  EXPECT_NEAR(r.h_approx_to_original, d, 1e-12);
+  EXPECT_DOUBLE_EQ(r.rms, std::sqrt(r.E));
+  EXPECT_NEAR(r.bbox_diag, std::sqrt(3.0), 1e-15);
+  EXPECT_DOUBLE_EQ(r.E_rel, r.E / 3.0);
+  EXPECT_DOUBLE_EQ(r.hausdorff_rel, r.hausdorff / std::sqrt(3.0));
+  EXPECT_DOUBLE_EQ(r.area_original, 6.0);
+}
+
+// Every point of a fine icosphere is within 1 - r of the icosahedron (r its inradius, 0.794654 for
+// circumradius 1), with equality only at the sphere point above a face centre; the icosphere lies
+// inside the sphere, so 1 - r is a strict upper bound and a fine sampling gets close to it.
+TEST(Measure, IcosphereVsIcosahedronHausdorff) {
+  const double inradius = std::sqrt((5 + 2 * std::sqrt(5.0)) / 15);  // r / R of the icosahedron
+  const double bound = 1 - inradius;
+  ASSERT_NEAR(bound, 0.205346, 1e-6);
+  const MeasureResult r = measure(test::icosphere(5), test::icosphere(0), with_samples(200000, 2));
+  EXPECT_LE(r.hausdorff, bound + 1e-12);
+  EXPECT_NEAR(r.hausdorff, bound, 2e-3);
+  EXPECT_EQ(r.hausdorff, r.h_original_to_approx);
+  // The other way, the icosahedron's face centres are the farthest: 1 - r minus the icosphere's sag.
+  EXPECT_LT(r.h_approx_to_original, bound);
+  EXPECT_GT(r.h_approx_to_original, bound - 5e-3);
+}
+
+TEST(Measure, DeterministicAcrossRunsAndThreads) {
+  const Mesh a = test::icosphere(4);
+  const Mesh b = test::transformed(test::icosphere(2), 1.02, 0.01, 0, 0);
+  const MeasureResult r1 = measure(a, b, with_samples(50000, 1));
+  for (unsigned threads : {1u, 2u, 3u, 8u}) {
+    const MeasureResult r = measure(a, b, with_samples(50000, threads));
+    EXPECT_TRUE(bit_equal(r.E, r1.E)) << threads;
+    EXPECT_TRUE(bit_equal(r.mean, r1.mean)) << threads;
+    EXPECT_TRUE(bit_equal(r.hausdorff, r1.hausdorff)) << threads;
+    EXPECT_TRUE(bit_equal(r.rms_approx_to_original, r1.rms_approx_to_original)) << threads;
+  }
+  MeasureOptions other = with_samples(50000, 2);
+  other.seed = 2;
+  const MeasureResult r2 = measure(a, b, other);
+  EXPECT_NE(r2.E, r1.E);                  // a different sample set...
+  EXPECT_NEAR(r2.E, r1.E, 0.05 * r1.E);  // ...estimating the same integral
+}
+
+TEST(Measure, PerVertexDistances) {
+  const double d = 0.1;
+  MeasureOptions o = with_samples(1000);
+  o.per_vertex = true;
+  const MeasureResult r = measure(test::cube(), test::transformed(test::cube(), 1, d, 0, 0), o);
+  ASSERT_EQ(r.vertex_distance.size(), 8u);
+  const Mesh shifted = test::transformed(test::cube(), 1, d, 0, 0);
+  for (std::size_t v = 0; v < 8; ++v) {
+    // Vertices at x = d lie on C's side faces (distance 0), those at x = 1 + d are d outside.
+    const double expected = shifted.positions[3 * v] > 1 ? d : 0.0;
+    EXPECT_NEAR(r.vertex_distance[v], expected, 1e-15) << v;
+  }
+}
+
+TEST(Measure, DegenerateFacesIgnoredAndBadInputRejected) {
+  Mesh m = test::cube();
+  m.positions.insert(m.positions.end(), {5, 5, 5});
+  m.indices.insert(m.indices.end(), {0, 8, 8});  // zero-area needle far away: no surface there
+  const MeasureResult r = measure(test::cube(), m, with_samples(10000));
+  EXPECT_EQ(r.degenerate_approx, 1u);
+  EXPECT_LT(r.E, 1e-28);
+  // Its vertex still counts for the one-sided Hausdorff (vertices are surface points in the bench).
+  EXPECT_NEAR(r.h_approx_to_original, std::sqrt(3 * 16.0), 1e-12);
+
+  Mesh flat;
+  flat.positions = {0, 0, 0, 1, 0, 0, 2, 0, 0};
+  flat.indices = {0, 1, 2};
+  EXPECT_THROW(measure(test::cube(), flat), Error);
+  Mesh bad = test::cube();
+  bad.indices[5] = 99;
+  EXPECT_THROW(measure(bad, test::cube()), Error);
+}
+
+}  // namespace
+}  // namespace qem

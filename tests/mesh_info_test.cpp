@@ -1,0 +1,281 @@
+// mesh_info on small meshes built in code, each with counts worked out by hand.
+#include "qem/mesh_info.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <random>
+#include <tuple>
+
+#include "qem/error.h"
+#include "test_meshes.h"
+
+namespace qem {
+namespace {
+
+#if defined(__SANITIZE_ADDRESS__)
+#define QEM_TEST_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define QEM_TEST_ASAN 1
+#endif
+#endif
+#if defined(NDEBUG) && !defined(QEM_TEST_ASAN)
+constexpr bool kOptimisedBuild = true;
+#else
+constexpr bool kOptimisedBuild = false;
+#endif
+
+/// Merges vertices with equal coordinates (first occurrence wins), so meshes built from separate
+/// pieces can share vertices.
+Mesh welded(const Mesh& in) {
+  Mesh out;
+  std::map<std::tuple<double, double, double>, std::uint32_t> index;
+  std::vector<std::uint32_t> remap(in.vertex_count());
+  for (std::size_t v = 0; v < in.vertex_count(); ++v) {
+    auto key = std::make_tuple(in.positions[3 * v], in.positions[3 * v + 1], in.positions[3 * v + 2]);
+    auto [it, inserted] = index.emplace(key, std::uint32_t(out.vertex_count()));
+    if (inserted)
+      out.positions.insert(out.positions.end(), in.positions.begin() + 3 * v,
+                           in.positions.begin() + 3 * v + 3);
+    remap[v] = it->second;
+  }
+  for (std::uint32_t i : in.indices) out.indices.push_back(remap[i]);
+  return out;
+}
+
+void flip_face(Mesh& m, std::size_t f) { std::swap(m.indices[3 * f + 1], m.indices[3 * f + 2]); }
+
+TEST(MeshInfo, CubeIsClosedGenusZero) {
+  MeshInfo i = mesh_info(test::cube());
+  EXPECT_EQ(i.vertices, 8u);
+  EXPECT_EQ(i.faces, 12u);
+  EXPECT_EQ(i.edges, 18u);
+  EXPECT_EQ(i.boundary_edges, 0u);
+  EXPECT_EQ(i.boundary_loops, 0u);
+  EXPECT_EQ(i.non_manifold_edges, 0u);
+  EXPECT_EQ(i.non_manifold_vertices, 0u);
+  EXPECT_EQ(i.components, 1u);
+  EXPECT_EQ(i.orientation_conflicts, 0u);
+  EXPECT_EQ(i.duplicate_faces, 0u);
+  EXPECT_EQ(i.degenerate_faces, 0u);
+  EXPECT_EQ(i.unreferenced_vertices, 0u);
+  EXPECT_EQ(i.euler, 2);
+  EXPECT_EQ(i.genus, 0);
+  EXPECT_TRUE(i.watertight());
+  EXPECT_TRUE(i.manifold());
+  EXPECT_DOUBLE_EQ(i.box.diagonal(), std::sqrt(3.0));
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(i.box.lo[k], 0.0);
+    EXPECT_EQ(i.box.hi[k], 1.0);
+  }
+}
+
+TEST(MeshInfo, IcosphereAndTetrahedronAreGenusZero) {
+  MeshInfo s = mesh_info(test::icosphere(2));
+  EXPECT_EQ(s.faces, 320u);
+  EXPECT_EQ(s.edges, 480u);
+  EXPECT_EQ(s.genus, 0);
+  MeshInfo t = mesh_info(test::tetrahedron());
+  EXPECT_EQ(t.edges, 6u);
+  EXPECT_EQ(t.genus, 0);
+  EXPECT_EQ(t.orientation_conflicts, 0u);
+}
+
+TEST(MeshInfo, GridHasOneBoundaryLoop) {
+  const int n = 4;
+  MeshInfo i = mesh_info(test::grid(n));
+  EXPECT_EQ(i.vertices, 25u);
+  EXPECT_EQ(i.faces, 32u);
+  EXPECT_EQ(i.edges, 2u * n * (n + 1) + n * n);  // rows, columns, one diagonal per quad
+  EXPECT_EQ(i.boundary_edges, 4u * n);
+  EXPECT_EQ(i.boundary_loops, 1u);
+  EXPECT_EQ(i.components, 1u);
+  EXPECT_EQ(i.euler, 1);  // a disk
+  EXPECT_EQ(i.genus, -1);
+  EXPECT_FALSE(i.watertight());
+  EXPECT_TRUE(i.manifold());
+}
+
+TEST(MeshInfo, TorusHasGenusOne) {
+  // n x n grid wrapped in both directions (vertex indices modulo n): a closed torus.
+  const int n = 6;
+  Mesh m;
+  const double pi = std::acos(-1.0);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      double u = 2 * pi * i / n, v = 2 * pi * j / n;
+      m.positions.insert(m.positions.end(),
+                         {(2 + std::cos(v)) * std::cos(u), (2 + std::cos(v)) * std::sin(u), std::sin(v)});
+    }
+  auto id = [n](int i, int j) { return std::uint32_t((j % n) * n + (i % n)); };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      m.indices.insert(m.indices.end(), {id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      m.indices.insert(m.indices.end(), {id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+  MeshInfo i = mesh_info(m);
+  EXPECT_EQ(i.boundary_edges, 0u);
+  EXPECT_EQ(i.orientation_conflicts, 0u);
+  EXPECT_EQ(i.euler, 0);
+  EXPECT_EQ(i.genus, 1);
+}
+
+TEST(MeshInfo, TwoCubesSharingAnEdgeAreNonManifold) {
+  // The second cube's edge (0,0,0)-(0,0,1) lands on the first cube's edge (1,1,0)-(1,1,1).
+  Mesh m = welded(test::concatenated(test::cube(), test::transformed(test::cube(), 1, 1, 1, 0)));
+  MeshInfo i = mesh_info(m);
+  EXPECT_EQ(i.vertices, 14u);
+  EXPECT_EQ(i.edges, 35u);
+  EXPECT_EQ(i.non_manifold_edges, 1u);
+  EXPECT_EQ(i.non_manifold_vertices, 2u);  // the shared edge's ends: one fan per cube
+  EXPECT_EQ(i.boundary_edges, 0u);
+  EXPECT_EQ(i.components, 1u);
+  EXPECT_FALSE(i.manifold());
+  EXPECT_FALSE(i.watertight());
+  EXPECT_EQ(i.genus, -1);
+}
+
+TEST(MeshInfo, TwoTetrahedraSharingAVertexHaveOneNonManifoldVertex) {
+  Mesh a = test::tetrahedron();
+  // Mirror through the vertex (1,1,1): the copy touches the original only there.
+  Mesh b = test::transformed(a, -1, 2, 2, 2);
+  for (std::size_t f = 0; f < b.face_count(); ++f) flip_face(b, f);  // mirroring flips orientation
+  MeshInfo i = mesh_info(welded(test::concatenated(a, b)));
+  EXPECT_EQ(i.vertices, 7u);
+  EXPECT_EQ(i.non_manifold_edges, 0u);
+  EXPECT_EQ(i.non_manifold_vertices, 1u);
+  EXPECT_EQ(i.components, 1u);
+  EXPECT_EQ(i.orientation_conflicts, 0u);
+  EXPECT_EQ(i.genus, -1);  // not a manifold, so no genus
+}
+
+TEST(MeshInfo, FlippedFaceGivesOrientationConflicts) {
+  Mesh m = test::cube();
+  flip_face(m, 5);
+  MeshInfo i = mesh_info(m);
+  EXPECT_EQ(i.orientation_conflicts, 3u);
+  EXPECT_TRUE(i.watertight());
+  EXPECT_TRUE(i.manifold());
+  EXPECT_EQ(i.genus, -1);
+}
+
+TEST(MeshInfo, DuplicateFacesCountedOncePerExtraCopy) {
+  Mesh m = test::cube();
+  // Face 0 again, once as stored and once reversed: same vertex set both times.
+  m.indices.insert(m.indices.end(), {0, 2, 1, 1, 2, 0});
+  MeshInfo i = mesh_info(m);
+  EXPECT_EQ(i.duplicate_faces, 2u);
+  EXPECT_EQ(i.non_manifold_edges, 3u);  // each edge of face 0 now has 4 faces
+  EXPECT_EQ(i.edges, 18u);
+  EXPECT_EQ(i.degenerate_faces, 0u);
+}
+
+TEST(MeshInfo, DegenerateFacesRepeatedIndexAndZeroArea) {
+  Mesh m = test::grid(4);
+  m.indices.insert(m.indices.end(), {0, 0, 6});  // repeated index: no edges
+  m.indices.insert(m.indices.end(), {0, 1, 2});  // three collinear vertices of the first row
+  MeshInfo i = mesh_info(m);
+  EXPECT_EQ(i.degenerate_faces, 2u);
+  EXPECT_EQ(i.zero_area_faces, 1u);
+  // The zero-area face adds the edge 0-2 and makes 0-1 and 1-2 two-face edges.
+  EXPECT_EQ(i.edges, 56u + 1u);
+  EXPECT_EQ(i.boundary_edges, 16u - 2u + 1u);
+  EXPECT_EQ(i.euler, 25 - 57 + 33);
+}
+
+TEST(MeshInfo, SeparateComponentsAndUnreferencedVertices) {
+  Mesh m = test::concatenated(test::cube(), test::transformed(test::cube(), 1, 5, 0, 0));
+  m = test::concatenated(m, test::transformed(test::tetrahedron(), 1, 0, 5, 0));
+  m.positions.insert(m.positions.end(), {9, 9, 9});  // unreferenced
+  MeshInfo i = mesh_info(m);
+  EXPECT_EQ(i.components, 3u);
+  EXPECT_EQ(i.unreferenced_vertices, 1u);
+  EXPECT_EQ(i.genus, 0);  // sum over components
+  EXPECT_EQ(i.euler, 6);
+  EXPECT_EQ(i.box.hi[0], 9.0);  // the box includes unreferenced vertices
+}
+
+TEST(MeshInfo, SeparateTrianglesAreSeparateLoops) {
+  Mesh m;
+  m.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, 5, 0, 0, 6, 0, 0, 5, 1, 0};
+  m.indices = {0, 1, 2, 3, 4, 5};
+  MeshInfo i = mesh_info(m);
+  EXPECT_EQ(i.components, 2u);
+  EXPECT_EQ(i.boundary_loops, 2u);
+  EXPECT_EQ(i.boundary_edges, 6u);
+}
+
+TEST(MeshInfo, EmptyMesh) {
+  MeshInfo i = mesh_info(Mesh{});
+  EXPECT_EQ(i.vertices, 0u);
+  EXPECT_EQ(i.faces, 0u);
+  EXPECT_EQ(i.edges, 0u);
+  EXPECT_EQ(i.components, 0u);
+  EXPECT_EQ(i.genus, -1);
+}
+
+TEST(MeshInfo, IndexOutOfRangeThrows) {
+  Mesh m = test::cube();
+  m.indices[7] = 8;
+  EXPECT_THROW(mesh_info(m), Error);
+  try {
+    mesh_info(m);
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("face 2"), std::string::npos) << e.what();
+  }
+}
+
+TEST(MeshInfo, FaceOrderDoesNotMatter) {
+  Mesh m = welded(test::concatenated(test::cube(), test::transformed(test::cube(), 1, 1, 1, 0)));
+  flip_face(m, 3);
+  m.indices.insert(m.indices.end(), {0, 1, 1, 2, 3, 0});
+  MeshInfo a = mesh_info(m);
+  std::vector<std::size_t> order(m.face_count());
+  for (std::size_t f = 0; f < order.size(); ++f) order[f] = f;
+  std::mt19937 rng(7);
+  std::shuffle(order.begin(), order.end(), rng);
+  Mesh s = m;
+  for (std::size_t f = 0; f < order.size(); ++f)
+    for (int k = 0; k < 3; ++k) s.indices[3 * f + k] = m.indices[3 * order[f] + k];
+  MeshInfo b = mesh_info(s);
+  EXPECT_EQ(a.edges, b.edges);
+  EXPECT_EQ(a.boundary_edges, b.boundary_edges);
+  EXPECT_EQ(a.boundary_loops, b.boundary_loops);
+  EXPECT_EQ(a.non_manifold_edges, b.non_manifold_edges);
+  EXPECT_EQ(a.non_manifold_vertices, b.non_manifold_vertices);
+  EXPECT_EQ(a.orientation_conflicts, b.orientation_conflicts);
+  EXPECT_EQ(a.duplicate_faces, b.duplicate_faces);
+  EXPECT_EQ(a.degenerate_faces, b.degenerate_faces);
+  EXPECT_EQ(a.components, b.components);
+  EXPECT_EQ(a.euler, b.euler);
+}
+
+TEST(MeshInfo, MillionFacesIsFast) {
+  const int n = 708;  // 2 * 708^2 = 1,002,528 faces
+  Mesh m = test::grid(n);
+  // Best of two runs: the first one pays for page faults, and the machine may be shared.
+  MeshInfo i;
+  double seconds = 1e9;
+  for (int run = 0; run < 2; ++run) {
+    auto t0 = std::chrono::steady_clock::now();
+    i = mesh_info(m);
+    seconds = std::min(seconds, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+  RecordProperty("seconds", std::to_string(seconds));
+  EXPECT_EQ(i.faces, 2u * n * n);
+  EXPECT_EQ(i.boundary_edges, 4u * n);
+  EXPECT_EQ(i.boundary_loops, 1u);
+  EXPECT_EQ(i.edges, 2u * n * (n + 1) + std::size_t(n) * n);
+  EXPECT_EQ(i.euler, 1);
+  // Only optimised, uninstrumented builds promise the speed (1M faces well under a second).
+  if (kOptimisedBuild) {
+    EXPECT_LT(seconds, 1.0);
+  }
+}
+
+}  // namespace
+}  // namespace qem
