@@ -18,6 +18,9 @@ class Stopwatch {
   std::chrono::steady_clock::time_point start_;
 };
 
+/// CPU seconds used by this process so far (user + system).
+double process_cpu_seconds();
+
 /// Peak resident set size of this process in MB (VmHWM), or 0 if unknown.
 double peak_rss_mb();
 

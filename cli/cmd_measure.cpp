@@ -69,7 +69,8 @@ void print_table(const MeasureArgs& a, const Mesh& original, const Mesh& approx,
                  double seconds) {
   std::printf("original       %s (%zu faces, area %.6g)\n", a.original.c_str(), original.face_count(),
               r.area_original);
-  std::printf("approximation  %s (%zu faces, area %.6g", a.approx.c_str(), approx.face_count(), r.area_approx);
+  std::printf("approximation  %s (%zu faces, area %.6g", a.approx.c_str(), approx.face_count(),
+              r.area_approx);
   if (r.degenerate_approx) std::printf(", %zu zero-area faces ignored", r.degenerate_approx);
   std::printf(")\n");
   std::printf("samples        %zu on the original + %zu on the approximation (seed %llu)\n",
@@ -77,7 +78,9 @@ void print_table(const MeasureArgs& a, const Mesh& original, const Mesh& approx,
   std::printf("bbox diagonal  %.6g (of the original; \"relative\" divides by it, E by its square)\n\n",
               r.bbox_diag);
   std::printf("%-28s %14s %14s\n", "", "absolute", "relative");
-  auto row = [](const char* name, double abs, double rel) { std::printf("%-28s %14.6e %14.6e\n", name, abs, rel); };
+  auto row = [](const char* name, double abs, double rel) {
+    std::printf("%-28s %14.6e %14.6e\n", name, abs, rel);
+  };
   const double d = r.bbox_diag;
   row("E (GH97 6.1, mean sq dist)", r.E, r.E_rel);
   row("RMS = sqrt(E)", r.rms, r.rms_rel);
@@ -101,14 +104,17 @@ int run_measure(MeasureArgs& a) {
   a.options.per_vertex = !a.per_vertex.empty();
   MeasureResult r = measure(original, approx, a.options);
   const double seconds = clock.seconds();
-  if (a.json) print_json(a, original, approx, r, seconds);
-  else print_table(a, original, approx, r, seconds);
+  if (a.json)
+    print_json(a, original, approx, r, seconds);
+  else
+    print_table(a, original, approx, r, seconds);
   if (!a.per_vertex.empty()) {
     approx.vertex_properties.clear();
     approx.vertex_properties.push_back({"distance", std::move(r.vertex_distance)});
     save_mesh(a.per_vertex, approx);
-    if (!a.json) std::printf("per-vertex     %s (property `distance`: approx vertex -> original)\n",
-                             a.per_vertex.c_str());
+    if (!a.json)
+      std::printf("per-vertex     %s (property `distance`: approx vertex -> original)\n",
+                  a.per_vertex.c_str());
   }
   return 0;
 }

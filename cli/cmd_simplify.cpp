@@ -22,7 +22,7 @@ struct SimplifyArgs {
   double max_error = -1, max_error_rel = -1;
   double threshold = 0, threshold_rel = 0;
   std::string weighting = "area", placement = "optimal", inversion = "forbid";
-  double boundary_weight = 1000;
+  double boundary_weight = 1;
   double max_turn = 75;
   bool lock_border = false, allow_non_manifold = false;
   bool weld = false, no_weld = false, ascii = false;
@@ -78,8 +78,10 @@ int run_simplify(const SimplifyArgs& a) {
   const double load_s = t_load.seconds();
 
   Stopwatch t_simplify;
+  const double cpu0 = process_cpu_seconds();
   SimplifyResult r = simplify(mesh, opt);
   const double simplify_s = t_simplify.seconds();
+  const double simplify_cpu_s = process_cpu_seconds() - cpu0;
   if (show_progress) std::fprintf(stderr, "\n");
 
   Stopwatch t_write;
@@ -91,12 +93,14 @@ int run_simplify(const SimplifyArgs& a) {
   if (a.json) {
     std::printf(
         "{\"tool\":\"qem\",\"in_faces\":%zu,\"target_faces\":%zu,\"out_faces\":%zu,\"out_vertices\":%zu,"
-        "\"load_s\":%s,\"simplify_s\":%s,\"write_s\":%s,\"total_s\":%s,\"peak_rss_mb\":%s,\"max_error\":%s,"
-        "\"max_error_rel\":%s,\"contractions\":%zu,\"virtual_pairs\":%zu,\"stop\":\"%s\"}\n",
+        "\"load_s\":%s,\"simplify_s\":%s,\"simplify_cpu_s\":%s,\"write_s\":%s,\"total_s\":%s,\"peak_rss_mb\":%s,\"max_error\":%s,"
+        "\"max_error_rel\":%s,\"contractions\":%zu,\"virtual_pairs\":%zu,\"rejected_topology\":%zu,"
+        "\"rejected_inversion\":%zu,\"rejected_error\":%zu,\"stop\":\"%s\"}\n",
         mesh.face_count(), a.faces, r.mesh.face_count(), r.mesh.vertex_count(), json_number(load_s).c_str(),
-        json_number(simplify_s).c_str(), json_number(write_s).c_str(), json_number(total.seconds()).c_str(),
+        json_number(simplify_s).c_str(), json_number(simplify_cpu_s).c_str(), json_number(write_s).c_str(), json_number(total.seconds()).c_str(),
         json_number(peak_rss_mb()).c_str(), json_number(r.max_error).c_str(),
-        json_number(r.max_error_relative).c_str(), r.contractions, r.virtual_pairs, to_string(r.stop_reason));
+        json_number(r.max_error_relative).c_str(), r.contractions, r.virtual_pairs, r.rejected_topology, r.rejected_inversion, r.rejected_error,
+        to_string(r.stop_reason));
   }
   if (!a.quiet)
     std::fprintf(stderr, "qem: %zu -> %zu faces, %zu vertices, max error %.4g (%.3g of diagonal), %.3f s; %s\n",

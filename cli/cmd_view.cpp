@@ -35,7 +35,7 @@ struct ViewArgs {
 };
 
 view::ViewScene build_scene(const ViewArgs& a) {
-  if (a.chain && a.compare) throw Error("qem view: --chain and --compare exclude each other");
+  if (a.chain && a.compare) throw Error("--chain and --compare exclude each other");
   view::ViewScene scene;
   std::vector<view::ManifestLevel> entries;
   if (a.inputs.size() == 1 && view::is_manifest_path(a.inputs[0])) {
@@ -50,6 +50,10 @@ view::ViewScene build_scene(const ViewArgs& a) {
                  : entries.size() > 1 ? view::ViewMode::Chain
                                       : view::ViewMode::Single;
   }
+  // Checked before loading anything: the meshes may be large.
+  if (scene.mode == view::ViewMode::Compare && entries.size() != 2)
+    throw Error("--compare needs exactly two meshes (original and simplified), got " +
+                std::to_string(entries.size()));
   LoadOptions lo;
   lo.keep_vertex_properties = true;  // the `distance` heat map
   for (std::size_t i = 0; i < entries.size(); ++i) {
@@ -91,7 +95,7 @@ int run_view(const ViewArgs& a) {
                 a.export_dir.c_str());
     return 0;
   }
-  if (a.port < 0 || a.port > 65535) throw Error("qem view: --port must be 0..65535");
+  if (a.port < 0 || a.port > 65535) throw Error("--port must be 0..65535");
   view::HttpServer server(std::move(files), static_cast<std::uint16_t>(a.port));
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);

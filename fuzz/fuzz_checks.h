@@ -3,6 +3,7 @@
 //
 //  - check_mesh: the guarantees of io.h on a parsed mesh (valid indices, finite coordinates, one
 //    property value per vertex).
+//  - check_parse: parse, check, write back in every variant, read again.
 //  - decode_simplify_case: turns arbitrary bytes into a small mesh plus SimplifyOptions. Our own
 //    byte reader rather than libFuzzer's FuzzedDataProvider, so the decoding is identical in the
 //    fuzzer and in the GCC-built regression tests.
@@ -15,7 +16,11 @@
 #include <cstring>
 #include <limits>
 #include <string>
+#include <string_view>
+#include <vector>
 
+#include "qem/error.h"
+#include "qem/io.h"
 #include "qem/mesh.h"
 #include "qem/simplify.h"
 
@@ -36,6 +41,44 @@ inline std::string check_mesh(const Mesh& m) {
     if (p.values.size() != nv)
       return "property " + p.name + " has " + std::to_string(p.values.size()) + " values for " +
              std::to_string(nv) + " vertices";
+  return "";
+}
+
+/// Parses `bytes` as `format`. A qem::Error from the reader is the documented rejection and gives
+/// "". Otherwise the mesh must pass check_mesh, and what the writers write (a writer may refuse
+/// with qem::Error, e.g. a PLY property name it cannot write) must read back with the same face
+/// count. Returns "" or what is wrong; exceptions other than qem::Error propagate.
+inline std::string check_parse(std::string_view bytes, FileFormat format) {
+  LoadOptions options;
+  options.format = format;
+  options.keep_vertex_properties = true;  // exercise the property paths too
+  Mesh mesh;
+  try {
+    mesh = parse_mesh(bytes, format, "fuzz", options);
+  } catch (const Error&) {
+    return "";
+  }
+  std::string problem = check_mesh(mesh);
+  if (!problem.empty()) return problem;
+  const bool has_binary = format == FileFormat::Ply || format == FileFormat::Stl;
+  for (bool binary : {false, true}) {
+    if (binary && !has_binary) break;
+    std::string out;
+    try {
+      out = serialize_mesh(mesh, format, binary);
+    } catch (const Error&) {
+      return "";
+    }
+    Mesh again;
+    try {
+      again = parse_mesh(out, format, "fuzz-roundtrip", options);
+    } catch (const Error& e) {
+      return std::string("re-reading the written mesh failed: ") + e.what();
+    }
+    if (again.face_count() != mesh.face_count())
+      return "a write/read round trip changed the face count from " + std::to_string(mesh.face_count()) +
+             " to " + std::to_string(again.face_count());
+  }
   return "";
 }
 

@@ -3,6 +3,7 @@
 # runs each fuzzer for a bounded time. Usage: scripts/fuzz.sh [SECONDS_PER_FUZZER] (default 60).
 # Environment: JOBS (build parallelism), FUZZ_BUILD_DIR (default build-fuzz), FUZZERS (default
 # "obj ply stl off simplify").
+# Prints, per fuzzer, the executions reached (libFuzzer's final stat::number_of_executed_units).
 # Exits non-zero when any fuzzer finds a crash, leak, timeout or out-of-memory input; the input is
 # kept in $FUZZ_BUILD_DIR/fuzz/findings/<fuzzer>/ and the log beside it. Replay one with
 #   $FUZZ_BUILD_DIR/fuzz/fuzz_<name> <file>
@@ -44,7 +45,7 @@ for f in $FUZZERS; do
     -artifact_prefix="$findings/" >"$log" 2>&1
   rc=$?
   set -e
-  execs=$(awk '/stat::number_of_executed_runs/ {n = $2} END {print (n == "" ? "?" : n)}' "$log")
+  execs=$(awk '/stat::number_of_executed_(runs|units):/ {n = $2} END {print (n == "" ? "?" : n)}' "$log")
   # Inputs written by this run (earlier findings stay in the folder until someone removes them).
   new=$(find "$findings" -maxdepth 1 -type f -newer "$log.start" ! -name 'slow-unit-*')
   rm -f "$log.start"

@@ -9,6 +9,8 @@ FUZZ_SECONDS=${FUZZ_SECONDS:-60}
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j"$JOBS"
 ctest --test-dir build --output-on-failure -j"$JOBS"
+# The viewer in a real (headless) browser.
+BUILD_DIR=build scripts/test-web.sh
 
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DQEM_SANITIZE=ON
 cmake --build build-asan -j"$JOBS"

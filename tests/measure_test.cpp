@@ -4,14 +4,20 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <string>
 
 #include "measure/bvh.h"
 #include "measure/point_triangle.h"
 #include "measure/rng.h"
 #include "measure/surface_sampling.h"
+#include "qem/cluster.h"
 #include "qem/error.h"
+#include "qem/io.h"
 #include "test_meshes.h"
 
 namespace qem {
@@ -72,6 +78,22 @@ TEST(Measure, BvhMatchesBruteForce) {
   }
 }
 
+TEST(Measure, BvhWarmStartGivesSameAnswer) {
+  const Mesh sphere = test::icosphere(4);
+  const measure_detail::Surface s = measure_detail::make_surface(sphere, "sphere");
+  const measure_detail::TriangleBvh bvh(s.corners);
+  measure_detail::Rng rng(11);
+  std::uint32_t hint = UINT32_MAX;
+  for (int i = 0; i < 2000; ++i) {
+    // A random walk, so consecutive queries are close (the case the hint is for), with jumps.
+    const double p[3] = {1.2 * std::cos(i * 0.01), 1.2 * std::sin(i * 0.013), 0.8 * rng.uniform() - 0.4};
+    const auto cold = bvh.closest(p);
+    const auto warm = bvh.closest(p, &hint);
+    ASSERT_EQ(warm.d2, cold.d2) << i;
+    EXPECT_EQ(hint, warm.triangle);
+  }
+}
+
 TEST(Measure, SamplesAreUniformByArea) {
   // Two triangles of areas 1/8 and 7/8 (split of the unit square at x = 1/4 on the bottom edge):
   // the mean x of area-uniform samples is the square's centroid, 1/2, only if faces are picked by area.
@@ -112,11 +134,12 @@ TEST(Measure, IdenticalMeshesGiveZero) {
 // Hausdorff: the corner (0,0,0) is d from C', and nothing is farther: exactly d.
 TEST(Measure, ShiftedCubeMatchesClosedForm) {
   const double d = 0.1;
-  const double I = d * d + d * d * (1 - 2 * d) * (1 - 2 * d) + 4 * d * d * d / 3 - 2 * d * d * d * d +
-                   4 * d * d * d / 3;
+  const double I =
+      d * d + d * d * (1 - 2 * d) * (1 - 2 * d) + 4 * d * d * d / 3 - 2 * d * d * d * d + 4 * d * d * d / 3;
   const double E_exact = I / 6;
   ASSERT_NEAR(E_exact, 0.0031444, 1e-7);
-  const double mean_exact = (d + d * (1 - 2 * d) * (1 - 2 * d) + 2 * d * d - 8 * d * d * d / 3 + 2 * d * d) / 6;
+  const double mean_exact =
+      (d + d * (1 - 2 * d) * (1 - 2 * d) + 2 * d * d - 8 * d * d * d / 3 + 2 * d * d) / 6;
   const Mesh c = test::cube();
   const Mesh shifted = test::transformed(c, 1, d, 0, 0);
   const MeasureResult r = measure(c, shifted, with_samples(400000, 2));
@@ -162,7 +185,7 @@ TEST(Measure, DeterministicAcrossRunsAndThreads) {
   MeasureOptions other = with_samples(50000, 2);
   other.seed = 2;
   const MeasureResult r2 = measure(a, b, other);
-  EXPECT_NE(r2.E, r1.E);                  // a different sample set...
+  EXPECT_NE(r2.E, r1.E);                 // a different sample set...
   EXPECT_NEAR(r2.E, r1.E, 0.05 * r1.E);  // ...estimating the same integral
 }
 
@@ -197,6 +220,66 @@ TEST(Measure, DegenerateFacesIgnoredAndBadInputRejected) {
   Mesh bad = test::cube();
   bad.indices[5] = 99;
   EXPECT_THROW(measure(bad, test::cube()), Error);
+}
+
+// The CLI prints the library's numbers (one JSON line) and writes the per-vertex distances.
+TEST(Measure, CliJsonAndPerVertex) {
+  const std::string dir = test::temp_dir();
+  const std::string a = dir + "/measure_cube.ply", b = dir + "/measure_shifted.ply",
+                    pv = dir + "/measure_pv.ply";
+  save_mesh(a, test::cube());
+  save_mesh(b, test::transformed(test::cube(), 1, 0.1, 0, 0));
+  const std::string cmd = std::string(QEM_CLI_PATH) + " measure " + a + " " + b +
+                          " --samples 20000 --json --per-vertex " + pv + " > " + dir + "/measure_out.json";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  std::FILE* f = std::fopen((dir + "/measure_out.json").c_str(), "rb");
+  ASSERT_NE(f, nullptr);
+  char buf[4096] = {};
+  const std::size_t len = std::fread(buf, 1, sizeof buf - 1, f);
+  std::fclose(f);
+  const std::string out(buf, len);
+  EXPECT_EQ(out.find('\n'), out.size() - 1);  // exactly one line
+  MeasureOptions o;
+  o.samples = 20000;
+  const MeasureResult r = measure(load_mesh(a), load_mesh(b), o);  // as stored (PLY may round to float)
+  const std::size_t at = out.find("\"E\":");
+  ASSERT_NE(at, std::string::npos) << out;
+  EXPECT_EQ(std::strtod(out.c_str() + at + 4, nullptr), r.E) << out;  // round-trip formatting
+  for (const char* key :
+       {"\"E_rel\":", "\"rms\":", "\"hausdorff\":", "\"mean_rel\":", "\"bbox_diag\":", "\"h_o2a\":"})
+    EXPECT_NE(out.find(key), std::string::npos) << key;
+  LoadOptions lo;
+  lo.keep_vertex_properties = true;
+  const Mesh m = load_mesh(pv, lo);
+  const VertexProperty* d = m.find_property("distance");
+  ASSERT_NE(d, nullptr);
+  ASSERT_EQ(d->values.size(), 8u);
+  for (std::size_t v = 0; v < 8; ++v) EXPECT_NEAR(d->values[v], m.positions[3 * v] > 1 ? 0.1 : 0.0, 1e-6);
+}
+
+// On a real mesh: swapping the arguments exchanges the one-sided values and keeps E (up to
+// sampling), and a finer clustering is closer than a coarser one.
+TEST(Measure, RealMeshSymmetryAndMonotonicity) {
+  const std::string path = test::shared_data("gh_cow.obj");
+  if (path.empty()) GTEST_SKIP() << "shared data not found";
+  const Mesh cow = load_mesh(path);
+  ClusterOptions co;
+  co.cell = 0.02;
+  co.cell_relative = true;
+  const Mesh coarse = cluster(cow, co);
+  co.cell = 0.01;
+  const Mesh fine = cluster(cow, co);
+  MeasureOptions o;
+  o.samples = 200000;
+  const MeasureResult rc = measure(cow, coarse, o), rf = measure(cow, fine, o);
+  const MeasureResult swapped = measure(coarse, cow, o);
+  EXPECT_NEAR(swapped.E, rc.E, 0.05 * rc.E);
+  EXPECT_NEAR(swapped.mean_approx_to_original, rc.mean_original_to_approx, 0.05 * rc.mean_original_to_approx);
+  EXPECT_LT(rf.E, rc.E);
+  EXPECT_LT(rf.hausdorff, rc.hausdorff);
+  EXPECT_GT(rf.E, 0);
+  EXPECT_LE(rc.rms, rc.hausdorff);
+  EXPECT_LE(rc.mean, rc.rms);
 }
 
 }  // namespace

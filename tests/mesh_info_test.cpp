@@ -4,13 +4,19 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
 #include <map>
+#include <optional>
 #include <random>
+#include <string>
 #include <tuple>
 
 #include "qem/error.h"
+#include "qem/io.h"
 #include "test_meshes.h"
 
 namespace qem {
@@ -102,7 +108,7 @@ TEST(MeshInfo, GridHasOneBoundaryLoop) {
 
 TEST(MeshInfo, TorusHasGenusOne) {
   // n x n grid wrapped in both directions (vertex indices modulo n): a closed torus.
-  const int n = 6;
+  constexpr int n = 6;
   Mesh m;
   const double pi = std::acos(-1.0);
   for (int j = 0; j < n; ++j)
@@ -111,7 +117,7 @@ TEST(MeshInfo, TorusHasGenusOne) {
       m.positions.insert(m.positions.end(),
                          {(2 + std::cos(v)) * std::cos(u), (2 + std::cos(v)) * std::sin(u), std::sin(v)});
     }
-  auto id = [n](int i, int j) { return std::uint32_t((j % n) * n + (i % n)); };
+  auto id = [](int i, int j) { return std::uint32_t((j % n) * n + (i % n)); };
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i) {
       m.indices.insert(m.indices.end(), {id(i, j), id(i + 1, j), id(i + 1, j + 1)});
@@ -276,6 +282,81 @@ TEST(MeshInfo, MillionFacesIsFast) {
     EXPECT_LT(seconds, 1.0);
   }
 }
+
+// --- agreement with the catalogue's reference statistics (shared data, skipped when absent) ---------
+
+/// The number stored under "key" in one JSON line of stats.jsonl; nullopt for null or absent.
+std::optional<double> json_number(const std::string& line, const std::string& key) {
+  std::size_t at = line.find("\"" + key + "\": ");
+  if (at == std::string::npos) return std::nullopt;
+  const char* p = line.c_str() + at + key.size() + 4;
+  char* end = nullptr;
+  double v = std::strtod(p, &end);
+  if (end == p) return std::nullopt;  // null, true, a string...
+  return v;
+}
+
+/// The stats.jsonl line of a catalogue file, or "".
+std::string catalogue_line(const std::string& file) {
+  std::string path = test::shared_data("gen/stats.jsonl");
+  if (path.empty()) return "";
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line))
+    if (line.find("\"file\": \"" + file + "\"") != std::string::npos) return line;
+  return "";
+}
+
+class MeshInfoCatalogue : public testing::TestWithParam<const char*> {};
+
+TEST_P(MeshInfoCatalogue, MatchesReferenceStatistics) {
+  const std::string file = GetParam();
+  const std::string path = test::shared_data(file);
+  const std::string line = catalogue_line(file);
+  if (path.empty() || line.empty()) GTEST_SKIP() << file << " or gen/stats.jsonl not in the shared data";
+  // The reference tool welds STL by exact position, as load_mesh does by default (Weld::Auto).
+  MeshInfo i = mesh_info(load_mesh(path));
+  auto expect = [&](const char* key, double actual) {
+    std::optional<double> want = json_number(line, key);
+    ASSERT_TRUE(want.has_value()) << key;
+    EXPECT_EQ(actual, *want) << file << ": " << key;
+  };
+  expect("V", double(i.vertices));
+  expect("T", double(i.faces));
+  expect("unreferenced_V", double(i.unreferenced_vertices));
+  expect("E", double(i.edges));
+  expect("boundary_E", double(i.boundary_edges));
+  expect("boundary_loops", double(i.boundary_loops));
+  expect("nonmanifold_E", double(i.non_manifold_edges));
+  expect("nonmanifold_V", double(i.non_manifold_vertices));
+  expect("components", double(i.components));
+  expect("duplicate_T", double(i.duplicate_faces));
+  expect("zero_area_T", double(i.zero_area_faces));
+  expect("degenerate_T", double(i.degenerate_faces - i.zero_area_faces));  // repeated index only there
+  expect("orientation_conflicts", double(i.orientation_conflicts));
+  expect("euler", double(i.euler));
+  std::optional<double> genus = json_number(line, "genus_sum");
+  EXPECT_EQ(i.genus, genus ? (long long)*genus : -1) << file << ": genus";
+  std::optional<double> diag = json_number(line, "bbox_diag");
+  ASSERT_TRUE(diag.has_value());
+  EXPECT_NEAR(i.box.diagonal(), *diag, 1e-6 * (1 + *diag));  // stats round to 6 decimals
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    SharedData, MeshInfoCatalogue,
+    testing::Values("tiny_non_manifold_wrap.obj", "tiny_degenerate_faces.obj", "tiny_isolated_triangles.obj",
+                    "tiny_joined_tetrahedra.obj", "tiny_shared_edge_cubes.stl", "tiny_sphere_vcolor.ply",
+                    "tiny_soup.stl", "tiny_wallhole_linecont.obj", "tiny_multibody.stl", "gh_cow.obj",
+                    "gh_bunny_zipper.ply", "gh_foot_bones.off", "synth_cubes_10x10.ply", "suzanne.obj",
+                    "cgal_blobby_shuffled.off", "cgal_b9_mesh.off", "stanford_dragon_vrip_res4.ply",
+                    "trimesh_chair.obj", "falconstatue_boundary.obj", "hoppe_mechpart.ply",
+                    "cgal_couplingdown.off", "stanford_bunny_soup.stl"),
+    [](const testing::TestParamInfo<const char*>& info) {
+      std::string name = info.param;
+      for (char& c : name)
+        if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+      return name;
+    });
 
 }  // namespace
 }  // namespace qem

@@ -1,5 +1,6 @@
 #include "test_meshes.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <filesystem>

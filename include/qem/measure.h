@@ -24,10 +24,10 @@ struct MeasureOptions {
 };
 
 struct MeasureResult {
-  double E = 0, E_rel = 0;                  ///< mean squared distance over both sample sets
-  double rms = 0, rms_rel = 0;              ///< sqrt(E)
-  double mean = 0, mean_rel = 0;            ///< mean distance over both sample sets
-  double hausdorff = 0, hausdorff_rel = 0;  ///< symmetric
+  double E = 0, E_rel = 0;                                    ///< mean squared distance over both sample sets
+  double rms = 0, rms_rel = 0;                                ///< sqrt(E)
+  double mean = 0, mean_rel = 0;                              ///< mean distance over both sample sets
+  double hausdorff = 0, hausdorff_rel = 0;                    ///< symmetric
   double h_original_to_approx = 0, h_approx_to_original = 0;  ///< one-sided maxima
   double mean_original_to_approx = 0, mean_approx_to_original = 0;
   double rms_original_to_approx = 0, rms_approx_to_original = 0;
@@ -35,7 +35,7 @@ struct MeasureResult {
   double area_original = 0, area_approx = 0;
   std::size_t samples_original = 0, samples_approx = 0;
   std::size_t degenerate_original = 0, degenerate_approx = 0;  ///< zero-area faces, ignored
-  std::vector<double> vertex_distance;  ///< per approx vertex (all of them), if asked
+  std::vector<double> vertex_distance;                         ///< per approx vertex (all of them), if asked
 };
 
 /// Throws qem::Error when a mesh has an out-of-range index or no face of non-zero area.

@@ -59,7 +59,7 @@ struct SimplifyOptions {
   double threshold = 0;
   bool threshold_is_relative = false;  ///< threshold is a fraction of the bounding-box diagonal
   /// Penalty weight of the boundary constraint planes (GH97 §6); 0 disables them.
-  double boundary_weight = 1000;
+  double boundary_weight = 1;
   bool lock_border = false;  ///< boundary vertices never move
   InversionPolicy inversion = InversionPolicy::Forbid;
   /// A face that turns by more than this (degrees) counts as an inversion; must be < 90.
@@ -77,6 +77,8 @@ struct SimplifyResult {
   std::size_t input_vertices = 0;   ///< referenced vertices of the input
   std::size_t contractions = 0;
   std::size_t virtual_pairs = 0;    ///< non-edge pairs found with the threshold t
+  /// Candidate contractions popped from the heap and refused (each may be retried later).
+  std::size_t rejected_topology = 0, rejected_inversion = 0, rejected_error = 0;
   double max_error = 0;             ///< largest contraction error performed (distance units)
   double max_error_relative = 0;    ///< the same over the bounding-box diagonal
   StopReason stop_reason = StopReason::TargetReached;

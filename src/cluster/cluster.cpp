@@ -64,8 +64,8 @@ Grid grid_of(MeshView mesh, const std::vector<char>& used, const ClusterOptions&
   if (use_grid) {
     for (int k = 0; k < 3; ++k) {
       if (o.grid[k] > kMaxCellsPerAxis)
-        throw Error("cluster: grid of " + std::to_string(o.grid[k]) + " cells along an axis is too fine (at most " +
-                    std::to_string(kMaxCellsPerAxis) + ")");
+        throw Error("cluster: grid of " + std::to_string(o.grid[k]) +
+                    " cells along an axis is too fine (at most " + std::to_string(kMaxCellsPerAxis) + ")");
       g.n[k] = o.grid[k];
       g.size[k] = extent[k] / double(g.n[k]);
     }
@@ -129,7 +129,8 @@ std::vector<double> place(MeshView mesh, const std::vector<std::uint32_t>& clust
   for (std::size_t f = 0; f < mesh.face_count(); ++f) {
     const std::uint32_t* t = &mesh.indices[3 * f];
     const double *a = &P[3 * t[0]], *b = &P[3 * t[1]], *c = &P[3 * t[2]];
-    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]},
+                 w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
     double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
     const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     if (!(len > 0)) continue;  // zero-area face: no plane
@@ -205,7 +206,8 @@ Mesh cluster(MeshView mesh, const ClusterOptions& options) {
   for (std::size_t i = 0; i < mesh.indices.size(); ++i) {
     if (mesh.indices[i] >= nv)
       throw Error("cluster: face " + std::to_string(i / 3) + " references vertex " +
-                  std::to_string(mesh.indices[i]) + " but there are only " + std::to_string(nv) + " vertices");
+                  std::to_string(mesh.indices[i]) + " but there are only " + std::to_string(nv) +
+                  " vertices");
     used[mesh.indices[i]] = 1;
   }
   for (std::size_t v = 0; v < nv; ++v)

@@ -1,9 +1,13 @@
-// A binary min-heap over item ids 0..n-1 keyed by an external cost array, with O(log n) update and
-// removal of any item: the "heap keyed on cost" of GH97 §4. Indexed rather than lazy, so memory
-// stays at 8 bytes per pair however many times costs change. Ties break on the id, so the order
-// of contractions is fully determined by the input.
+// A 4-ary min-heap over item ids 0..n-1 with O(log n) update and removal of any item: the "heap
+// keyed on cost" of GH97 §4. Indexed rather than lazy, so memory stays at 16 + 4 bytes per pair
+// however many times costs change. Each entry carries its key, so sifting touches only the heap
+// array (no indirection into a cost array: that was the simplifier's main source of cache misses).
+// Ties break on the id, so the order of contractions is fully determined by the input. Four
+// children of 16 bytes fill one 64-byte cache line, and the tree is half as deep as a binary one:
+// sift-down, the heap's hot path, then costs about half the cache misses.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -13,8 +17,6 @@ class IndexedHeap {
  public:
   static constexpr std::uint32_t kAbsent = 0xffffffffu;
 
-  explicit IndexedHeap(const std::vector<double>& keys) : keys_(keys) {}
-
   void reset(std::size_t id_count) {
     heap_.clear();
     slot_.assign(id_count, kAbsent);
@@ -22,82 +24,94 @@ class IndexedHeap {
   bool empty() const { return heap_.empty(); }
   std::size_t size() const { return heap_.size(); }
   bool contains(std::uint32_t id) const { return slot_[id] != kAbsent; }
-  std::uint32_t top() const { return heap_[0]; }
+  std::uint32_t top() const { return heap_[0].id; }
+  /// The key `id` is held at (it must be in the heap).
+  double key_of(std::uint32_t id) const { return heap_[slot_[id]].key; }
+  double top_key() const { return heap_[0].key; }
 
-  /// Builds the heap from all ids at once in O(n) (Floyd).
-  void build(const std::vector<std::uint32_t>& ids) {
-    heap_ = ids;
-    for (std::uint32_t i = 0; i < heap_.size(); ++i) slot_[heap_[i]] = i;
-    for (std::size_t i = heap_.size() / 2; i-- > 0;) sift_down(std::uint32_t(i));
+  /// Appends without ordering; call heapify() once after the last push (Floyd, O(n)).
+  void push_unordered(std::uint32_t id, double key) {
+    slot_[id] = std::uint32_t(heap_.size());
+    heap_.push_back({key, id});
+  }
+  void heapify() {
+    for (std::size_t i = heap_.size() / kArity + 1; i-- > 0;)
+      if (i < heap_.size()) sift_down(std::uint32_t(i));
   }
 
-  /// Inserts `id`, or repositions it after its key changed.
-  void update(std::uint32_t id) {
+  /// Inserts `id` with `key`, or moves it to its new key.
+  void update(std::uint32_t id, double key) {
     std::uint32_t s = slot_[id];
     if (s == kAbsent) {
       s = std::uint32_t(heap_.size());
-      heap_.push_back(id);
+      heap_.push_back({key, id});
       slot_[id] = s;
       sift_up(s);
-    } else {
-      sift_up(s);
-      sift_down(slot_[id]);
+      return;
     }
+    double old = heap_[s].key;
+    heap_[s].key = key;
+    if (key < old) sift_up(s);
+    else sift_down(s);
   }
 
   void remove(std::uint32_t id) {
     std::uint32_t s = slot_[id];
     if (s == kAbsent) return;
-    std::uint32_t last = heap_.back();
+    Entry last = heap_.back();
     heap_.pop_back();
     slot_[id] = kAbsent;
-    if (last == id) return;
+    if (last.id == id) return;
     heap_[s] = last;
-    slot_[last] = s;
+    slot_[last.id] = s;
     sift_up(s);
-    sift_down(slot_[last]);
+    sift_down(slot_[last.id]);
   }
 
   std::uint32_t pop() {
-    std::uint32_t id = heap_[0];
+    std::uint32_t id = heap_[0].id;
     remove(id);
     return id;
   }
 
  private:
-  bool less(std::uint32_t a, std::uint32_t b) const {
-    return keys_[a] < keys_[b] || (keys_[a] == keys_[b] && a < b);
-  }
+  struct Entry {
+    double key;
+    std::uint32_t id;
+  };
+  static bool less(const Entry& a, const Entry& b) { return a.key < b.key || (a.key == b.key && a.id < b.id); }
+  static constexpr std::uint32_t kArity = 4;
   void sift_up(std::uint32_t s) {
-    std::uint32_t id = heap_[s];
+    Entry e = heap_[s];
     while (s > 0) {
-      std::uint32_t parent = (s - 1) / 2;
-      if (!less(id, heap_[parent])) break;
+      std::uint32_t parent = (s - 1) / kArity;
+      if (!less(e, heap_[parent])) break;
       heap_[s] = heap_[parent];
-      slot_[heap_[s]] = s;
+      slot_[heap_[s].id] = s;
       s = parent;
     }
-    heap_[s] = id;
-    slot_[id] = s;
+    heap_[s] = e;
+    slot_[e.id] = s;
   }
   void sift_down(std::uint32_t s) {
-    std::uint32_t id = heap_[s];
+    Entry e = heap_[s];
     const std::uint32_t n = std::uint32_t(heap_.size());
     for (;;) {
-      std::uint32_t child = 2 * s + 1;
-      if (child >= n) break;
-      if (child + 1 < n && less(heap_[child + 1], heap_[child])) ++child;
-      if (!less(heap_[child], id)) break;
+      std::uint32_t first = kArity * s + 1;
+      if (first >= n) break;
+      std::uint32_t last = std::min(first + kArity, n), child = first;
+      for (std::uint32_t c = first + 1; c < last; ++c)
+        if (less(heap_[c], heap_[child])) child = c;
+      if (!less(heap_[child], e)) break;
       heap_[s] = heap_[child];
-      slot_[heap_[s]] = s;
+      slot_[heap_[s].id] = s;
       s = child;
     }
-    heap_[s] = id;
-    slot_[id] = s;
+    heap_[s] = e;
+    slot_[e.id] = s;
   }
 
-  const std::vector<double>& keys_;
-  std::vector<std::uint32_t> heap_;
+  std::vector<Entry> heap_;
   std::vector<std::uint32_t> slot_;
 };
 

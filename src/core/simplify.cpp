@@ -20,6 +20,7 @@
 #include "core/indexed_heap.h"
 #include "core/placement.h"
 #include "core/quadric.h"
+#include "core/spatial_order.h"
 #include "core/valid_pairs.h"
 #include "core/vertex_lists.h"
 #include "qem/error.h"
@@ -70,7 +71,7 @@ enum PairState : std::uint8_t {
 
 class Simplifier {
  public:
-  Simplifier(MeshView input, const SimplifyOptions& options) : in_(input), opt_(options), heap_(cost_) {}
+  Simplifier(MeshView input, const SimplifyOptions& options) : in_(input), opt_(options) {}
 
   SimplifyResult run();
 
@@ -83,6 +84,7 @@ class Simplifier {
   void resolve_targets();
 
   // --- the contraction loop ------------------------------------------------------------------
+  bool pair_cost(std::uint32_t p, double& cost);
   void cost_pair(std::uint32_t p);
   bool is_edge_and_link_ok(std::uint32_t a, std::uint32_t b, bool& is_edge);
   bool flips(std::uint32_t a, std::uint32_t b, const Vec3& target);
@@ -119,15 +121,24 @@ class Simplifier {
 
   std::vector<Vec3> pos_;
   std::vector<Quadric> quadric_;
-  std::vector<std::uint8_t> vertex_alive_, boundary_, moved_, has_blocked_;
+  std::vector<std::uint8_t> boundary_, moved_, has_blocked_;
   std::vector<std::uint32_t> tri_;  // 3 per working face
-  std::vector<std::uint32_t> face_source_;  // input face index of each working face
+  std::vector<std::uint32_t> face_source_;    // input face index of each working face
+  std::vector<std::uint32_t> source_vertex_;  // input vertex index of each working vertex
   std::vector<std::uint8_t> face_alive_;
   VertexLists vertex_faces_, vertex_pairs_;
 
-  std::vector<std::uint32_t> pair_v_;  // 2 per pair
-  std::vector<std::uint8_t> pair_state_;
-  std::vector<std::uint8_t> pair_virtual_;  // 1 = created by the threshold t, not an edge
+  // One record per valid pair, packed so that a pair costs one cache line visit.
+  struct PairRecord {
+    std::uint32_t v[2];
+    std::uint8_t state;
+    std::uint8_t is_virtual;  // created by the threshold t (GH97 §3.2 rule 2), not an edge
+  };
+  std::vector<PairRecord> pairs_;
+  // The current cost of each pair. Its heap key may be lower: a cost that rises (as it nearly
+  // always does after a contraction, since quadrics only grow) is not sifted down the heap; the
+  // pair is re-keyed when it reaches the top. Keys are lower bounds and the popped pair's key is
+  // verified current, so the order is exactly GH97's greedy order at a fraction of the heap work.
   std::vector<double> cost_;
   IndexedHeap heap_;
 
@@ -163,66 +174,99 @@ void Simplifier::prepare_input() {
       throw Error("face " + std::to_string(i / 3) + " refers to vertex " + std::to_string(in_.indices[i]) +
                   ", but there are only " + std::to_string(nv) + " vertices");
 
-  // Degenerate faces (a repeated corner) carry no plane and no area: drop them. Duplicate faces
-  // (same three vertices, either orientation) would count their plane twice and survive as
-  // duplicates in the output: keep the first.
-  std::vector<std::pair<std::array<std::uint32_t, 3>, std::uint32_t>> sorted;
-  sorted.reserve(nf);
-  for (std::uint32_t f = 0; f < nf; ++f) {
-    std::array<std::uint32_t, 3> t{in_.indices[3 * f], in_.indices[3 * f + 1], in_.indices[3 * f + 2]};
+  // Referenced vertices only: unreferenced ones take no part and are dropped from the output.
+  // Degenerate faces (a repeated corner) carry no plane and no area: dropped too.
+  std::vector<std::uint8_t> referenced(nv, 0);
+  for (std::size_t f = 0; f < nf; ++f) {
+    const std::uint32_t* t = &in_.indices[3 * f];
     if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
       ++dropped_degenerate_;
       continue;
     }
-    std::sort(t.begin(), t.end());
-    sorted.push_back({t, f});
+    referenced[t[0]] = referenced[t[1]] = referenced[t[2]] = 1;
   }
-  std::sort(sorted.begin(), sorted.end());
-  std::vector<std::uint8_t> keep(nf, 0);
-  for (std::size_t i = 0; i < sorted.size(); ++i) {
-    if (i > 0 && sorted[i].first == sorted[i - 1].first) {
-      ++dropped_duplicate_;
-      continue;
-    }
-    keep[sorted[i].second] = 1;
-  }
-  for (std::uint32_t f = 0; f < nf; ++f) {
-    if (!keep[f]) continue;
-    tri_.insert(tri_.end(), {in_.indices[3 * f], in_.indices[3 * f + 1], in_.indices[3 * f + 2]});
-    face_source_.push_back(f);
-  }
-  faces_alive_ = face_source_.size();
-  face_alive_.assign(faces_alive_, 1);
-
-  vertex_alive_.assign(nv, 0);
-  for (std::uint32_t v : tri_) vertex_alive_[v] = 1;
-  vertices_alive_ = 0;
-  for (std::uint8_t a : vertex_alive_) vertices_alive_ += a;
+  std::vector<std::uint32_t> used;
+  for (std::uint32_t v = 0; v < nv; ++v)
+    if (referenced[v]) used.push_back(v);
 
   // Normalised frame from the referenced vertices' bounding box.
   double lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
-  for (std::size_t v = 0; v < nv; ++v) {
-    if (!vertex_alive_[v]) continue;
+  for (std::uint32_t v : used)
     for (int k = 0; k < 3; ++k) {
       lo[k] = std::min(lo[k], in_.positions[3 * v + k]);
       hi[k] = std::max(hi[k], in_.positions[3 * v + k]);
     }
-  }
-  if (vertices_alive_ > 0) {
+  if (!used.empty()) {
     center_ = {(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2};
-    Vec3 extent{hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
-    scale_ = length(extent);
+    scale_ = length(Vec3(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]));
     if (!(scale_ > 0) || !std::isfinite(scale_)) scale_ = 1;
   }
-  pos_.resize(nv);
-  for (std::size_t v = 0; v < nv; ++v)
-    pos_[v] = Vec3(in_.positions[3 * v], in_.positions[3 * v + 1], in_.positions[3 * v + 2]) - center_;
-  for (Vec3& p : pos_) p = p * (1.0 / scale_);
+  std::vector<Vec3> input_pos(nv);
+  for (std::uint32_t v : used)
+    input_pos[v] = (Vec3(in_.positions[3 * v], in_.positions[3 * v + 1], in_.positions[3 * v + 2]) - center_) *
+                   (1.0 / scale_);
 
-  moved_.assign(nv, 0);
-  boundary_.assign(nv, 0);
-  has_blocked_.assign(nv, 0);
-  mark_.assign(nv, 0);
+  // Internal numbering along a Morton curve (see spatial_order.h); source_vertex_ maps back.
+  source_vertex_ = morton_order(input_pos, used);
+  const std::uint32_t n = std::uint32_t(source_vertex_.size());
+  std::vector<std::uint32_t> internal(nv, 0);
+  pos_.resize(n);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    internal[source_vertex_[i]] = i;
+    pos_[i] = input_pos[source_vertex_[i]];
+  }
+  std::vector<Vec3>().swap(input_pos);
+
+  // Faces bucketed by their lowest internal vertex (a counting sort: neighbouring faces end up
+  // together in memory). Duplicates (same three vertices, either orientation) share a bucket:
+  // they would count their plane twice and survive as duplicates in the output, so only the
+  // first in input order is kept.
+  std::vector<std::uint32_t> bucket_start(n + 1, 0);
+  auto sorted_corners = [&](std::size_t f) {
+    std::array<std::uint32_t, 3> t{internal[in_.indices[3 * f]], internal[in_.indices[3 * f + 1]],
+                                   internal[in_.indices[3 * f + 2]]};
+    std::sort(t.begin(), t.end());
+    return t;
+  };
+  auto degenerate = [&](std::size_t f) {
+    const std::uint32_t* t = &in_.indices[3 * f];
+    return t[0] == t[1] || t[1] == t[2] || t[0] == t[2];
+  };
+  for (std::size_t f = 0; f < nf; ++f)
+    if (!degenerate(f)) ++bucket_start[sorted_corners(f)[0] + 1];
+  for (std::uint32_t i = 0; i < n; ++i) bucket_start[i + 1] += bucket_start[i];
+  std::vector<std::uint32_t> bucketed(bucket_start[n]);
+  {
+    std::vector<std::uint32_t> fill(bucket_start.begin(), bucket_start.end() - 1);
+    for (std::size_t f = 0; f < nf; ++f)
+      if (!degenerate(f)) bucketed[fill[sorted_corners(f)[0]]++] = std::uint32_t(f);
+  }
+  tri_.reserve(3 * bucketed.size());
+  face_source_.reserve(bucketed.size());
+  std::vector<std::pair<std::array<std::uint32_t, 3>, std::uint32_t>> bucket;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    bucket.clear();
+    for (std::uint32_t k = bucket_start[i]; k < bucket_start[i + 1]; ++k)
+      bucket.push_back({sorted_corners(bucketed[k]), bucketed[k]});
+    std::sort(bucket.begin(), bucket.end());
+    for (std::size_t k = 0; k < bucket.size(); ++k) {
+      if (k > 0 && bucket[k].first == bucket[k - 1].first) {
+        ++dropped_duplicate_;
+        continue;
+      }
+      const std::uint32_t f = bucket[k].second;
+      for (int c = 0; c < 3; ++c) tri_.push_back(internal[in_.indices[3 * std::size_t(f) + c]]);
+      face_source_.push_back(f);
+    }
+  }
+  faces_alive_ = face_source_.size();
+  face_alive_.assign(faces_alive_, 1);
+
+  vertices_alive_ = n;
+  moved_.assign(n, 0);
+  boundary_.assign(n, 0);
+  has_blocked_.assign(n, 0);
+  mark_.assign(n, 0);
   result_.input_faces = faces_alive_;
   result_.input_vertices = vertices_alive_;
 }
@@ -267,7 +311,7 @@ void Simplifier::compute_quadrics() {
 }
 
 void Simplifier::select_pairs() {
-  std::vector<Edge> edges = unique_edges(tri_);
+  std::vector<Edge> edges = unique_edges(tri_, vertex_faces_, pos_.size());
 
   // Boundary edges (one incident face): mark their vertices, and add GH97 §6's constraint plane
   // through the edge, perpendicular to its face, weighted by the penalty. The weight grows with
@@ -298,31 +342,25 @@ void Simplifier::select_pairs() {
   if (opt_.threshold > 0) {
     double t = opt_.threshold_is_relative ? opt_.threshold : opt_.threshold / scale_;
     std::vector<std::uint32_t> candidates;
-    for (std::uint32_t v = 0; v < pos_.size(); ++v)
-      if (vertex_alive_[v]) candidates.push_back(v);
+    for (std::uint32_t v = 0; v < pos_.size(); ++v) candidates.push_back(v);
     virtual_pairs = close_pairs(pos_, candidates, t, edges, std::max<std::size_t>(4 * candidates.size(), 1000));
   }
   virtual_pairs_ = virtual_pairs.size();
 
   const std::size_t np = edges.size() + virtual_pairs.size();
   if (np >= 0xffffffffu) throw Error("too many pairs for 32-bit pair ids");
-  pair_v_.resize(2 * np);
-  pair_virtual_.assign(np, 0);
-  for (std::size_t i = 0; i < edges.size(); ++i) pair_v_[2 * i] = edges[i].lo, pair_v_[2 * i + 1] = edges[i].hi;
-  for (std::size_t i = 0; i < virtual_pairs.size(); ++i) {
-    std::size_t p = edges.size() + i;
-    pair_v_[2 * p] = virtual_pairs[i].first, pair_v_[2 * p + 1] = virtual_pairs[i].second;
-    pair_virtual_[p] = 1;
-  }
+  pairs_.resize(np);
+  for (std::size_t i = 0; i < edges.size(); ++i) pairs_[i] = {{edges[i].lo, edges[i].hi}, kInHeap, 0};
+  for (std::size_t i = 0; i < virtual_pairs.size(); ++i)
+    pairs_[edges.size() + i] = {{virtual_pairs[i].first, virtual_pairs[i].second}, kInHeap, 1};
+  std::vector<Edge>().swap(edges);
   std::vector<std::uint32_t> count(pos_.size(), 0);
-  for (std::uint32_t v : pair_v_) ++count[v];
+  for (const PairRecord& r : pairs_) ++count[r.v[0]], ++count[r.v[1]];
   vertex_pairs_.layout(count);
   for (std::uint32_t p = 0; p < np; ++p) {
-    vertex_pairs_.push_initial(pair_v_[2 * p], p);
-    vertex_pairs_.push_initial(pair_v_[2 * p + 1], p);
+    vertex_pairs_.push_initial(pairs_[p].v[0], p);
+    vertex_pairs_.push_initial(pairs_[p].v[1], p);
   }
-  pair_state_.assign(np, kInHeap);
-  cost_.assign(np, 0);
 }
 
 void Simplifier::resolve_targets() {
@@ -357,7 +395,7 @@ void Simplifier::resolve_targets() {
 
 // The quadric and placement of pair p, honouring --lock-border. False if the pair can never move.
 bool Simplifier::placement_for(std::uint32_t p, Quadric& q, Placed& placed) {
-  std::uint32_t a = pair_v_[2 * p], b = pair_v_[2 * p + 1];
+  std::uint32_t a = pairs_[p].v[0], b = pairs_[p].v[1];
   q = quadric_[a] + quadric_[b];
   if (opt_.lock_border && (boundary_[a] || boundary_[b])) {
     if (boundary_[a] && boundary_[b]) return false;
@@ -369,21 +407,28 @@ bool Simplifier::placement_for(std::uint32_t p, Quadric& q, Placed& placed) {
   return true;
 }
 
-void Simplifier::cost_pair(std::uint32_t p) {
+// The key of pair p in the heap: the quadric error at its placement (GH97 §4), plus a penalty that
+// sorts it after every clean contraction when it would flip a face and inversions are penalised.
+bool Simplifier::pair_cost(std::uint32_t p, double& cost) {
   Quadric q;
   Placed placed;
-  if (!placement_for(p, q, placed)) {
-    pair_state_[p] = kLocked;
+  if (!placement_for(p, q, placed)) return false;
+  cost = placed.error;
+  if (opt_.inversion == InversionPolicy::Penalize && flips(pairs_[p].v[0], pairs_[p].v[1], placed.position))
+    cost += q.weight > 0 ? q.weight : 1;  // as if moved by a whole diagonal
+  return true;
+}
+
+void Simplifier::cost_pair(std::uint32_t p) {
+  double c;
+  if (!pair_cost(p, c)) {
+    pairs_[p].state = kLocked;
     heap_.remove(p);
     return;
   }
-  double c = placed.error;
-  if (opt_.inversion == InversionPolicy::Penalize &&
-      flips(pair_v_[2 * p], pair_v_[2 * p + 1], placed.position))
-    c += q.weight > 0 ? q.weight : 1;  // as if moved by a whole diagonal: after every clean one
+  pairs_[p].state = kInHeap;
   cost_[p] = c;
-  pair_state_[p] = kInHeap;
-  heap_.update(p);
+  if (!heap_.contains(p) || c < heap_.key_of(p)) heap_.update(p, c);
 }
 
 // GH97 §6 "preventing mesh inversion": a face around a or b (that survives the contraction) whose
@@ -457,19 +502,19 @@ bool Simplifier::is_edge_and_link_ok(std::uint32_t a, std::uint32_t b, bool& is_
 }
 
 void Simplifier::block(std::uint32_t p) {
-  pair_state_[p] = kBlocked;
-  has_blocked_[pair_v_[2 * p]] = has_blocked_[pair_v_[2 * p + 1]] = 1;
+  pairs_[p].state = kBlocked;
+  has_blocked_[pairs_[p].v[0]] = has_blocked_[pairs_[p].v[1]] = 1;
 }
 
 // The neighbourhood of v changed: pairs of v's neighbours that were rejected get another chance.
 void Simplifier::unblock_around(std::uint32_t v) {
   for (std::uint32_t p : vertex_pairs_[v]) {
-    if (pair_state_[p] == kDead) continue;
-    std::uint32_t o = pair_v_[2 * p] == v ? pair_v_[2 * p + 1] : pair_v_[2 * p];
+    if (pairs_[p].state == kDead) continue;
+    std::uint32_t o = pairs_[p].v[0] == v ? pairs_[p].v[1] : pairs_[p].v[0];
     if (!has_blocked_[o]) continue;
     has_blocked_[o] = 0;
     for (std::uint32_t q : vertex_pairs_[o])
-      if (pair_state_[q] == kBlocked) cost_pair(q);
+      if (pairs_[q].state == kBlocked) cost_pair(q);
   }
 }
 
@@ -478,18 +523,17 @@ void Simplifier::unblock_around(std::uint32_t v) {
 // ---------------------------------------------------------------------------------------------
 
 void Simplifier::contract(std::uint32_t p, const Quadric& q, const Vec3& target) {
-  const std::uint32_t a = pair_v_[2 * p], b = pair_v_[2 * p + 1];
+  const std::uint32_t a = pairs_[p].v[0], b = pairs_[p].v[1];
   pos_[a] = target;
   quadric_[a] = q;
   boundary_[a] |= boundary_[b];
   moved_[a] = 1;
-  vertex_alive_[b] = 0;
   --vertices_alive_;
 
   // Faces: those containing both ends degenerate and die; b's others now use a. Where the
   // topology check did not run (virtual pairs, or --no-preserve-topology), a face can land on the
   // same three vertices as one of a's: it dies too, so the output never has duplicate faces.
-  const bool may_duplicate = pair_virtual_[p] || !opt_.preserve_topology;
+  const bool may_duplicate = pairs_[p].is_virtual || !opt_.preserve_topology;
   scratch_.clear();
   for (std::uint32_t f : vertex_faces_[a]) {
     if (!face_alive_[f]) continue;
@@ -518,25 +562,25 @@ void Simplifier::contract(std::uint32_t p, const Quadric& q, const Vec3& target)
     }
     scratch_.push_back(f);
   }
-  vertex_faces_.assign(a, scratch_.data(), scratch_.size());
+  vertex_faces_.assign(a, scratch_.data(), scratch_.size(), b);
   vertex_faces_.clear(b);
 
   // Pairs: GH97 §4 "pair sets merge": b's pairs now start at a; the contracted pair and any pair
   // that now duplicates another (same two vertices) are removed.
-  pair_state_[p] = kDead;
+  pairs_[p].state = kDead;
   heap_.remove(p);
   const std::uint32_t s = ++stamp_;
   mark_[a] = s;
   scratch2_.clear();
   for (int end = 0; end < 2; ++end) {
     for (std::uint32_t r : vertex_pairs_[end == 0 ? a : b]) {
-      if (pair_state_[r] == kDead) continue;
-      std::uint32_t* v = &pair_v_[2 * std::size_t(r)];
+      if (pairs_[r].state == kDead) continue;
+      std::uint32_t* v = pairs_[r].v;
       if (v[0] == b) v[0] = a;
       if (v[1] == b) v[1] = a;
       std::uint32_t o = v[0] == a ? v[1] : v[0];
       if (mark_[o] == s) {  // duplicate of a pair already kept (or a degenerate (a, a) pair)
-        pair_state_[r] = kDead;
+        pairs_[r].state = kDead;
         heap_.remove(r);
         continue;
       }
@@ -545,12 +589,12 @@ void Simplifier::contract(std::uint32_t p, const Quadric& q, const Vec3& target)
       scratch2_.push_back(r);
     }
   }
-  vertex_pairs_.assign(a, scratch2_.data(), scratch2_.size());
+  vertex_pairs_.assign(a, scratch2_.data(), scratch2_.size(), b);
   vertex_pairs_.clear(b);
 
   // GH97 §4 step 5: update the costs of all valid pairs involving the new vertex.
   for (std::uint32_t r : vertex_pairs_[a])
-    if (pair_state_[r] != kLocked) cost_pair(r);
+    if (pairs_[r].state != kLocked) cost_pair(r);
   unblock_around(a);
 }
 
@@ -570,25 +614,14 @@ SimplifyResult Simplifier::run() {
   result_.virtual_pairs = virtual_pairs_;
 
   // Initial costs and the heap (GH97 §4 steps 3-4).
-  {
-    std::vector<std::uint32_t> ids;
-    ids.reserve(pair_state_.size());
-    heap_.reset(pair_state_.size());
-    for (std::uint32_t p = 0; p < pair_state_.size(); ++p) {
-      Quadric q;
-      Placed placed;
-      if (!placement_for(p, q, placed)) {
-        pair_state_[p] = kLocked;
-        continue;
-      }
-      double c = placed.error;
-      if (opt_.inversion == InversionPolicy::Penalize && flips(pair_v_[2 * p], pair_v_[2 * p + 1], placed.position))
-        c += q.weight > 0 ? q.weight : 1;
-      cost_[p] = c;
-      ids.push_back(p);
-    }
-    heap_.build(ids);
+  heap_.reset(pairs_.size());
+  cost_.assign(pairs_.size(), 0);
+  for (std::uint32_t p = 0; p < pairs_.size(); ++p) {
+    double c;
+    if (pair_cost(p, c)) heap_.push_unordered(p, c), cost_[p] = c;
+    else pairs_[p].state = kLocked;
   }
+  heap_.heapify();
 
   const std::size_t start_faces = faces_alive_;
   const std::size_t span = start_faces > target_faces_ ? start_faces - target_faces_ : 1;
@@ -608,8 +641,13 @@ SimplifyResult Simplifier::run() {
         break;
       }
     }
+    const std::uint32_t top = heap_.top();
+    if (cost_[top] > heap_.top_key()) {  // stale key: re-key and look again
+      heap_.update(top, cost_[top]);
+      continue;
+    }
     const std::uint32_t p = heap_.pop();
-    const std::uint32_t a = pair_v_[2 * p], b = pair_v_[2 * p + 1];
+    const std::uint32_t a = pairs_[p].v[0], b = pairs_[p].v[1];
 
     bool is_edge = false;
     if (!is_edge_and_link_ok(a, b, is_edge)) {
@@ -617,9 +655,9 @@ SimplifyResult Simplifier::run() {
       block(p);
       continue;
     }
-    if (!is_edge && !pair_virtual_[p]) {
+    if (!is_edge && !pairs_[p].is_virtual) {
       // An edge pair whose faces all died: at t = 0 only edges are valid pairs (GH97 §3.2).
-      pair_state_[p] = kDead;
+      pairs_[p].state = kDead;
       continue;
     }
     Quadric q;
@@ -642,6 +680,9 @@ SimplifyResult Simplifier::run() {
   }
   if (opt_.progress && result_.stop_reason != StopReason::Cancelled) opt_.progress(1.0);
 
+  result_.rejected_topology = blocked_by_topology_;
+  result_.rejected_inversion = blocked_by_inversion_;
+  result_.rejected_error = blocked_by_error_;
   result_.max_error_relative = max_error_norm_done;
   result_.max_error = max_error_norm_done * scale_;
   switch (result_.stop_reason) {
@@ -660,27 +701,37 @@ SimplifyResult Simplifier::run() {
 }
 
 SimplifyResult Simplifier::build_output() {
-  // Unreferenced vertices are dropped; survivors keep their input order, faces too.
-  const std::size_t nv = pos_.size();
-  std::vector<std::uint32_t> remap(nv, 0xffffffffu);
-  std::vector<std::uint8_t> used(nv, 0);
+  // Vertices no face uses any more are dropped; survivors and faces keep their input order.
+  const std::uint32_t n = std::uint32_t(pos_.size());
+  std::vector<std::uint8_t> used(n, 0);
+  std::vector<std::uint32_t> faces;
   for (std::uint32_t f = 0; f < face_alive_.size(); ++f)
-    if (face_alive_[f])
+    if (face_alive_[f]) {
+      faces.push_back(f);
       for (int k = 0; k < 3; ++k) used[tri_[3 * f + k]] = 1;
+    }
+  std::sort(faces.begin(), faces.end(), [&](std::uint32_t x, std::uint32_t y) { return face_source_[x] < face_source_[y]; });
+  std::vector<std::uint32_t> survivors;
+  for (std::uint32_t v = 0; v < n; ++v)
+    if (used[v]) survivors.push_back(v);
+  std::sort(survivors.begin(), survivors.end(),
+            [&](std::uint32_t x, std::uint32_t y) { return source_vertex_[x] < source_vertex_[y]; });
+  std::vector<std::uint32_t> remap(n, 0xffffffffu);
   Mesh& out = result_.mesh;
-  for (std::uint32_t v = 0; v < nv; ++v) {
-    if (!used[v]) continue;
+  out.positions.reserve(3 * survivors.size());
+  for (std::uint32_t v : survivors) {
     remap[v] = std::uint32_t(out.positions.size() / 3);
     if (moved_[v]) {
       const Vec3 p = pos_[v] * scale_ + center_;
       out.positions.insert(out.positions.end(), {p.x, p.y, p.z});
-    } else {
-      out.positions.insert(out.positions.end(), in_.positions.begin() + 3 * v, in_.positions.begin() + 3 * v + 3);
+    } else {  // exact input coordinates for vertices that never moved
+      const double* p = &in_.positions[3 * std::size_t(source_vertex_[v])];
+      out.positions.insert(out.positions.end(), p, p + 3);
     }
   }
-  for (std::uint32_t f = 0; f < face_alive_.size(); ++f)
-    if (face_alive_[f])
-      for (int k = 0; k < 3; ++k) out.indices.push_back(remap[tri_[3 * f + k]]);
+  out.indices.reserve(3 * faces.size());
+  for (std::uint32_t f : faces)
+    for (int k = 0; k < 3; ++k) out.indices.push_back(remap[tri_[3 * f + k]]);
   return std::move(result_);
 }
 

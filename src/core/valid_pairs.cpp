@@ -8,46 +8,27 @@
 
 namespace qem::core {
 
-namespace {
-std::uint64_t edge_key(std::uint32_t a, std::uint32_t b) {
-  if (a > b) std::swap(a, b);
-  return (std::uint64_t(a) << 32) | b;
-}
-
-// LSD radix sort on 64-bit keys, 16 bits a pass: the edge keys of a million-face mesh sort in a
-// fraction of the time std::sort takes, and this runs once per simplification.
-void radix_sort(std::vector<std::uint64_t>& keys) {
-  std::vector<std::uint64_t> tmp(keys.size());
-  std::uint64_t all_or = 0;
-  for (std::uint64_t k : keys) all_or |= k;
-  for (int shift = 0; shift < 64; shift += 16) {
-    if (((all_or >> shift) & 0xffff) == 0) continue;  // digit is zero everywhere: nothing to do
-    std::vector<std::size_t> count(65537, 0);
-    for (std::uint64_t k : keys) ++count[((k >> shift) & 0xffff) + 1];
-    for (std::size_t i = 1; i < count.size(); ++i) count[i] += count[i - 1];
-    for (std::uint64_t k : keys) tmp[count[(k >> shift) & 0xffff]++] = k;
-    keys.swap(tmp);
-  }
-}
-}  // namespace
-
-std::vector<Edge> unique_edges(const std::vector<std::uint32_t>& triangles) {
-  std::vector<std::uint64_t> keys;
-  keys.reserve(triangles.size());
-  for (std::size_t f = 0; f + 2 < triangles.size(); f += 3) {
-    const std::uint32_t* t = &triangles[f];
-    keys.push_back(edge_key(t[0], t[1]));
-    keys.push_back(edge_key(t[1], t[2]));
-    keys.push_back(edge_key(t[2], t[0]));
-  }
-  radix_sort(keys);
+std::vector<Edge> unique_edges(const std::vector<std::uint32_t>& triangles, const VertexLists& vertex_faces,
+                               std::size_t vertex_count) {
   std::vector<Edge> edges;
-  edges.reserve(keys.size() / 2 + 16);
-  for (std::size_t i = 0; i < keys.size();) {
-    std::size_t j = i + 1;
-    while (j < keys.size() && keys[j] == keys[i]) ++j;
-    edges.push_back({std::uint32_t(keys[i] >> 32), std::uint32_t(keys[i]), std::uint32_t(j - i)});
-    i = j;
+  edges.reserve(triangles.size() / 2 + 16);  // 3F/2 edges on a closed manifold
+  std::vector<std::uint32_t> slot(vertex_count, 0xffffffffu);  // edge index of (v, w) while at v
+  for (std::uint32_t v = 0; v < vertex_count; ++v) {
+    const std::size_t first = edges.size();
+    for (std::uint32_t f : vertex_faces[v]) {
+      const std::uint32_t* t = &triangles[3 * std::size_t(f)];
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t w = t[k];
+        if (w <= v) continue;  // each edge is found from its lower end
+        if (slot[w] != 0xffffffffu && slot[w] >= first) {
+          ++edges[slot[w]].faces;
+        } else {
+          slot[w] = std::uint32_t(edges.size());
+          edges.push_back({v, w, 1});
+        }
+      }
+    }
+    std::sort(edges.begin() + first, edges.end(), [](const Edge& a, const Edge& b) { return a.hi < b.hi; });
   }
   return edges;
 }

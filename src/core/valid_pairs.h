@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "core/quadric.h"
+#include "core/vertex_lists.h"
 
 namespace qem::core {
 
@@ -14,8 +15,10 @@ struct Edge {
   std::uint32_t faces;
 };
 
-/// The unique edges of a triangle list (3 indices per face), sorted by (lo, hi).
-std::vector<Edge> unique_edges(const std::vector<std::uint32_t>& triangles);
+/// The unique edges of a triangle list (3 indices per face), sorted by (lo, hi), found through the
+/// per-vertex face lists (no global sort, no 64-bit key array: this runs on million-face meshes).
+std::vector<Edge> unique_edges(const std::vector<std::uint32_t>& triangles, const VertexLists& vertex_faces,
+                               std::size_t vertex_count);
 
 /// Pairs (i < j) of `candidates` with |p_i - p_j| < t that are not edges, found with a uniform
 /// grid of cell size t (never O(n^2) unless the points crowd into few cells). Sorted, unique.

@@ -24,14 +24,24 @@ class VertexLists {
       capacity_[v] = sizes[v];
       total += sizes[v];
     }
+    data_.reserve(total + total / 4);
     data_.assign(total, 0);
-    data_.reserve(total + total / 2);
   }
   void push_initial(std::uint32_t v, std::uint32_t item) { data_[begin_[v] + size_[v]++] = item; }
 
   std::span<const std::uint32_t> operator[](std::uint32_t v) const { return {data_.data() + begin_[v], size_[v]}; }
 
-  /// Replaces the list of v by items[0..n).
+  /// Replaces the list of v by items[0..n), which must not point into this arena. If it does not
+  /// fit, it takes the slot of `donor` (a list being emptied, e.g. the contracted vertex) if that
+  /// is large enough, and only otherwise moves to the end of the arena.
+  void assign(std::uint32_t v, const std::uint32_t* items, std::size_t n, std::uint32_t donor) {
+    if (n > capacity_[v] && n <= capacity_[donor]) {
+      std::swap(begin_[v], begin_[donor]);
+      std::swap(capacity_[v], capacity_[donor]);
+      size_[donor] = 0;
+    }
+    assign(v, items, n);
+  }
   void assign(std::uint32_t v, const std::uint32_t* items, std::size_t n) {
     if (n > capacity_[v]) {
       begin_[v] = data_.size();

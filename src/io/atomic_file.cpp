@@ -39,7 +39,8 @@ void write_file_atomic(const std::string& path, std::string_view bytes) {
   for (unsigned attempt = 0; attempt < 100 && fd < 0; ++attempt) {
     tmp = temp_name(path, attempt);
     fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd < 0 && errno != EEXIST) throw Error(path + ": cannot create a temporary file beside it: " + std::strerror(errno));
+    if (fd < 0 && errno != EEXIST)
+      throw Error(path + ": cannot create a temporary file beside it: " + std::strerror(errno));
   }
   if (fd < 0) throw Error(path + ": cannot create a unique temporary file beside it");
   auto abandon = [&](const char* what, int err) {

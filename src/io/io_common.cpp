@@ -19,7 +19,8 @@ void fail_line(const std::string& name, std::size_t line, const std::string& wha
   throw Error(name + ", line " + std::to_string(line) + ": " + what);
 }
 
-void fail_element(const std::string& name, std::string_view element, std::size_t index, const std::string& what) {
+void fail_element(const std::string& name, std::string_view element, std::size_t index,
+                  const std::string& what) {
   throw Error(name + ", " + std::string(element) + " " + std::to_string(index) + ": " + what);
 }
 
@@ -36,10 +37,16 @@ FileData::FileData(const std::string& path) {
     ::close(fd);
     throw Error(path + ": cannot read: is a directory");
   }
+  if (!S_ISREG(st.st_mode) && !S_ISFIFO(st.st_mode)) {
+    // Devices such as /dev/zero never end: reading them would hang.
+    ::close(fd);
+    throw Error(path + ": cannot read: not a regular file");
+  }
   if (S_ISREG(st.st_mode) && st.st_size > 0) {
     // Private read-only mapping: the pages come straight from the page cache (MAP_POPULATE maps
     // them up front), which costs far less than copying into fresh, zero-filled memory.
-    void* m = ::mmap(nullptr, static_cast<std::size_t>(st.st_size), PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+    void* m =
+        ::mmap(nullptr, static_cast<std::size_t>(st.st_size), PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
     if (m != MAP_FAILED) {
       map_ = m;
       data_ = static_cast<const char*>(m);
@@ -70,7 +77,8 @@ FileData::~FileData() {
   if (map_) ::munmap(map_, size_);
 }
 
-bool TextCursor::try_number(double& value) {
+template <class T>
+bool TextCursor::parse_real(T& value) {
   const char* b = p_;
   if (b < end_ && *b == '+') ++b;  // fast_float 3.x rejects a leading '+', which some writers emit
   auto r = fast_float::from_chars(b, end_, value);
@@ -78,6 +86,9 @@ bool TextCursor::try_number(double& value) {
   p_ = r.ptr;
   return true;
 }
+
+bool TextCursor::try_number(double& value) { return parse_real(value); }
+bool TextCursor::try_number(float& value) { return parse_real(value); }
 
 bool TextCursor::try_integer(long long& value, bool allow_slash) {
   const char* b = p_;
@@ -93,7 +104,8 @@ void TextCursor::fail_expected(const char* what) const {
   std::string got;
   for (const char* q = p_; q < end_ && got.size() < 20 && *q != '\n' && *q != '\r'; ++q)
     got += (static_cast<unsigned char>(*q) >= 32 && static_cast<unsigned char>(*q) < 127) ? *q : '?';
-  fail(std::string("expected ") + what + (got.empty() ? std::string(", found end of line") : ", found '" + got + "'"));
+  fail(std::string("expected ") + what +
+       (got.empty() ? std::string(", found end of line") : ", found '" + got + "'"));
 }
 
 void append_number(std::string& out, double v) {
@@ -124,8 +136,8 @@ void check_mesh_for_writing(const Mesh& mesh) {
                   std::to_string(mesh.indices[i]) + " of " + std::to_string(nv));
   for (const VertexProperty& p : mesh.vertex_properties)
     if (p.values.size() != nv)
-      throw Error("cannot write mesh: vertex property '" + p.name + "' has " + std::to_string(p.values.size()) +
-                  " values for " + std::to_string(nv) + " vertices");
+      throw Error("cannot write mesh: vertex property '" + p.name + "' has " +
+                  std::to_string(p.values.size()) + " values for " + std::to_string(nv) + " vertices");
 }
 
 }  // namespace qem::io

@@ -44,9 +44,7 @@ class FileData {
 
 /// True when a*b <= limit, without overflow: the guard used before every reserve() driven by a count
 /// read from the file, so a lying header cannot make us allocate memory the data does not back.
-inline bool fits(std::uint64_t a, std::uint64_t b, std::uint64_t limit) {
-  return b == 0 || a <= limit / b;
-}
+inline bool fits(std::uint64_t a, std::uint64_t b, std::uint64_t limit) { return b == 0 || a <= limit / b; }
 
 /// Forward cursor over text with a line counter. `continuation` enables OBJ's backslash-newline
 /// joining; `comment` (0 = none) starts a comment running to the end of the line.
@@ -54,8 +52,12 @@ class TextCursor {
  public:
   TextCursor(std::string_view text, const std::string& name, char comment, bool continuation,
              std::size_t first_line = 1)
-      : p_(text.data()), end_(text.data() + text.size()), name_(name), comment_(comment),
-        continuation_(continuation), line_(first_line) {}
+      : p_(text.data()),
+        end_(text.data() + text.size()),
+        name_(name),
+        comment_(comment),
+        continuation_(continuation),
+        line_(first_line) {}
 
   std::size_t line() const { return line_; }
   bool at_end() const { return p_ >= end_; }
@@ -122,6 +124,9 @@ class TextCursor {
 
   /// Parses a floating-point number at the cursor (must be followed by a delimiter).
   bool try_number(double& value);
+  /// Single precision, rounded once from the text (ASCII PLY `float` properties, ASCII STL), so
+  /// an ASCII file reads back exactly like its binary twin.
+  bool try_number(float& value);
   double number(const char* what) {
     double v;
     if (!try_number(v)) fail_expected(what);
@@ -150,6 +155,8 @@ class TextCursor {
   }
 
  private:
+  template <class T>
+  bool parse_real(T& value);
   bool continues_line(const char* bs) const {
     const char* q = bs + 1;
     if (q < end_ && *q == '\r') ++q;
@@ -183,13 +190,19 @@ struct PolygonSink {
   }
 };
 
-inline bool finite3(double x, double y, double z) { return std::isfinite(x) && std::isfinite(y) && std::isfinite(z); }
+inline bool finite3(double x, double y, double z) {
+  return std::isfinite(x) && std::isfinite(y) && std::isfinite(z);
+}
 
 /// Readers and writers of each format (one file each). Readers throw qem::Error on malformed input.
-Mesh parse_obj(std::string_view bytes, const std::string& name, const LoadOptions& options, LoadReport& report);
-Mesh parse_ply(std::string_view bytes, const std::string& name, const LoadOptions& options, LoadReport& report);
-Mesh parse_stl(std::string_view bytes, const std::string& name, const LoadOptions& options, LoadReport& report);
-Mesh parse_off(std::string_view bytes, const std::string& name, const LoadOptions& options, LoadReport& report);
+Mesh parse_obj(std::string_view bytes, const std::string& name, const LoadOptions& options,
+               LoadReport& report);
+Mesh parse_ply(std::string_view bytes, const std::string& name, const LoadOptions& options,
+               LoadReport& report);
+Mesh parse_stl(std::string_view bytes, const std::string& name, const LoadOptions& options,
+               LoadReport& report);
+Mesh parse_off(std::string_view bytes, const std::string& name, const LoadOptions& options,
+               LoadReport& report);
 /// True when `bytes` has exactly the size of a binary STL with the triangle count of its header.
 bool stl_is_binary(std::string_view bytes);
 

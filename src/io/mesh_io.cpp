@@ -44,12 +44,14 @@ std::string_view first_word(std::string_view bytes) {
 
 /// Recognises a format by its content, or returns Auto.
 FileFormat sniff(std::string_view bytes) {
-  if (bytes.size() >= 4 && bytes.substr(0, 3) == "ply" && (bytes[3] == '\n' || bytes[3] == '\r')) return FileFormat::Ply;
+  if (bytes.size() >= 4 && bytes.substr(0, 3) == "ply" && (bytes[3] == '\n' || bytes[3] == '\r'))
+    return FileFormat::Ply;
   if (io::stl_is_binary(bytes)) return FileFormat::Stl;
   std::string_view w = first_word(bytes);
   if (w.size() >= 3 && w.size() <= 7 && w.substr(w.size() - 3) == "OFF") return FileFormat::Off;
   if (w == "solid") return FileFormat::Stl;
-  static constexpr std::string_view kObj[] = {"v", "vt", "vn", "vp", "f", "o", "g", "s", "usemtl", "mtllib", "l", "p"};
+  static constexpr std::string_view kObj[] = {"v", "vt", "vn",     "vp",     "f", "o",
+                                              "g", "s",  "usemtl", "mtllib", "l", "p"};
   if (std::find(std::begin(kObj), std::end(kObj), w) != std::end(kObj)) return FileFormat::Obj;
   return FileFormat::Auto;
 }
@@ -64,11 +66,16 @@ Mesh dispatch(std::string_view bytes, FileFormat format, const std::string& name
   }
   try {
     switch (format) {
-      case FileFormat::Obj: return io::parse_obj(bytes, name, options, report);
-      case FileFormat::Ply: return io::parse_ply(bytes, name, options, report);
-      case FileFormat::Stl: return io::parse_stl(bytes, name, options, report);
-      case FileFormat::Off: return io::parse_off(bytes, name, options, report);
-      case FileFormat::Auto: break;
+      case FileFormat::Obj:
+        return io::parse_obj(bytes, name, options, report);
+      case FileFormat::Ply:
+        return io::parse_ply(bytes, name, options, report);
+      case FileFormat::Stl:
+        return io::parse_stl(bytes, name, options, report);
+      case FileFormat::Off:
+        return io::parse_off(bytes, name, options, report);
+      case FileFormat::Auto:
+        break;
     }
   } catch (const std::bad_alloc&) {
     io::fail(name, "out of memory while reading");
@@ -89,8 +96,8 @@ FileFormat format_from_extension(const std::string& path) {
   return FileFormat::Auto;
 }
 
-Mesh parse_mesh(std::string_view bytes, FileFormat format, const std::string& name, const LoadOptions& options,
-                LoadReport* report) {
+Mesh parse_mesh(std::string_view bytes, FileFormat format, const std::string& name,
+                const LoadOptions& options, LoadReport* report) {
   LoadReport local;
   LoadReport& r = report ? *report : local;
   r = LoadReport{};
@@ -106,7 +113,8 @@ Mesh load_mesh(const std::string& path, const LoadOptions& options, LoadReport* 
   FileFormat format = options.format != FileFormat::Auto ? options.format : format_from_extension(path);
   if (format == FileFormat::Auto && sniff(bytes) == FileFormat::Auto) {
     std::string ext = extension_of(path);
-    io::fail(path, "unknown mesh format (" + (ext.empty() ? std::string("no extension") : "extension '." + ext + "'") +
+    io::fail(path, "unknown mesh format (" +
+                       (ext.empty() ? std::string("no extension") : "extension '." + ext + "'") +
                        ", and the content is not OBJ, PLY, STL or OFF)");
   }
   return parse_mesh(bytes, format, path, options, report);
@@ -115,11 +123,16 @@ Mesh load_mesh(const std::string& path, const LoadOptions& options, LoadReport* 
 std::string serialize_mesh(const Mesh& mesh, const SaveOptions& options) {
   io::check_mesh_for_writing(mesh);
   switch (options.format) {
-    case FileFormat::Obj: return io::write_obj(mesh);
-    case FileFormat::Ply: return io::write_ply(mesh, options.binary, options.double_precision);
-    case FileFormat::Stl: return io::write_stl(mesh, options.binary);
-    case FileFormat::Off: return io::write_off(mesh);
-    case FileFormat::Auto: break;
+    case FileFormat::Obj:
+      return io::write_obj(mesh);
+    case FileFormat::Ply:
+      return io::write_ply(mesh, options.binary, options.double_precision);
+    case FileFormat::Stl:
+      return io::write_stl(mesh, options.binary);
+    case FileFormat::Off:
+      return io::write_off(mesh);
+    case FileFormat::Auto:
+      break;
   }
   throw Error("cannot serialise a mesh without a format");
 }

@@ -52,10 +52,13 @@ Mesh parse_off(std::string_view bytes, const std::string& name, const LoadOption
   }
   in.next_line();
   const std::uint64_t nv = static_cast<std::uint64_t>(counts[0]), nf = static_cast<std::uint64_t>(counts[1]);
-  const std::uint64_t left = static_cast<std::uint64_t>(bytes.size() - static_cast<std::size_t>(in.pos() - bytes.data()));
+  const std::uint64_t left =
+      static_cast<std::uint64_t>(bytes.size() - static_cast<std::size_t>(in.pos() - bytes.data()));
   // A vertex row takes at least 6 bytes ("0 0 0\n"), a face row at least 8 ("3 0 0 0\n").
-  if (!fits(nv, 6, left + 1)) in.fail("header declares " + std::to_string(nv) + " vertices but the file is too short");
-  if (!fits(nf, 8, left + 1)) in.fail("header declares " + std::to_string(nf) + " faces but the file is too short");
+  if (!fits(nv, 6, left + 1))
+    in.fail("header declares " + std::to_string(nv) + " vertices but the file is too short");
+  if (!fits(nf, 8, left + 1))
+    in.fail("header declares " + std::to_string(nf) + " faces but the file is too short");
   if (nv > 0xFFFFFFFFull) in.fail("too many vertices for 32-bit indices");
 
   Mesh mesh;
@@ -63,7 +66,8 @@ Mesh parse_off(std::string_view bytes, const std::string& name, const LoadOption
   for (std::uint64_t i = 0; i < nv; ++i) {
     double c[4] = {0, 0, 0, 1};
     for (int k = 0; k < (h.homogeneous ? 4 : 3); ++k) {
-      if (!in.skip_space()) in.fail("unexpected end of file: vertex " + std::to_string(i) + " of " + std::to_string(nv));
+      if (!in.skip_space())
+        in.fail("unexpected end of file: vertex " + std::to_string(i) + " of " + std::to_string(nv));
       c[k] = in.number("a vertex coordinate");
     }
     if (h.homogeneous) {
@@ -79,10 +83,12 @@ Mesh parse_off(std::string_view bytes, const std::string& name, const LoadOption
   PolygonSink sink{&mesh.indices};
   std::vector<std::uint32_t> corners;
   for (std::uint64_t f = 0; f < nf; ++f) {
-    if (!in.skip_space()) in.fail("unexpected end of file: face " + std::to_string(f) + " of " + std::to_string(nf));
+    if (!in.skip_space())
+      in.fail("unexpected end of file: face " + std::to_string(f) + " of " + std::to_string(nf));
     long long k = in.integer("a face vertex count");
     if (k < 3) in.fail("face with " + std::to_string(k) + " vertices (at least 3 needed)");
-    const std::uint64_t rest = static_cast<std::uint64_t>(bytes.size() - static_cast<std::size_t>(in.pos() - bytes.data()));
+    const std::uint64_t rest =
+        static_cast<std::uint64_t>(bytes.size() - static_cast<std::size_t>(in.pos() - bytes.data()));
     if (!fits(static_cast<std::uint64_t>(k), 2, rest + 1))
       in.fail("face vertex count " + std::to_string(k) + " exceeds the data left in the file");
     corners.clear();

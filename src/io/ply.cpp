@@ -24,10 +24,10 @@ bool parse_type(std::string_view s, Type& t) {
   static constexpr struct {
     std::string_view name;
     Type type;
-  } kTypes[] = {{"char", Type::I8},     {"int8", Type::I8},    {"uchar", Type::U8},    {"uint8", Type::U8},
-                {"short", Type::I16},   {"int16", Type::I16},  {"ushort", Type::U16},  {"uint16", Type::U16},
-                {"int", Type::I32},     {"int32", Type::I32},  {"uint", Type::U32},    {"uint32", Type::U32},
-                {"float", Type::F32},   {"float32", Type::F32}, {"double", Type::F64}, {"float64", Type::F64}};
+  } kTypes[] = {{"char", Type::I8},   {"int8", Type::I8},     {"uchar", Type::U8},   {"uint8", Type::U8},
+                {"short", Type::I16}, {"int16", Type::I16},   {"ushort", Type::U16}, {"uint16", Type::U16},
+                {"int", Type::I32},   {"int32", Type::I32},   {"uint", Type::U32},   {"uint32", Type::U32},
+                {"float", Type::F32}, {"float32", Type::F32}, {"double", Type::F64}, {"float64", Type::F64}};
   for (const auto& k : kTypes)
     if (k.name == s) {
       t = k.type;
@@ -39,13 +39,17 @@ bool parse_type(std::string_view s, Type& t) {
 constexpr std::size_t type_size(Type t) {
   switch (t) {
     case Type::I8:
-    case Type::U8: return 1;
+    case Type::U8:
+      return 1;
     case Type::I16:
-    case Type::U16: return 2;
+    case Type::U16:
+      return 2;
     case Type::I32:
     case Type::U32:
-    case Type::F32: return 4;
-    case Type::F64: return 8;
+    case Type::F32:
+      return 4;
+    case Type::F64:
+      return 8;
   }
   return 0;
 }
@@ -108,10 +112,14 @@ Header parse_header(std::string_view bytes, const std::string& name) {
     if (kw == "format") {
       in.skip_blank();
       std::string_view f = in.word();
-      if (f == "ascii") h.encoding = Encoding::Ascii;
-      else if (f == "binary_little_endian") h.encoding = Encoding::Little;
-      else if (f == "binary_big_endian") h.encoding = Encoding::Big;
-      else in.fail("unknown PLY format '" + std::string(f) + "'");
+      if (f == "ascii")
+        h.encoding = Encoding::Ascii;
+      else if (f == "binary_little_endian")
+        h.encoding = Encoding::Little;
+      else if (f == "binary_big_endian")
+        h.encoding = Encoding::Big;
+      else
+        in.fail("unknown PLY format '" + std::string(f) + "'");
       have_format = true;
     } else if (kw == "element") {
       Element e;
@@ -174,14 +182,22 @@ inline T load(const unsigned char* p, bool swap) {
 
 inline double load_as_double(const unsigned char* p, Type t, bool swap) {
   switch (t) {
-    case Type::I8: return load<std::int8_t>(p, swap);
-    case Type::U8: return load<std::uint8_t>(p, swap);
-    case Type::I16: return load<std::int16_t>(p, swap);
-    case Type::U16: return load<std::uint16_t>(p, swap);
-    case Type::I32: return load<std::int32_t>(p, swap);
-    case Type::U32: return load<std::uint32_t>(p, swap);
-    case Type::F32: return load<float>(p, swap);
-    case Type::F64: return load<double>(p, swap);
+    case Type::I8:
+      return load<std::int8_t>(p, swap);
+    case Type::U8:
+      return load<std::uint8_t>(p, swap);
+    case Type::I16:
+      return load<std::int16_t>(p, swap);
+    case Type::U16:
+      return load<std::uint16_t>(p, swap);
+    case Type::I32:
+      return load<std::int32_t>(p, swap);
+    case Type::U32:
+      return load<std::uint32_t>(p, swap);
+    case Type::F32:
+      return load<float>(p, swap);
+    case Type::F64:
+      return load<double>(p, swap);
   }
   return 0;
 }
@@ -189,12 +205,24 @@ inline double load_as_double(const unsigned char* p, Type t, bool swap) {
 /// Integer value of a count or an index; float types must hold a whole number.
 inline bool load_as_int(const unsigned char* p, Type t, bool swap, long long& out) {
   switch (t) {
-    case Type::I8: out = load<std::int8_t>(p, swap); return true;
-    case Type::U8: out = load<std::uint8_t>(p, swap); return true;
-    case Type::I16: out = load<std::int16_t>(p, swap); return true;
-    case Type::U16: out = load<std::uint16_t>(p, swap); return true;
-    case Type::I32: out = load<std::int32_t>(p, swap); return true;
-    case Type::U32: out = load<std::uint32_t>(p, swap); return true;
+    case Type::I8:
+      out = load<std::int8_t>(p, swap);
+      return true;
+    case Type::U8:
+      out = load<std::uint8_t>(p, swap);
+      return true;
+    case Type::I16:
+      out = load<std::int16_t>(p, swap);
+      return true;
+    case Type::U16:
+      out = load<std::uint16_t>(p, swap);
+      return true;
+    case Type::I32:
+      out = load<std::int32_t>(p, swap);
+      return true;
+    case Type::U32:
+      out = load<std::uint32_t>(p, swap);
+      return true;
     case Type::F32:
     case Type::F64: {
       double d = load_as_double(p, t, swap);
@@ -223,7 +251,8 @@ class BodyReader {
   bool ascii() const { return ascii_; }
   bool swap() const { return swap_; }
   std::uint64_t remaining() const {
-    return ascii_ ? static_cast<std::uint64_t>(text_end() - text_.pos()) : static_cast<std::uint64_t>(end_ - p_);
+    return ascii_ ? static_cast<std::uint64_t>(text_end() - text_.pos())
+                  : static_cast<std::uint64_t>(end_ - p_);
   }
   const unsigned char* ptr() const { return p_; }
   void advance(std::size_t n) { p_ += n; }
@@ -240,6 +269,11 @@ class BodyReader {
   double real(Type t) {
     if (ascii_) {
       if (!text_.skip_space()) fail("unexpected end of file (the header declares more data)");
+      if (t == Type::F32) {
+        float f;
+        if (!text_.try_number(f)) fail_expected_number();
+        return f;
+      }
       double v;
       if (!text_.try_number(v)) fail_expected_number();
       return v;
@@ -316,17 +350,23 @@ class BodyReader {
   std::uint64_t index_ = 0;
 };
 
-bool is_index_list(const Property& p) { return p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index"); }
+bool is_index_list(const Property& p) {
+  return p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index");
+}
 
 /// Reads the vertex element: x, y, z (and, if asked, every other scalar property).
-void read_vertices(BodyReader& in, const Element& e, Mesh& mesh, const LoadOptions& options, LoadReport& report) {
+void read_vertices(BodyReader& in, const Element& e, Mesh& mesh, const LoadOptions& options,
+                   LoadReport& report) {
   int ix = -1, iy = -1, iz = -1;
   for (std::size_t k = 0; k < e.props.size(); ++k) {
     const Property& p = e.props[k];
     if (p.is_list) continue;
-    if (p.name == "x") ix = static_cast<int>(k);
-    else if (p.name == "y") iy = static_cast<int>(k);
-    else if (p.name == "z") iz = static_cast<int>(k);
+    if (p.name == "x")
+      ix = static_cast<int>(k);
+    else if (p.name == "y")
+      iy = static_cast<int>(k);
+    else if (p.name == "z")
+      iz = static_cast<int>(k);
   }
   if (ix < 0 || iy < 0 || iz < 0) in.fail("vertex element has no x, y, z properties");
   report.double_precision = e.props[ix].type == Type::F64;
@@ -340,7 +380,8 @@ void read_vertices(BodyReader& in, const Element& e, Mesh& mesh, const LoadOptio
   if (options.keep_vertex_properties)
     for (std::size_t k = 0; k < e.props.size(); ++k) {
       const Property& p = e.props[k];
-      if (p.is_list || static_cast<int>(k) == ix || static_cast<int>(k) == iy || static_cast<int>(k) == iz) continue;
+      if (p.is_list || static_cast<int>(k) == ix || static_cast<int>(k) == iy || static_cast<int>(k) == iz)
+        continue;
       prop_slot[k] = static_cast<int>(mesh.vertex_properties.size());
       mesh.vertex_properties.push_back({p.name, std::vector<double>(n)});
     }
@@ -405,10 +446,14 @@ void read_vertices(BodyReader& in, const Element& e, Mesh& mesh, const LoadOptio
         continue;
       }
       double v = in.real(p.type);
-      if (static_cast<int>(k) == ix) pos[3 * i] = v;
-      else if (static_cast<int>(k) == iy) pos[3 * i + 1] = v;
-      else if (static_cast<int>(k) == iz) pos[3 * i + 2] = v;
-      else if (prop_slot[k] >= 0) mesh.vertex_properties[prop_slot[k]].values[i] = v;
+      if (static_cast<int>(k) == ix)
+        pos[3 * i] = v;
+      else if (static_cast<int>(k) == iy)
+        pos[3 * i + 1] = v;
+      else if (static_cast<int>(k) == iz)
+        pos[3 * i + 2] = v;
+      else if (prop_slot[k] >= 0)
+        mesh.vertex_properties[prop_slot[k]].values[i] = v;
     }
     if (!finite3(pos[3 * i], pos[3 * i + 1], pos[3 * i + 2])) in.fail("vertex coordinate is not finite");
   }
@@ -416,7 +461,8 @@ void read_vertices(BodyReader& in, const Element& e, Mesh& mesh, const LoadOptio
 
 /// Fast path for the common binary face layout: fixed-size scalars around one index list whose
 /// count is 1 byte and whose items are 4-byte integers. Returns false (nothing consumed) otherwise.
-bool read_faces_fast(BodyReader& in, const Element& e, std::size_t list_prop, std::uint64_t nv, PolygonSink& sink) {
+bool read_faces_fast(BodyReader& in, const Element& e, std::size_t list_prop, std::uint64_t nv,
+                     PolygonSink& sink) {
   if (in.ascii() || e.props.size() > 16) return false;
   for (std::size_t k = 0; k < e.props.size(); ++k)
     if (k != list_prop && e.props[k].is_list) return false;
@@ -424,49 +470,70 @@ bool read_faces_fast(BodyReader& in, const Element& e, std::size_t list_prop, st
   if (type_size(lp.count_type) != 1 || (lp.type != Type::I32 && lp.type != Type::U32)) return false;
   std::size_t pre = 0, post = 0;
   for (std::size_t k = 0; k < e.props.size(); ++k)
-    if (k < list_prop) pre += type_size(e.props[k].type);
-    else if (k > list_prop) post += type_size(e.props[k].type);
+    if (k < list_prop)
+      pre += type_size(e.props[k].type);
+    else if (k > list_prop)
+      post += type_size(e.props[k].type);
   const bool swap = in.swap();
   const bool signed_count = lp.count_type == Type::I8;
   const bool signed_index = lp.type == Type::I32;
   const unsigned char* p = in.ptr();
   const unsigned char* end = p + in.remaining();
-  std::uint32_t corners[256];
   const std::size_t n = static_cast<std::size_t>(e.count);
+  // Triangles are written straight into the index array. Its first size is what the data can
+  // back (a valid face row is at least pre + 1 + 12 + post bytes); polygons grow it as needed.
+  std::vector<std::uint32_t>& out = *sink.indices;
+  std::size_t w = out.size();
+  out.resize(w + 3 * std::min<std::size_t>(n, in.remaining() / (pre + post + 13)));
+  auto fail_at = [&](std::size_t i, const std::string& what) {
+    out.resize(w);
+    in.set_context(&e, i);
+    in.fail(what);
+  };
+  auto check_range = [&](std::size_t i, const std::uint32_t* c, int count) {
+    for (int k = 0; k < count; ++k)
+      if (c[k] >= nv) {
+        long long v = signed_index ? static_cast<long long>(static_cast<std::int32_t>(c[k])) : c[k];
+        fail_at(i,
+                "vertex index " + std::to_string(v) + " out of range (" + std::to_string(nv) + " vertices)");
+      }
+  };
+  std::uint32_t corners[256];
   for (std::size_t i = 0; i < n; ++i) {
-    if (static_cast<std::size_t>(end - p) < pre + 1) {
-      in.set_context(&e, i);
-      in.fail("file is truncated (the header declares more faces)");
-    }
+    if (static_cast<std::size_t>(end - p) < pre + 1)
+      fail_at(i, "file is truncated (the header declares more faces)");
     p += pre;
     const int c = signed_count ? static_cast<int>(static_cast<std::int8_t>(*p)) : static_cast<int>(*p);
     ++p;
-    if (c < 3) {
-      in.set_context(&e, i);
-      in.fail("face with " + std::to_string(c) + " vertices (at least 3 needed)");
-    }
+    if (c < 3) fail_at(i, "face with " + std::to_string(c) + " vertices (at least 3 needed)");
     const std::size_t bytes = 4 * static_cast<std::size_t>(c) + post;
-    if (static_cast<std::size_t>(end - p) < bytes) {
-      in.set_context(&e, i);
-      in.fail("file is truncated (the header declares more faces)");
-    }
-    std::memcpy(corners, p, 4 * static_cast<std::size_t>(c));
-    p += bytes;
-    bool bad = false;
-    for (int k = 0; k < c; ++k) {
-      if (swap) corners[k] = __builtin_bswap32(corners[k]);
-      bad |= corners[k] >= nv;  // a negative int32 becomes >= 2^31, which is out of range as well
-    }
-    if (bad) {
-      in.set_context(&e, i);
+    if (static_cast<std::size_t>(end - p) < bytes)
+      fail_at(i, "file is truncated (the header declares more faces)");
+    const std::size_t need = 3 * static_cast<std::size_t>(c - 2);
+    if (w + need > out.size()) out.resize(std::max(2 * out.size(), w + need));
+    std::uint32_t* dst = out.data() + w;
+    if (c == 3 && !swap) {
+      // The common case: one triangle, copied as is. A negative int32 reads as >= 2^31, which is
+      // out of range as well.
+      std::memcpy(dst, p, 12);
+      if ((dst[0] >= nv) | (dst[1] >= nv) | (dst[2] >= nv)) check_range(i, dst, 3);
+      w += 3;
+    } else {
+      std::memcpy(corners, p, 4 * static_cast<std::size_t>(c));
       for (int k = 0; k < c; ++k)
-        if (corners[k] >= nv) {
-          long long v = signed_index ? static_cast<long long>(static_cast<std::int32_t>(corners[k])) : corners[k];
-          in.fail("vertex index " + std::to_string(v) + " out of range (" + std::to_string(nv) + " vertices)");
-        }
+        if (swap) corners[k] = __builtin_bswap32(corners[k]);
+      check_range(i, corners, c);
+      if (c > 3) ++sink.polygons;
+      for (int k = 2; k < c; ++k) {
+        *dst++ = corners[0];
+        *dst++ = corners[k - 1];
+        *dst++ = corners[k];
+      }
+      w += need;
     }
-    sink.add(corners, static_cast<std::size_t>(c));
+    p += bytes;
   }
+  out.resize(w);
   in.advance(static_cast<std::size_t>(p - in.ptr()));
   return true;
 }
@@ -487,10 +554,7 @@ void read_faces(BodyReader& in, const Element& e, std::uint64_t nv, bool strips,
   if (!fits(e.count, min_row, in.remaining() + 1))
     in.fail("header declares " + std::to_string(e.count) + " " + e.name +
             " elements but the file is too short for them");
-  if (!strips) {
-    sink.indices->reserve(sink.indices->size() + 3 * static_cast<std::size_t>(e.count));
-    if (read_faces_fast(in, e, list_prop, nv, sink)) return;
-  }
+  if (!strips && read_faces_fast(in, e, list_prop, nv, sink)) return;
 
   std::vector<std::uint32_t> corners;
   const Property& lp = e.props[list_prop];
@@ -511,7 +575,8 @@ void read_faces(BodyReader& in, const Element& e, std::uint64_t nv, bool strips,
           continue;
         }
         if (v < 0 || static_cast<std::uint64_t>(v) >= nv)
-          in.fail("vertex index " + std::to_string(v) + " out of range (" + std::to_string(nv) + " vertices)");
+          in.fail("vertex index " + std::to_string(v) + " out of range (" + std::to_string(nv) +
+                  " vertices)");
         corners.push_back(static_cast<std::uint32_t>(v));
       }
       if (!strips) {
@@ -556,7 +621,8 @@ void skip_element(BodyReader& in, const Element& e) {
 
 }  // namespace
 
-Mesh parse_ply(std::string_view bytes, const std::string& name, const LoadOptions& options, LoadReport& report) {
+Mesh parse_ply(std::string_view bytes, const std::string& name, const LoadOptions& options,
+               LoadReport& report) {
   if (bytes.empty()) fail(name, "empty file");
   Header h = parse_header(bytes, name);
   report.format = FileFormat::Ply;
@@ -569,7 +635,8 @@ Mesh parse_ply(std::string_view bytes, const std::string& name, const LoadOption
       vertex = &e;
     }
   if (!vertex) fail(name, "PLY header declares no vertex element");
-  if (vertex->count > 0xFFFFFFFFull) fail_line(name, vertex->header_line, "too many vertices for 32-bit indices");
+  if (vertex->count > 0xFFFFFFFFull)
+    fail_line(name, vertex->header_line, "too many vertices for 32-bit indices");
   const std::uint64_t nv = vertex->count;
 
   Mesh mesh;
@@ -577,10 +644,14 @@ Mesh parse_ply(std::string_view bytes, const std::string& name, const LoadOption
   BodyReader in(bytes.substr(h.body_offset), h, name);
   for (const Element& e : h.elements) {
     in.set_context(&e, 0);
-    if (&e == vertex) read_vertices(in, e, mesh, options, report);
-    else if (e.name == "face") read_faces(in, e, nv, false, sink);
-    else if (e.name == "tristrips") read_faces(in, e, nv, true, sink);
-    else skip_element(in, e);
+    if (&e == vertex)
+      read_vertices(in, e, mesh, options, report);
+    else if (e.name == "face")
+      read_faces(in, e, nv, false, sink);
+    else if (e.name == "tristrips")
+      read_faces(in, e, nv, true, sink);
+    else
+      skip_element(in, e);
   }
   if (mesh.indices.empty()) fail(name, "no faces");
   report.polygons_triangulated = sink.polygons;
@@ -622,7 +693,8 @@ std::string write_ply(const Mesh& mesh, bool binary, bool double_precision) {
   append_uint(out, nv);
   out += '\n';
   for (const char* axis : {"x", "y", "z"}) out += std::string("property ") + type + " " + axis + "\n";
-  for (const VertexProperty& p : mesh.vertex_properties) out += std::string("property ") + type + " " + p.name + "\n";
+  for (const VertexProperty& p : mesh.vertex_properties)
+    out += std::string("property ") + type + " " + p.name + "\n";
   out += "element face ";
   append_uint(out, nf);
   out += "\nproperty list uchar int vertex_indices\nend_header\n";
@@ -633,12 +705,16 @@ std::string write_ply(const Mesh& mesh, bool binary, bool double_precision) {
     for (std::size_t i = 0; i < nv; ++i) {
       for (int k = 0; k < 3; ++k) {
         double v = mesh.positions[3 * i + k];
-        if (double_precision) put(out, v);
-        else put(out, static_cast<float>(v));
+        if (double_precision)
+          put(out, v);
+        else
+          put(out, static_cast<float>(v));
       }
       for (const VertexProperty& p : mesh.vertex_properties) {
-        if (double_precision) put(out, p.values[i]);
-        else put(out, static_cast<float>(p.values[i]));
+        if (double_precision)
+          put(out, p.values[i]);
+        else
+          put(out, static_cast<float>(p.values[i]));
       }
     }
     for (std::size_t f = 0; f < nf; ++f) {
@@ -648,8 +724,10 @@ std::string write_ply(const Mesh& mesh, bool binary, bool double_precision) {
     return out;
   }
   auto number = [&](double v) {
-    if (double_precision) append_number(out, v);
-    else append_number(out, static_cast<float>(v));
+    if (double_precision)
+      append_number(out, v);
+    else
+      append_number(out, static_cast<float>(v));
   };
   for (std::size_t i = 0; i < nv; ++i) {
     number(mesh.positions[3 * i]);

@@ -25,7 +25,8 @@ float load_f32le(const unsigned char* p) { return std::bit_cast<float>(load_u32l
 
 bool starts_with_solid(std::string_view bytes) {
   std::size_t i = 0;
-  while (i < bytes.size() && (bytes[i] == ' ' || bytes[i] == '\t' || bytes[i] == '\r' || bytes[i] == '\n')) ++i;
+  while (i < bytes.size() && (bytes[i] == ' ' || bytes[i] == '\t' || bytes[i] == '\r' || bytes[i] == '\n'))
+    ++i;
   return bytes.substr(i, 5) == "solid";
 }
 
@@ -37,6 +38,9 @@ class CornerSink {
       : mesh_(mesh), weld_(weld), welder_(mesh.positions, weld ? expected_triangles / 2 + 16 : 0) {
     mesh_.positions.reserve(3 * (weld ? expected_triangles / 2 + 16 : 3 * expected_triangles));
     mesh_.indices.reserve(3 * expected_triangles);
+  }
+  void prefetch(double x, double y, double z) const {
+    if (weld_) welder_.prefetch(x, y, z);
   }
   std::uint32_t add(double x, double y, double z) {
     if (weld_) return welder_.add(x, y, z);
@@ -61,7 +65,13 @@ Mesh parse_binary(std::string_view bytes, const std::string& name, bool weld, st
   Mesh mesh;
   CornerSink sink(mesh, weld, static_cast<std::size_t>(n));
   const unsigned char* t = base + 84;
+  constexpr std::uint64_t kAhead = 8;  // triangles between prefetch and use
   for (std::uint64_t i = 0; i < n; ++i, t += 50) {
+    if (i + kAhead < n)
+      for (int c = 0; c < 3; ++c) {
+        const unsigned char* q = t + 50 * kAhead + 12 + 12 * c;
+        sink.prefetch(load_f32le(q), load_f32le(q + 4), load_f32le(q + 8));
+      }
     // 12 bytes of normal (recomputed by whoever needs it), then 3 corners, then 2 attribute bytes.
     for (int c = 0; c < 3; ++c) {
       const unsigned char* q = t + 12 + 12 * c;
@@ -103,7 +113,9 @@ Mesh parse_ascii(std::string_view bytes, const std::string& name, bool weld, std
       double c[3];
       for (double& v : c) {
         if (!in.skip_space()) in.fail("unexpected end of file in a vertex");
-        v = in.number("a vertex coordinate");
+        float f;  // STL coordinates are single precision, in ASCII files too
+        if (!in.try_number(f)) in.fail_expected("a vertex coordinate");
+        v = f;
       }
       if (!finite3(c[0], c[1], c[2])) in.fail("vertex coordinate is not finite");
       if (mesh.vertex_count() >= 0xFFFFFFFEull) in.fail("too many vertices");
@@ -144,7 +156,8 @@ bool stl_is_binary(std::string_view bytes) {
   return bytes.size() == 84 + 50 * n;
 }
 
-Mesh parse_stl(std::string_view bytes, const std::string& name, const LoadOptions& options, LoadReport& report) {
+Mesh parse_stl(std::string_view bytes, const std::string& name, const LoadOptions& options,
+               LoadReport& report) {
   if (bytes.empty()) fail(name, "empty file");
   report.format = FileFormat::Stl;
   const bool weld = options.weld != Weld::Off;  // Auto welds STL
@@ -158,12 +171,14 @@ Mesh parse_stl(std::string_view bytes, const std::string& name, const LoadOption
     report.binary = false;
     return parse_ascii(bytes, name, weld, report.vertices_welded);
   }
-  if (bytes.size() < 84) fail(name, "too short for a binary STL (" + std::to_string(bytes.size()) + " bytes)");
+  if (bytes.size() < 84)
+    fail(name, "too short for a binary STL (" + std::to_string(bytes.size()) + " bytes)");
   const std::uint64_t n = load_u32le(reinterpret_cast<const unsigned char*>(bytes.data()) + 80);
   const std::uint64_t have = (bytes.size() - 84) / 50;
   fail_element(name, "triangle", std::min(n, have),
-               "binary STL header declares " + std::to_string(n) + " triangles (" + std::to_string(84 + 50 * n) +
-                   " bytes) but the file has " + std::to_string(bytes.size()) + " bytes");
+               "binary STL header declares " + std::to_string(n) + " triangles (" +
+                   std::to_string(84 + 50 * n) + " bytes) but the file has " + std::to_string(bytes.size()) +
+                   " bytes");
 }
 
 std::string write_stl(const Mesh& mesh, bool binary) {
@@ -197,8 +212,8 @@ std::string write_stl(const Mesh& mesh, bool binary) {
       for (int k = 0; k < 3; ++k) put32(at + 4 * k, std::bit_cast<std::uint32_t>(n[k]));
       for (int c = 0; c < 3; ++c)
         for (int k = 0; k < 3; ++k)
-          put32(at + 12 + 12 * c + 4 * k,
-                std::bit_cast<std::uint32_t>(static_cast<float>(mesh.positions[3 * std::size_t{mesh.indices[3 * f + c]} + k])));
+          put32(at + 12 + 12 * c + 4 * k, std::bit_cast<std::uint32_t>(static_cast<float>(
+                                              mesh.positions[3 * std::size_t{mesh.indices[3 * f + c]} + k])));
     }
     return out;
   }

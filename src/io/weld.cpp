@@ -15,7 +15,12 @@ std::size_t weld_exact(Mesh& mesh) {
   std::vector<std::uint32_t> remap(nv);
   std::vector<std::uint32_t> first;  // new index -> old index of its first occurrence
   first.reserve(nv);
+  constexpr std::size_t kAhead = 16;  // vertices between prefetch and use (see VertexWelder::prefetch)
   for (std::size_t v = 0; v < nv; ++v) {
+    if (v + kAhead < nv) {
+      const double* a = &mesh.positions[3 * (v + kAhead)];
+      welder.prefetch(a[0], a[1], a[2]);
+    }
     const double* p = &mesh.positions[3 * v];
     remap[v] = welder.add(p[0], p[1], p[2]);
     if (remap[v] == first.size()) first.push_back(static_cast<std::uint32_t>(v));

@@ -9,7 +9,7 @@ namespace qem::measure_detail {
 
 namespace {
 
-constexpr int kBins = 16;          // SAH bins per split: 8-32 give the same tree quality (Wald 2007)
+constexpr int kBins = 16;           // SAH bins per split: 8-32 give the same tree quality (Wald 2007)
 constexpr std::uint32_t kLeaf = 4;  // triangles per leaf at most
 // Below this depth splits switch from SAH (which may peel off a few triangles per level on skewed
 // inputs) to object medians, so the depth stays below kSahDepth + 32 and fits the query stack.
@@ -46,31 +46,40 @@ inline double box_d2(const double* p, const double* lo, const double* hi) {
 TriangleBvh::TriangleBvh(const std::vector<double>& corners) {
   const std::uint32_t n = std::uint32_t(corners.size() / 9);
   if (n == 0) return;
-  std::vector<Bounds> box(n);
-  std::vector<double> centroid(3 * std::size_t(n));
+  // Build items are partitioned in place, so every pass over a node's range reads contiguous memory.
+  struct Item {
+    Bounds box;
+    double centroid[3];
+    std::uint32_t id;
+  };
+  std::vector<Item> items(n);
+  Bounds root, root_c;
   for (std::uint32_t t = 0; t < n; ++t) {
-    for (int c = 0; c < 3; ++c) box[t].grow(&corners[9 * std::size_t(t) + 3 * c]);
-    for (int k = 0; k < 3; ++k) centroid[3 * t + k] = 0.5 * (box[t].lo[k] + box[t].hi[k]);
+    Item& it = items[t];
+    for (int c = 0; c < 3; ++c) it.box.grow(&corners[9 * std::size_t(t) + 3 * c]);
+    for (int k = 0; k < 3; ++k) it.centroid[k] = 0.5 * (it.box.lo[k] + it.box.hi[k]);
+    it.id = t;
+    root.grow(it.box);
+    root_c.grow(it.centroid);
   }
-  std::vector<std::uint32_t> order(n);
-  for (std::uint32_t t = 0; t < n; ++t) order[t] = t;
+  auto range_bounds = [&](std::uint32_t begin, std::uint32_t end, Bounds& box, Bounds& cbox) {
+    box = cbox = Bounds{};
+    for (std::uint32_t i = begin; i < end; ++i) box.grow(items[i].box), cbox.grow(items[i].centroid);
+  };
 
   nodes_.reserve(2 * std::size_t(n) / kLeaf + 1);
   nodes_.push_back({});
   struct Task {
     std::uint32_t node, begin, end, depth;
+    Bounds box, cbox;  ///< of the triangles and of their centroids, known from the parent's bins
   };
-  std::vector<Task> stack{{0, 0, n, 0}};
+  std::vector<Task> stack{{0, 0, n, 0, root, root_c}};
   while (!stack.empty()) {
     const Task task = stack.back();
     stack.pop_back();
-    Bounds bounds, cbounds;
-    for (std::uint32_t i = task.begin; i < task.end; ++i) {
-      bounds.grow(box[order[i]]);
-      cbounds.grow(&centroid[3 * order[i]]);
-    }
+    const Bounds& cbounds = task.cbox;
     Node& node = nodes_[task.node];
-    for (int k = 0; k < 3; ++k) node.lo[k] = bounds.lo[k], node.hi[k] = bounds.hi[k];
+    for (int k = 0; k < 3; ++k) node.lo[k] = task.box.lo[k], node.hi[k] = task.box.hi[k];
     node.first = task.begin;
     node.count = task.end - task.begin;
     if (node.count <= kLeaf) continue;
@@ -81,26 +90,29 @@ TriangleBvh::TriangleBvh(const std::vector<double>& corners) {
       if (cbounds.hi[k] - cbounds.lo[k] > cbounds.hi[axis] - cbounds.lo[axis]) axis = k;
     const double extent = cbounds.hi[axis] - cbounds.lo[axis];
     std::uint32_t mid;
+    Bounds lbox, lcbox, rbox, rcbox;
+    bool bounds_known = false;
     if (!(extent > 0)) {
       // All centroids coincide: no plane separates them; halve by index to keep leaves small.
       mid = task.begin + (task.end - task.begin) / 2;
     } else if (task.depth >= kSahDepth) {
       mid = task.begin + (task.end - task.begin) / 2;
-      std::nth_element(order.begin() + task.begin, order.begin() + mid, order.begin() + task.end,
-                       [&](std::uint32_t a, std::uint32_t b) {
-                         return centroid[3 * a + axis] < centroid[3 * b + axis] ||
-                                (centroid[3 * a + axis] == centroid[3 * b + axis] && a < b);
+      std::nth_element(items.begin() + task.begin, items.begin() + mid, items.begin() + task.end,
+                       [&](const Item& a, const Item& b) {
+                         return a.centroid[axis] < b.centroid[axis] ||
+                                (a.centroid[axis] == b.centroid[axis] && a.id < b.id);
                        });
     } else {
       const double scale = kBins / extent;
-      auto bin_of = [&](std::uint32_t t) {
-        return std::min(kBins - 1, int((centroid[3 * t + axis] - cbounds.lo[axis]) * scale));
+      auto bin_of = [&](const Item& it) {
+        return std::min(kBins - 1, int((it.centroid[axis] - cbounds.lo[axis]) * scale));
       };
-      Bounds bin_box[kBins];
+      Bounds bin_box[kBins], bin_cbox[kBins];
       std::uint32_t bin_count[kBins] = {};
       for (std::uint32_t i = task.begin; i < task.end; ++i) {
-        const int b = bin_of(order[i]);
-        bin_box[b].grow(box[order[i]]);
+        const int b = bin_of(items[i]);
+        bin_box[b].grow(items[i].box);
+        bin_cbox[b].grow(items[i].centroid);
         ++bin_count[b];
       }
       // Sweep from the right for the suffix costs, then from the left to pick the cheapest plane.
@@ -122,32 +134,71 @@ TriangleBvh::TriangleBvh(const std::vector<double>& corners) {
         const double cost = (cnt ? acc.half_area() * cnt : 0) + right_cost[b + 1];
         if (cost < best_cost) best_cost = cost, best = b;
       }
-      auto it = std::partition(order.begin() + task.begin, order.begin() + task.end,
-                               [&](std::uint32_t t) { return bin_of(t) <= best; });
-      mid = std::uint32_t(it - order.begin());
-      if (mid == task.begin || mid == task.end) mid = task.begin + (task.end - task.begin) / 2;
+      auto it = std::partition(items.begin() + task.begin, items.begin() + task.end,
+                               [&](const Item& item) { return bin_of(item) <= best; });
+      mid = std::uint32_t(it - items.begin());
+      if (mid == task.begin || mid == task.end) {
+        mid = task.begin + (task.end - task.begin) / 2;
+      } else {
+        for (int b = 0; b < kBins; ++b) {
+          (b <= best ? lbox : rbox).grow(bin_box[b]);
+          (b <= best ? lcbox : rcbox).grow(bin_cbox[b]);
+        }
+        bounds_known = true;
+      }
+    }
+    if (!bounds_known) {
+      range_bounds(task.begin, mid, lbox, lcbox);
+      range_bounds(mid, task.end, rbox, rcbox);
     }
     const std::uint32_t left = std::uint32_t(nodes_.size());
     nodes_.push_back({});
     nodes_.push_back({});
     nodes_[task.node].first = left;  // `node` may dangle after push_back: index again
     nodes_[task.node].count = 0;
-    stack.push_back({left + 1, mid, task.end, task.depth + 1});
-    stack.push_back({left, task.begin, mid, task.depth + 1});
+    stack.push_back({left + 1, mid, task.end, task.depth + 1, rbox, rcbox});
+    stack.push_back({left, task.begin, mid, task.depth + 1, lbox, lcbox});
   }
 
   tris_.resize(9 * std::size_t(n));
-  ids_ = std::move(order);
-  for (std::uint32_t i = 0; i < n; ++i)
+  ids_.resize(n);
+  slot_of_.resize(n);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    ids_[i] = items[i].id;
     std::copy_n(&corners[9 * std::size_t(ids_[i])], 9, &tris_[9 * std::size_t(i)]);
+    slot_of_[ids_[i]] = i;
+  }
+}
+
+double TriangleBvh::slot_d2(const double p[3], std::uint32_t slot, double point[3]) const {
+  const double* t = &tris_[9 * std::size_t(slot)];
+  const Vec3 q{p[0], p[1], p[2]};
+  const Vec3 c = closest_point_on_triangle(q, {t[0], t[1], t[2]}, {t[3], t[4], t[5]}, {t[6], t[7], t[8]});
+  point[0] = c.x, point[1] = c.y, point[2] = c.z;
+  return squared_distance(q, c);
 }
 
 TriangleBvh::Hit TriangleBvh::closest(const double p[3], double max_d2) const {
+  return search(p, max_d2, UINT32_MAX);
+}
+
+TriangleBvh::Hit TriangleBvh::closest(const double p[3], std::uint32_t* hint) const {
+  if (ids_.empty()) return Hit{};
+  double best = std::numeric_limits<double>::infinity();
+  std::uint32_t slot = UINT32_MAX;
+  if (*hint < ids_.size()) {
+    double point[3];
+    slot = slot_of_[*hint];
+    best = slot_d2(p, slot, point);
+  }
+  const Hit hit = search(p, best, slot);
+  *hint = hit.triangle;
+  return hit;
+}
+
+TriangleBvh::Hit TriangleBvh::search(const double p[3], double best, std::uint32_t best_tri) const {
   Hit hit;
   if (nodes_.empty()) return hit;
-  double best = max_d2;
-  std::uint32_t best_tri = UINT32_MAX;
-  Vec3 best_point{0, 0, 0};
   const Vec3 q{p[0], p[1], p[2]};
   struct Entry {
     std::uint32_t node;
@@ -163,9 +214,10 @@ TriangleBvh::Hit TriangleBvh::closest(const double p[3], double max_d2) const {
     if (node.count > 0) {
       for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
         const double* t = &tris_[9 * std::size_t(i)];
-        const Vec3 c = closest_point_on_triangle(q, {t[0], t[1], t[2]}, {t[3], t[4], t[5]}, {t[6], t[7], t[8]});
+        const Vec3 c =
+            closest_point_on_triangle(q, {t[0], t[1], t[2]}, {t[3], t[4], t[5]}, {t[6], t[7], t[8]});
         const double d2 = squared_distance(q, c);
-        if (d2 < best) best = d2, best_tri = i, best_point = c;
+        if (d2 < best) best = d2, best_tri = i;
       }
       continue;
     }
@@ -182,9 +234,9 @@ TriangleBvh::Hit TriangleBvh::closest(const double p[3], double max_d2) const {
     }
   }
   if (best_tri != UINT32_MAX) {
-    hit.d2 = best;
+    // The closest point is recomputed once here rather than stored at every improvement.
+    hit.d2 = slot_d2(p, best_tri, hit.point);
     hit.triangle = ids_[best_tri];
-    hit.point[0] = best_point.x, hit.point[1] = best_point.y, hit.point[2] = best_point.z;
   }
   return hit;
 }

@@ -15,8 +15,8 @@ class TriangleBvh {
  public:
   struct Hit {
     double d2 = std::numeric_limits<double>::infinity();  ///< squared distance
-    std::uint32_t triangle = UINT32_MAX;                   ///< index into the build input
-    double point[3] = {0, 0, 0};                           ///< closest point
+    std::uint32_t triangle = UINT32_MAX;                  ///< index into the build input
+    double point[3] = {0, 0, 0};                          ///< closest point
   };
 
   TriangleBvh() = default;
@@ -25,6 +25,10 @@ class TriangleBvh {
 
   /// The closest point of all triangles to `p`; none closer than sqrt(max_d2) -> Hit with d2 = inf.
   Hit closest(const double p[3], double max_d2 = std::numeric_limits<double>::infinity()) const;
+  /// Same, warm-started: the distance to triangle `*hint` (e.g. the previous query's answer, or
+  /// UINT32_MAX for none) bounds the search from the start, which prunes most of the tree when
+  /// consecutive queries are near each other. `*hint` is set to the closest triangle found.
+  Hit closest(const double p[3], std::uint32_t* hint) const;
 
   std::size_t triangle_count() const { return ids_.size(); }
   std::size_t node_count() const { return nodes_.size(); }
@@ -36,9 +40,13 @@ class TriangleBvh {
     std::uint32_t first;  ///< leaf: first triangle; inner: left child (right child = first + 1)
     std::uint32_t count;  ///< triangles in a leaf; 0 for an inner node
   };
+  Hit search(const double p[3], double best, std::uint32_t best_slot) const;
+  double slot_d2(const double p[3], std::uint32_t slot, double point[3]) const;
+
   std::vector<Node> nodes_;
-  std::vector<double> tris_;        ///< 9 per triangle, in leaf order
-  std::vector<std::uint32_t> ids_;  ///< input index of each stored triangle
+  std::vector<double> tris_;            ///< 9 per triangle, in leaf order
+  std::vector<std::uint32_t> ids_;      ///< input index of each stored triangle
+  std::vector<std::uint32_t> slot_of_;  ///< stored position of each input triangle
 };
 
 }  // namespace qem::measure_detail

@@ -6,9 +6,12 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
+#include <string>
 #include <thread>
 
 #include "measure/bvh.h"
+#include "measure/spatial_order.h"
 #include "measure/surface_sampling.h"
 #include "qem/error.h"
 
@@ -19,7 +22,7 @@ namespace {
 using measure_detail::Surface;
 using measure_detail::TriangleBvh;
 
-constexpr std::size_t kChunk = 4096;  // queries per work item: the unit of the deterministic sum
+constexpr std::size_t kChunk = 4096;  // queries per work item (and per warm-start run)
 
 unsigned resolve_threads(unsigned requested) {
   if (requested > 0) return requested;
@@ -47,25 +50,24 @@ struct Distances {
 };
 
 /// Distances from `samples` (counted in the sums and the max) and `vertices` (max only) to `tree`.
+/// Queries run in Morton order, warm-started from the previous answer within each fixed chunk; the
+/// sums then run in sample order on one thread, so nothing depends on the thread count.
 Distances distances(const TriangleBvh& tree, const std::vector<double>& samples,
                     const std::vector<double>& vertices, unsigned threads) {
-  const std::size_t ns = samples.size() / 3, nv = vertices.size() / 3;
-  std::vector<Distances> part((ns + nv + kChunk - 1) / kChunk);
-  for_chunks(ns + nv, threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
-    Distances d;
-    for (std::size_t i = begin; i < end; ++i) {
-      const double* p = i < ns ? &samples[3 * i] : &vertices[3 * (i - ns)];
-      const double d2 = tree.closest(p).d2;
-      const double dist = std::sqrt(d2);
-      if (i < ns) d.sum_d2 += d2, d.sum_d += dist, ++d.n;
-      d.max_d = std::max(d.max_d, dist);
-    }
-    part[c] = d;
+  const std::size_t ns = samples.size() / 3;
+  std::vector<double> points = samples;
+  points.insert(points.end(), vertices.begin(), vertices.end());
+  const std::vector<std::uint32_t> order = measure_detail::morton_order(points);
+  std::vector<double> d2(order.size());
+  for_chunks(order.size(), threads, [&](std::size_t, std::size_t begin, std::size_t end) {
+    std::uint32_t hint = UINT32_MAX;  // reset per chunk: the warm start never crosses chunks
+    for (std::size_t j = begin; j < end; ++j) d2[order[j]] = tree.closest(&points[3 * order[j]], &hint).d2;
   });
   Distances total;
-  for (const Distances& d : part) {  // chunk order: independent of which thread ran what
-    total.sum_d2 += d.sum_d2, total.sum_d += d.sum_d, total.n += d.n;
-    total.max_d = std::max(total.max_d, d.max_d);
+  for (std::size_t i = 0; i < d2.size(); ++i) {
+    const double dist = std::sqrt(d2[i]);
+    if (i < ns) total.sum_d2 += d2[i], total.sum_d += dist, ++total.n;
+    total.max_d = std::max(total.max_d, dist);
   }
   return total;
 }
@@ -87,6 +89,8 @@ MeasureResult measure(MeshView original, MeshView approx, const MeasureOptions& 
   if (sn.triangle_count() == 0) throw Error("original: no face with non-zero area, nothing to measure");
   if (si.triangle_count() == 0) throw Error("approximation: no face with non-zero area, nothing to measure");
   const unsigned threads = resolve_threads(options.threads);
+  if (options.samples + (sn.vertices.size() + si.vertices.size()) / 3 >= UINT32_MAX)
+    throw Error("measure: " + std::to_string(options.samples) + " samples is too many (at most about 4e9)");
 
   // Same density on both surfaces: split the samples in proportion to the areas.
   const double total = double(options.samples);
@@ -107,8 +111,10 @@ MeasureResult measure(MeshView original, MeshView approx, const MeasureOptions& 
     if (threads > 1) helper = std::thread(build_i);
     tree_n = TriangleBvh(sn.corners);
     xn = measure_detail::sample_surface(sn, nn, options.seed * 2);
-    if (helper.joinable()) helper.join();
-    else build_i();
+    if (helper.joinable())
+      helper.join();
+    else
+      build_i();
   }
   static const std::vector<double> kNone;
   const Distances o2a = distances(tree_i, xn, options.include_vertices ? sn.vertices : kNone, threads);
@@ -140,8 +146,9 @@ MeasureResult measure(MeshView original, MeshView approx, const MeasureOptions& 
     const std::size_t nv = approx.vertex_count();
     r.vertex_distance.assign(nv, 0.0);
     for_chunks(nv, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
+      std::uint32_t hint = UINT32_MAX;  // mesh vertex order is usually coherent enough
       for (std::size_t v = begin; v < end; ++v)
-        r.vertex_distance[v] = std::sqrt(tree_n.closest(&approx.positions[3 * v]).d2);
+        r.vertex_distance[v] = std::sqrt(tree_n.closest(&approx.positions[3 * v], &hint).d2);
     });
   }
   return r;

@@ -53,7 +53,8 @@ std::vector<double> sample_surface(const Surface& s, std::size_t n, std::uint64_
   Rng rng(seed);
   for (std::size_t k = 0; k < n; ++k) {
     const double r = rng.uniform() * s.area;
-    std::size_t f = std::size_t(std::upper_bound(s.cum_area.begin(), s.cum_area.end(), r) - s.cum_area.begin());
+    std::size_t f =
+        std::size_t(std::upper_bound(s.cum_area.begin(), s.cum_area.end(), r) - s.cum_area.begin());
     if (f >= nt) f = nt - 1;
     // Square-root warp: (1 - sqrt(r1), sqrt(r1)(1 - r2), sqrt(r1) r2) is uniform on the triangle.
     const double r1 = std::sqrt(rng.uniform()), r2 = rng.uniform();

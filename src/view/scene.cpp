@@ -37,9 +37,9 @@ void put_f32(std::string& out, double v) {
 }  // namespace
 
 std::map<std::string, std::string> scene_files(const ViewScene& scene) {
-  if (scene.levels.empty()) throw Error("qem view: no mesh to show");
+  if (scene.levels.empty()) throw Error("no mesh to show");
   if (scene.mode == ViewMode::Compare && scene.levels.size() != 2)
-    throw Error("qem view: --compare needs exactly two meshes (original and simplified), got " +
+    throw Error("--compare needs exactly two meshes (original and simplified), got " +
                 std::to_string(scene.levels.size()));
 
   // One frame for all levels: the page centres and zooms once, so switching levels never jumps.
@@ -53,7 +53,7 @@ std::map<std::string, std::string> scene_files(const ViewScene& scene) {
     }
     for (std::uint32_t idx : m.indices)
       if (idx >= m.vertex_count())
-        throw Error("qem view: " + level.name + ": face index " + std::to_string(idx) + " out of range (" +
+        throw Error(level.name + ": face index " + std::to_string(idx) + " out of range (" +
                     std::to_string(m.vertex_count()) + " vertices)");
     if (const VertexProperty* d = m.find_property(kHeatProperty))
       for (double x : d->values)

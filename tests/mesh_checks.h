@@ -1,0 +1,59 @@
+// Validity checks the tests apply to every simplifier output.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <set>
+#include <string>
+
+#include "qem/mesh.h"
+
+namespace qem::test {
+
+/// Empty if `m` is a valid indexed triangle mesh: finite coordinates, indices in range, no face
+/// with a repeated corner, no two faces on the same three vertices. Otherwise what is wrong.
+inline std::string validity_problem(const Mesh& m) {
+  for (double x : m.positions)
+    if (!std::isfinite(x)) return "non-finite coordinate";
+  if (m.indices.size() % 3) return "index count not a multiple of 3";
+  std::set<std::array<std::uint32_t, 3>> seen;
+  for (std::size_t f = 0; f < m.face_count(); ++f) {
+    std::array<std::uint32_t, 3> t{m.indices[3 * f], m.indices[3 * f + 1], m.indices[3 * f + 2]};
+    for (std::uint32_t i : t)
+      if (i >= m.vertex_count()) return "face " + std::to_string(f) + " index out of range";
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) return "face " + std::to_string(f) + " is degenerate";
+    std::sort(t.begin(), t.end());
+    if (!seen.insert(t).second) return "face " + std::to_string(f) + " duplicates an earlier face";
+  }
+  return {};
+}
+
+/// Edges used by more than two faces.
+inline std::size_t non_manifold_edges(const Mesh& m) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> count;
+  for (std::size_t f = 0; f < m.face_count(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      std::uint32_t a = m.indices[3 * f + k], b = m.indices[3 * f + (k + 1) % 3];
+      ++count[std::minmax(a, b)];
+    }
+  std::size_t n = 0;
+  for (auto& [e, c] : count) n += c > 2;
+  return n;
+}
+
+/// Edges used by exactly one face.
+inline std::size_t boundary_edges(const Mesh& m) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> count;
+  for (std::size_t f = 0; f < m.face_count(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      std::uint32_t a = m.indices[3 * f + k], b = m.indices[3 * f + (k + 1) % 3];
+      ++count[std::minmax(a, b)];
+    }
+  std::size_t n = 0;
+  for (auto& [e, c] : count) n += c == 1;
+  return n;
+}
+
+}  // namespace qem::test

@@ -1,0 +1,104 @@
+// The viewer's static server (src/view/http_server.h) answering real requests on 127.0.0.1.
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <thread>
+
+#include "qem/error.h"
+#include "view/http_server.h"
+
+namespace qem::view {
+namespace {
+
+/// Sends one raw request to 127.0.0.1:port and returns the whole response.
+std::string request(std::uint16_t port, const std::string& raw) {
+  int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(port);
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+    ::close(fd);
+    return "connect failed";
+  }
+  ::send(fd, raw.data(), raw.size(), MSG_NOSIGNAL);
+  std::string out;
+  char buf[4096];
+  ssize_t n;
+  while ((n = ::recv(fd, buf, sizeof buf, 0)) > 0) out.append(buf, static_cast<std::size_t>(n));
+  ::close(fd);
+  return out;
+}
+
+class ViewHttp : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    FileSet files{{"index.html", "<html>hello</html>"},
+                  {"data/scene.json", "{}"},
+                  {"data/level0.pos.f32", std::string("\0\x01\x02", 3)}};
+    server_ = std::make_unique<HttpServer>(files, 0);
+    thread_ = std::thread([this] { server_->serve(stop_); });
+  }
+  void TearDown() override {
+    stop_ = true;
+    thread_.join();
+  }
+  std::string get(const std::string& path) {
+    return request(server_->port(), "GET " + path + " HTTP/1.1\r\nHost: x\r\n\r\n");
+  }
+
+  std::atomic<bool> stop_{false};
+  std::unique_ptr<HttpServer> server_;
+  std::thread thread_;
+};
+
+TEST_F(ViewHttp, ServesFilesWithTypesAndLengths) {
+  EXPECT_NE(server_->port(), 0);
+  EXPECT_EQ(server_->url(), "http://127.0.0.1:" + std::to_string(server_->port()) + "/");
+  std::string r = get("/");
+  EXPECT_EQ(r.rfind("HTTP/1.1 200 OK\r\n", 0), 0u) << r;
+  EXPECT_NE(r.find("Content-Type: text/html"), std::string::npos);
+  EXPECT_NE(r.find("Content-Length: 18\r\n"), std::string::npos);
+  EXPECT_EQ(r.substr(r.size() - 18), "<html>hello</html>");
+  r = get("/data/scene.json?x=1");
+  EXPECT_NE(r.find("application/json"), std::string::npos) << r;
+  r = get("/data/level0.pos.f32");
+  EXPECT_EQ(r.substr(r.size() - 3), std::string("\0\x01\x02", 3));
+  EXPECT_GE(server_->requests(), 3u);
+}
+
+TEST_F(ViewHttp, AnswersErrorsWithoutTouchingTheFileSystem) {
+  EXPECT_EQ(get("/missing.js").rfind("HTTP/1.1 404", 0), 0u);
+  EXPECT_EQ(get("/../../etc/passwd").rfind("HTTP/1.1 404", 0), 0u);
+  EXPECT_EQ(request(server_->port(), "POST / HTTP/1.1\r\n\r\n").rfind("HTTP/1.1 405", 0), 0u);
+  EXPECT_EQ(request(server_->port(), "garbage\r\n\r\n").rfind("HTTP/1.1 400", 0), 0u);
+  std::string head = request(server_->port(), "HEAD /index.html HTTP/1.1\r\n\r\n");
+  EXPECT_EQ(head.rfind("HTTP/1.1 200", 0), 0u);
+  EXPECT_EQ(head.find("hello"), std::string::npos);  // HEAD: headers only
+}
+
+TEST_F(ViewHttp, AClientThatSaysNothingDoesNotBlockOthers) {
+  // A browser pre-connects sockets it may never use; other requests must still be answered.
+  int idle = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(server_->port());
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(::connect(idle, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+  auto t0 = std::chrono::steady_clock::now();
+  EXPECT_EQ(get("/").rfind("HTTP/1.1 200", 0), 0u);
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(2));
+  ::close(idle);
+}
+
+TEST(ViewHttpBind, APortInUseIsAClearError) {
+  HttpServer server({}, 0);
+  // The port is taken on 127.0.0.1: a second server on it must throw qem::Error, not crash.
+  EXPECT_THROW(HttpServer({}, server.port()), Error);
+}
+
+}  // namespace
+}  // namespace qem::view

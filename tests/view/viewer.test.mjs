@@ -1,0 +1,282 @@
+// End-to-end test of `qem view` in headless Chromium (Debian's /usr/bin/chromium driven by
+// playwright-core; no browser download). Starts `qem view` servers on free ports of 127.0.0.1,
+// loads the page, moves the LOD slider, toggles shading / wireframe / heat map, orbits and zooms
+// with the mouse, checks compare mode and a static export served by a plain HTTP server, and
+// checks that every screenshot shows a mesh (decoded with node:zlib, see png.mjs).
+// Env: QEM (the qem binary), MESH_DIR (from make_meshes.mjs), OUT_DIR (screenshots).
+// Prints one line per check and a final `N passed, M failed`; exits non-zero on any failure.
+import { spawn, spawnSync } from 'node:child_process';
+import { mkdirSync, readFileSync, existsSync, mkdtempSync, rmSync } from 'node:fs';
+import { createServer } from 'node:http';
+import { tmpdir } from 'node:os';
+import { dirname, join, normalize, resolve } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { createRequire } from 'node:module';
+import { decodePng, regionStats } from './png.mjs';
+
+// playwright-core is installed in web/node_modules (scripts/install-web-deps.sh), not beside this file.
+const here = dirname(fileURLToPath(import.meta.url));
+const { chromium } = createRequire(join(here, '..', '..', 'web', 'package.json'))('playwright-core');
+
+const QEM = resolve(process.env.QEM || 'build/qem');
+const MESH_DIR = resolve(process.env.MESH_DIR || 'build/web-test/meshes');
+const OUT_DIR = resolve(process.env.OUT_DIR || 'build/web-test');
+const CHROMIUM = process.env.CHROMIUM || '/usr/bin/chromium';
+const W = 900, H = 600;
+// Left panel area, excluded when judging what the canvas shows.
+const PANEL_RIGHT = 280;
+
+mkdirSync(OUT_DIR, { recursive: true });
+const children = new Set();
+let passed = 0, failed = 0;
+
+function killChildren() { for (const c of children) c.kill('SIGTERM'); children.clear(); }
+for (const sig of ['SIGINT', 'SIGTERM']) process.on(sig, () => { killChildren(); process.exit(1); });
+process.on('exit', killChildren);
+// The whole run must stay within a couple of minutes whatever hangs.
+setTimeout(() => { console.log('not ok - the test run timed out'); console.log(`${passed} passed, ${failed + 1} failed`); killChildren(); process.exit(1); }, 150000).unref();
+
+function check(cond, what) { if (!cond) throw new Error(what); }
+
+/// Starts `qem view ARGS --port 0` and resolves with its URL (read from its first output line).
+function startQem(args) {
+  return new Promise((res, rej) => {
+    const proc = spawn(QEM, ['view', ...args, '--port', '0'], { cwd: MESH_DIR, stdio: ['ignore', 'pipe', 'pipe'] });
+    children.add(proc);
+    let out = '', err = '';
+    const timer = setTimeout(() => rej(new Error(`qem view did not start: ${out}${err}`)), 30000);
+    proc.stdout.on('data', (d) => {
+      out += d;
+      const m = out.match(/http:\/\/127\.0\.0\.1:(\d+)\//);
+      if (m) { clearTimeout(timer); res({ url: m[0], proc }); }
+    });
+    proc.stderr.on('data', (d) => { err += d; });
+    proc.on('exit', (code) => { children.delete(proc); clearTimeout(timer); rej(new Error(`qem view exited with ${code}: ${err.trim()}`)); });
+  });
+}
+function stopQem(s) { if (s) { s.proc.kill('SIGTERM'); children.delete(s.proc); } }
+
+/// A plain static file server (not qem), to show an export can be hosted anywhere.
+function serveDir(dir) {
+  return new Promise((res) => {
+    const server = createServer((req, resp) => {
+      let p = decodeURIComponent(new URL(req.url, 'http://x').pathname);
+      if (p.endsWith('/')) p += 'index.html';
+      const file = normalize(join(dir, p));
+      if (!file.startsWith(dir) || !existsSync(file)) { resp.writeHead(404); resp.end(); return; }
+      const type = file.endsWith('.html') ? 'text/html' : file.endsWith('.js') ? 'text/javascript'
+        : file.endsWith('.css') ? 'text/css' : file.endsWith('.json') ? 'application/json' : 'application/octet-stream';
+      resp.writeHead(200, { 'Content-Type': type });
+      resp.end(readFileSync(file));
+    });
+    server.listen(0, '127.0.0.1', () => res({ server, url: `http://127.0.0.1:${server.address().port}/` }));
+  });
+}
+
+async function openViewer(browser, url) {
+  const page = await browser.newPage({ viewport: { width: W, height: H } });
+  const errors = [];
+  page.on('pageerror', (e) => errors.push(e.message));
+  await page.goto(url);
+  await page.waitForFunction(() => window.qemViewer && (window.qemViewer.ready || window.qemViewer.error), null, { timeout: 30000 });
+  const error = await page.evaluate(() => window.qemViewer.error);
+  check(!error, `the page reports an error: ${error}`);
+  check(errors.length === 0, `page errors: ${errors.join('; ')}`);
+  return page;
+}
+
+async function shot(page, name) {
+  const path = join(OUT_DIR, `${name}.png`);
+  await page.screenshot({ path });
+  return decodePng(readFileSync(path));
+}
+const text = (page, id) => page.locator(`#${id}`).innerText();
+const canvasStats = (img) => regionStats(img, PANEL_RIGHT, 0, img.width, img.height);
+function differs(a, b) {
+  let n = 0;
+  for (let i = 0; i < a.data.length; i += 4) if (a.data[i] !== b.data[i] || a.data[i + 1] !== b.data[i + 1] || a.data[i + 2] !== b.data[i + 2]) ++n;
+  return n;
+}
+
+const tests = [];
+const test = (name, fn) => tests.push({ name, fn });
+
+test('LOD chain: slider walks the levels, face count and error follow, screenshot not blank', async (ctx) => {
+  const page = await openViewer(ctx.browser, ctx.chain.url);
+  check(await page.locator('#levels').isVisible(), 'the level slider is hidden');
+  check((await text(page, 'face-count')) === '1,280', `faces at level 1: ${await text(page, 'face-count')}`);
+  check((await text(page, 'vertex-count')) === '642', `vertices at level 1: ${await text(page, 'vertex-count')}`);
+  const a = await shot(page, 'chain-level1');
+  const sa = canvasStats(a);
+  check(sa.distinct >= 30, `only ${sa.distinct} distinct colours: blank canvas?`);
+  check(sa.foreground > 0.1 * sa.pixels, `the mesh covers only ${sa.foreground} of ${sa.pixels} pixels`);
+  await page.locator('#level-slider').fill('2');
+  check((await text(page, 'face-count')) === '80', `faces at level 3: ${await text(page, 'face-count')}`);
+  check((await text(page, 'vertex-count')) === '42', `vertices at level 3: ${await text(page, 'vertex-count')}`);
+  check((await text(page, 'error-value')) === '0.0800', `error at level 3: ${await text(page, 'error-value')}`);
+  check((await text(page, 'level-index')) === '3 / 3', `level index: ${await text(page, 'level-index')}`);
+  const b = await shot(page, 'chain-level3');
+  check(canvasStats(b).foreground > 0.1 * sa.pixels, 'level 3 shows nothing');
+  check(differs(a, b) > 1000, 'the picture did not change with the level');
+  await page.locator('#level-slider').fill('1');
+  check((await text(page, 'face-count')) === '320', `faces at level 2: ${await text(page, 'face-count')}`);
+  check((await text(page, 'error-value')) === '0.0200', `error at level 2: ${await text(page, 'error-value')}`);
+  await page.close();
+});
+
+test('shading and wireframe toggles change the picture', async (ctx) => {
+  const page = await openViewer(ctx.browser, ctx.chain.url);
+  await page.locator('#level-slider').fill('1');
+  const flat = await shot(page, 'toggle-flat');
+  await page.locator('#shading-smooth').check();
+  const smooth = await shot(page, 'toggle-smooth');
+  check(differs(flat, smooth) > 1000, 'smooth shading looks like flat shading');
+  await page.locator('#wireframe').check();
+  const wire = await shot(page, 'toggle-wireframe');
+  check(differs(smooth, wire) > 1000, 'the wireframe did not appear');
+  // Dark edge pixels: the wireframe is near-black, the shaded sphere is not.
+  let dark = 0;
+  for (let i = 0; i < wire.data.length; i += 4) if (wire.data[i] + wire.data[i + 1] + wire.data[i + 2] < 200) ++dark;
+  check(dark > 500, `only ${dark} dark (edge) pixels`);
+  await page.close();
+});
+
+test('drag orbits and scroll zooms', async (ctx) => {
+  const page = await openViewer(ctx.browser, ctx.chain.url);
+  await page.locator('#level-slider').fill('2');  // few big faces: a rotation is easy to see
+  const before = await shot(page, 'orbit-before');
+  await page.mouse.move(600, 300);
+  await page.mouse.down();
+  await page.mouse.move(700, 340, { steps: 8 });
+  await page.mouse.up();
+  const after = await shot(page, 'orbit-after');
+  check(differs(before, after) > 1000, 'dragging did not rotate the view');
+  const f0 = canvasStats(after).foreground;
+  await page.mouse.move(600, 300);
+  for (let i = 0; i < 5; ++i) await page.mouse.wheel(0, -200);
+  await page.waitForTimeout(300);  // OrbitControls zooms on the next frames
+  const zoomed = await shot(page, 'zoom-in');
+  const f1 = canvasStats(zoomed).foreground;
+  check(f1 > f0 * 1.2, `zooming in did not enlarge the mesh (${f0} -> ${f1} pixels)`);
+  await page.close();
+});
+
+test('heat map: a mesh with a distance property is coloured, with a legend and a toggle', async (ctx) => {
+  const page = await openViewer(ctx.browser, ctx.heat.url);
+  check(await page.locator('#legend').isVisible(), 'no legend');
+  check(await page.locator('#heatmap-toggle').isVisible(), 'no heat map toggle');
+  check(!(await page.locator('#levels').isVisible()), 'a single mesh shows a level slider');
+  const legendMax = await text(page, 'legend-max');
+  check(legendMax === '1.00', `legend max ${legendMax}, expected 1.00`);
+  const on = await shot(page, 'heatmap-on');
+  const son = regionStats(on, PANEL_RIGHT, 0, W - 80, H);
+  check(son.saturated > 0.05 * son.pixels, `only ${son.saturated} coloured pixels with the heat map on`);
+  await page.locator('#heatmap').uncheck();
+  check(!(await page.locator('#legend').isVisible()), 'the legend stays when the heat map is off');
+  const off = await shot(page, 'heatmap-off');
+  const soff = regionStats(off, PANEL_RIGHT, 0, W - 80, H);
+  check(soff.saturated < son.saturated / 10, `still ${soff.saturated} coloured pixels with the heat map off`);
+  await page.close();
+});
+
+test('compare: original and simplified side by side, both drawn, labelled with their counts', async (ctx) => {
+  const page = await openViewer(ctx.browser, ctx.compare.url);
+  const l0 = await text(page, 'label-0'), l1 = await text(page, 'label-1');
+  check(l0.includes('1,280 faces') && l0.includes('Original'), `left label: ${l0}`);
+  check(l1.includes('80 faces') && l1.includes('Simplified'), `right label: ${l1}`);
+  check((await text(page, 'face-count')) === '80', 'the panel does not describe the simplified mesh');
+  check(!(await page.locator('#levels').isVisible()), 'compare mode shows a level slider');
+  const img = await shot(page, 'compare');
+  const left = regionStats(img, PANEL_RIGHT, 60, W / 2, H), right = regionStats(img, W / 2, 60, W, H);
+  check(left.foreground > 0.05 * left.pixels, `left half nearly empty (${left.foreground} pixels)`);
+  check(right.foreground > 0.05 * right.pixels, `right half nearly empty (${right.foreground} pixels)`);
+  // Linked cameras: one drag turns both meshes.
+  await page.mouse.move(W * 0.75, H / 2);
+  await page.mouse.down();
+  await page.mouse.move(W * 0.75 + 120, H / 2 + 30, { steps: 8 });
+  await page.mouse.up();
+  const img2 = await shot(page, 'compare-orbit');
+  const changedLeft = differs({ data: img.data.subarray(0, img.data.length) }, { data: img2.data });
+  check(changedLeft > 1000, 'the drag did not change the view');
+  let leftChanged = 0;
+  for (let y = 60; y < H; ++y) for (let x = PANEL_RIGHT; x < W / 2; ++x) { const o = (y * W + x) * 4; if (img.data[o] !== img2.data[o]) ++leftChanged; }
+  check(leftChanged > 500, 'dragging on the right did not turn the left view: cameras not linked');
+  await page.close();
+});
+
+test('static export: qem view --export writes a page that any HTTP server can host', async (ctx) => {
+  const dir = mkdtempSync(join(tmpdir(), 'qem-export-'));
+  try {
+    const r = spawnSync(QEM, ['view', 'chain.json', '--export', dir], { cwd: MESH_DIR, encoding: 'utf8' });
+    check(r.status === 0, `qem view --export failed: ${r.stderr}`);
+    for (const f of ['index.html', 'app.js', 'style.css', 'data/scene.json', 'data/level0.pos.f32', 'data/level2.idx.u32'])
+      check(existsSync(join(dir, f)), `${f} missing from the export`);
+    const scene = JSON.parse(readFileSync(join(dir, 'data/scene.json'), 'utf8'));
+    check(scene.levels.map((l) => l.faces).join() === '1280,320,80', `levels ${scene.levels.map((l) => l.faces)}`);
+    const { server, url } = await serveDir(dir);
+    try {
+      const page = await openViewer(ctx.browser, url);
+      check((await text(page, 'face-count')) === '1,280', 'wrong face count from the export');
+      const s = canvasStats(await shot(page, 'export'));
+      check(s.distinct >= 30 && s.foreground > 0.1 * s.pixels, 'the exported page shows nothing');
+      await page.close();
+    } finally { server.close(); }
+  } finally { rmSync(dir, { recursive: true, force: true }); }
+});
+
+test('several meshes on the command line form a chain; errors are measured when not given', async (ctx) => {
+  const s = await startQem(['sphere_l3.obj', 'sphere_l2.obj', 'sphere_l1.obj', '--chain']);
+  try {
+    const page = await openViewer(ctx.browser, s.url);
+    check((await text(page, 'error-value')) === '0', `level 1 error ${await text(page, 'error-value')}`);
+    await page.locator('#level-slider').fill('2');
+    const e = Number(await text(page, 'error-value'));
+    // Icosphere level 1 vs level 3 (unit sphere): the Hausdorff distance is about 0.1.
+    check(e > 0.03 && e < 0.3, `measured error ${e} out of the plausible range`);
+    await page.close();
+  } finally { stopQem(s); }
+});
+
+async function run() {
+  for (const [bin, what] of [[QEM, 'the qem binary (build it first)'], [CHROMIUM, 'Chromium (scripts/install-web-deps.sh)']])
+    if (!existsSync(bin)) { console.log(`not ok - ${what} not found at ${bin}`); console.log('0 passed, 1 failed'); process.exit(1); }
+  const ctx = {};
+  const userDataDir = mkdtempSync(join(tmpdir(), 'qem-chromium-'));
+  let browser;
+  try {
+    [ctx.chain, ctx.heat, ctx.compare] = await Promise.all([
+      startQem(['chain.json']), startQem(['sphere_distance.ply']), startQem(['--compare', 'sphere_l3.obj', 'sphere_l1.obj']),
+    ]);
+    const context = await chromium.launchPersistentContext(userDataDir, {
+      executablePath: CHROMIUM,
+      headless: true,
+      viewport: { width: W, height: H },
+      args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
+        '--disable-component-update', '--disable-sync', '--enable-unsafe-swiftshader'],
+    });
+    browser = context;
+    ctx.browser = context;
+    for (const t of tests) {
+      try {
+        await t.fn(ctx);
+        ++passed;
+        console.log(`ok - ${t.name}`);
+      } catch (e) {
+        ++failed;
+        console.log(`not ok - ${t.name}: ${e.message.split('\n')[0]}`);
+      }
+    }
+  } catch (e) {
+    ++failed;
+    console.log(`not ok - setup: ${e.message.split('\n')[0]}`);
+  } finally {
+    if (browser) await browser.close().catch(() => {});
+    for (const s of [ctx.chain, ctx.heat, ctx.compare]) stopQem(s);
+    rmSync(userDataDir, { recursive: true, force: true });
+  }
+  console.log(`screenshots in ${OUT_DIR}`);
+  console.log(`${passed} passed, ${failed} failed`);
+  process.exit(failed ? 1 : 0);
+}
+
+run();
