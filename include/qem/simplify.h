@@ -7,6 +7,7 @@
 #include <functional>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "qem/mesh.h"
 
@@ -42,6 +43,23 @@ const char* to_string(StopReason reason);
 const char* to_string(Weighting w);
 const char* to_string(Placement p);
 
+/// The whole contraction sequence of one run (GH97 §3: M_n, M_n-1, ..., M_g), in input vertex and
+/// face indices, so that any intermediate mesh can be rebuilt (see qem/progressive.h).
+struct ContractionLog {
+  /// Input faces the run started from (degenerate and duplicate input faces are not among them).
+  std::vector<std::uint32_t> initial_faces;
+  // One entry per contraction, in order:
+  std::vector<std::uint32_t> kept;     ///< input vertex that survives
+  std::vector<std::uint32_t> removed;  ///< input vertex merged into `kept`
+  std::vector<double> position;        ///< 3 per contraction: where `kept` went (output coordinates)
+  std::vector<double> error;           ///< contraction error, distance units
+  /// Input faces that died in contraction i: dead_faces[dead_begin[i] .. dead_begin[i+1]).
+  std::vector<std::uint32_t> dead_begin{0};
+  std::vector<std::uint32_t> dead_faces;
+
+  std::size_t size() const { return kept.size(); }
+};
+
 struct SimplifyOptions {
   // --- stop criteria: any combination, the first reached wins -----------------------------------
   std::size_t target_faces = 0;     ///< stop at or below this many faces (0 = no face target)
@@ -66,6 +84,9 @@ struct SimplifyOptions {
   double max_normal_turn_degrees = 75;
   /// Refuse edge collapses that break the link condition (non-manifold edges, duplicate faces).
   bool preserve_topology = true;
+
+  /// If set, every contraction is appended to this log (cleared first).
+  ContractionLog* record = nullptr;
 
   /// Called every so often with the fraction done (0..1); return false to cancel.
   std::function<bool(double)> progress;

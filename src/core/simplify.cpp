@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <string>
 
@@ -61,6 +62,17 @@ namespace {
 using namespace core;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
+// Heap keys keep 32 significant bits. The same model scaled or moved gives costs that differ only
+// by rounding noise (~1e-16 relative); truncated, they tie, ties break on the pair id, and the
+// contraction order (and so the output) does not depend on the model's scale or position.
+double round_key(double cost) {
+  std::uint64_t bits;
+  std::memcpy(&bits, &cost, sizeof bits);
+  bits &= ~((std::uint64_t(1) << 20) - 1);
+  std::memcpy(&cost, &bits, sizeof bits);
+  return cost;
+}
+
 enum PairState : std::uint8_t {
   kInHeap,   // candidate, keyed in the heap
   kBlocked,  // rejected at its last check (topology, inversion, error limit); retried when its
@@ -91,6 +103,8 @@ class Simplifier {
   bool placement_for(std::uint32_t p, Quadric& q, Placed& placed);
   void contract(std::uint32_t p, const Quadric& q, const Vec3& target);
   void block(std::uint32_t p);
+  void record_contraction(double error);
+  bool kill_if_coincident(std::uint32_t f, std::size_t own);
   void unblock_around(std::uint32_t v);
   bool done() const { return faces_alive_ <= target_faces_ || vertices_alive_ <= target_vertices_; }
   double normalized_error(double q_error, double weight) const {
@@ -99,6 +113,7 @@ class Simplifier {
   void kill_face(std::uint32_t f) {
     face_alive_[f] = 0;
     --faces_alive_;
+    if (opt_.record) opt_.record->dead_faces.push_back(face_source_[f]);
   }
   bool face_has(std::uint32_t f, std::uint32_t v) const {
     const std::uint32_t* t = &tri_[3 * std::size_t(f)];
@@ -111,6 +126,12 @@ class Simplifier {
     return cross(p1 - p0, p2 - p0);
   }
   SimplifyResult build_output();
+  /// A vertex's position in the input frame: exact input coordinates if it never moved.
+  Vec3 output_position(std::uint32_t v) const {
+    if (moved_[v]) return pos_[v] * scale_ + center_;
+    const double* p = &in_.positions[3 * std::size_t(source_vertex_[v])];
+    return {p[0], p[1], p[2]};
+  }
 
   MeshView in_;
   const SimplifyOptions& opt_;
@@ -154,6 +175,7 @@ class Simplifier {
   std::size_t dropped_degenerate_ = 0, dropped_duplicate_ = 0;
   std::size_t blocked_by_error_ = 0, blocked_by_topology_ = 0, blocked_by_inversion_ = 0;
   std::size_t virtual_pairs_ = 0;
+  std::uint32_t last_kept_ = 0, last_removed_ = 0;
 
   SimplifyResult result_;
 };
@@ -416,6 +438,7 @@ bool Simplifier::pair_cost(std::uint32_t p, double& cost) {
   cost = placed.error;
   if (opt_.inversion == InversionPolicy::Penalize && flips(pairs_[p].v[0], pairs_[p].v[1], placed.position))
     cost += q.weight > 0 ? q.weight : 1;  // as if moved by a whole diagonal
+  cost = round_key(cost);
   return true;
 }
 
@@ -501,6 +524,37 @@ bool Simplifier::is_edge_and_link_ok(std::uint32_t a, std::uint32_t b, bool& is_
   return true;
 }
 
+// Face f (now on a) against a's own faces scratch_[0..own): on the same three vertices with the
+// same orientation it is a duplicate and dies; with the opposite orientation the two are the
+// touching walls of two aggregated parts (GH97 §3.2, Fig. 3) and both die, like glued faces.
+bool Simplifier::kill_if_coincident(std::uint32_t f, std::size_t own) {
+  const std::uint32_t* t = &tri_[3 * std::size_t(f)];
+  for (std::size_t i = 0; i < own; ++i) {
+    const std::uint32_t g = scratch_[i];
+    if (!face_alive_[g] || !(face_has(g, t[0]) && face_has(g, t[1]) && face_has(g, t[2]))) continue;
+    const std::uint32_t* u = &tri_[3 * std::size_t(g)];
+    int k = 0;
+    while (u[k] != t[0]) ++k;
+    const bool same_orientation = u[(k + 1) % 3] == t[1];
+    kill_face(f);
+    if (!same_orientation) kill_face(g);
+    return true;
+  }
+  return false;
+}
+
+// Appends the contraction just made to the log; `last_kept_` / `last_removed_` are set by
+// contract(), the dead faces were appended by kill_face().
+void Simplifier::record_contraction(double error) {
+  ContractionLog& log = *opt_.record;
+  log.kept.push_back(source_vertex_[last_kept_]);
+  log.removed.push_back(source_vertex_[last_removed_]);
+  const Vec3 p = output_position(last_kept_);
+  log.position.insert(log.position.end(), {p.x, p.y, p.z});
+  log.error.push_back(error);
+  log.dead_begin.push_back(std::uint32_t(log.dead_faces.size()));
+}
+
 void Simplifier::block(std::uint32_t p) {
   pairs_[p].state = kBlocked;
   has_blocked_[pairs_[p].v[0]] = has_blocked_[pairs_[p].v[1]] = 1;
@@ -523,11 +577,16 @@ void Simplifier::unblock_around(std::uint32_t v) {
 // ---------------------------------------------------------------------------------------------
 
 void Simplifier::contract(std::uint32_t p, const Quadric& q, const Vec3& target) {
-  const std::uint32_t a = pairs_[p].v[0], b = pairs_[p].v[1];
+  std::uint32_t a = pairs_[p].v[0], b = pairs_[p].v[1];
+  // When the target is one of the ends (endpoint placement, a locked border vertex), that end
+  // survives, so its exact input coordinates reach the output untouched.
+  const auto same = [](const Vec3& x, const Vec3& y) { return x.x == y.x && x.y == y.y && x.z == y.z; };
+  if (same(target, pos_[b]) && !same(target, pos_[a])) std::swap(a, b);
+  moved_[a] |= !same(target, pos_[a]);
+  last_kept_ = a, last_removed_ = b;
   pos_[a] = target;
   quadric_[a] = q;
   boundary_[a] |= boundary_[b];
-  moved_[a] = 1;
   --vertices_alive_;
 
   // Faces: those containing both ends degenerate and die; b's others now use a. Where the
@@ -549,18 +608,14 @@ void Simplifier::contract(std::uint32_t p, const Quadric& q, const Vec3& target)
     std::uint32_t* t = &tri_[3 * std::size_t(f)];
     for (int k = 0; k < 3; ++k)
       if (t[k] == b) t[k] = a;
-    if (may_duplicate) {
-      bool duplicate = false;
-      for (std::size_t i = 0; i < own && !duplicate; ++i) {
-        const std::uint32_t g = scratch_[i];
-        duplicate = face_has(g, t[0]) && face_has(g, t[1]) && face_has(g, t[2]);
-      }
-      if (duplicate) {
-        kill_face(f);
-        continue;
-      }
-    }
+    if (may_duplicate && kill_if_coincident(f, own)) continue;
     scratch_.push_back(f);
+  }
+  if (may_duplicate) {  // drop the partners that cancelled
+    std::size_t kept = 0;
+    for (std::uint32_t f : scratch_)
+      if (face_alive_[f]) scratch_[kept++] = f;
+    scratch_.resize(kept);
   }
   vertex_faces_.assign(a, scratch_.data(), scratch_.size(), b);
   vertex_faces_.clear(b);
@@ -603,6 +658,12 @@ void Simplifier::contract(std::uint32_t p, const Quadric& q, const Vec3& target)
 SimplifyResult Simplifier::run() {
   prepare_input();
   resolve_targets();
+  if (opt_.record) {
+    *opt_.record = ContractionLog{};
+    opt_.record->initial_faces = face_source_;
+    std::sort(opt_.record->initial_faces.begin(), opt_.record->initial_faces.end());
+  }
+
   if (done()) {
     result_.stop_reason = StopReason::AlreadyBelowTarget;
     result_.stop_detail = "the input already meets the target";
@@ -677,6 +738,7 @@ SimplifyResult Simplifier::run() {
     max_error_norm_done = std::max(max_error_norm_done, err);
     contract(p, q, placed.position);
     ++result_.contractions;
+    if (opt_.record) record_contraction(err * scale_);
   }
   if (opt_.progress && result_.stop_reason != StopReason::Cancelled) opt_.progress(1.0);
 
@@ -721,13 +783,8 @@ SimplifyResult Simplifier::build_output() {
   out.positions.reserve(3 * survivors.size());
   for (std::uint32_t v : survivors) {
     remap[v] = std::uint32_t(out.positions.size() / 3);
-    if (moved_[v]) {
-      const Vec3 p = pos_[v] * scale_ + center_;
-      out.positions.insert(out.positions.end(), {p.x, p.y, p.z});
-    } else {  // exact input coordinates for vertices that never moved
-      const double* p = &in_.positions[3 * std::size_t(source_vertex_[v])];
-      out.positions.insert(out.positions.end(), p, p + 3);
-    }
+    const Vec3 p = output_position(v);
+    out.positions.insert(out.positions.end(), {p.x, p.y, p.z});
   }
   out.indices.reserve(3 * faces.size());
   for (std::uint32_t f : faces)
