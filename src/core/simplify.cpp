@@ -365,7 +365,8 @@ void Simplifier::select_pairs() {
     double t = opt_.threshold_is_relative ? opt_.threshold : opt_.threshold / scale_;
     std::vector<std::uint32_t> candidates;
     for (std::uint32_t v = 0; v < pos_.size(); ++v) candidates.push_back(v);
-    virtual_pairs = close_pairs(pos_, candidates, t, edges, std::max<std::size_t>(4 * candidates.size(), 1000));
+    // At most 8 pairs a vertex on average (GH97 §3.2 warns that a large t creates O(n^2) pairs).
+    virtual_pairs = close_pairs(pos_, candidates, t, edges, std::max<std::size_t>(8 * candidates.size(), 100000));
   }
   virtual_pairs_ = virtual_pairs.size();
 

@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Installs qem from the build tree into a temporary prefix, builds examples/hello_qem against it
+# with find_package(qem), and runs it on a generated mesh: the README's library example works.
+set -euo pipefail
+build_dir=$1 source_dir=$2
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+cmake --install "$build_dir" --prefix "$work/prefix" >/dev/null
+cmake -S "$source_dir/examples/hello_qem" -B "$work/build" -DCMAKE_PREFIX_PATH="$work/prefix" \
+  -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build "$work/build" >/dev/null
+"$work/prefix/bin/qem" generate sphere "$work/in.ply" --faces 5000 2>/dev/null
+out=$("$work/build/hello_qem" "$work/in.ply" "$work/out.obj")
+echo "$out"
+[[ "$out" == "5120 -> 512 faces"* ]]
+[ -s "$work/out.obj" ]
