@@ -10,6 +10,7 @@
 #include "command.h"
 #include "qem/error.h"
 #include "qem/io.h"
+#include "qem/progressive.h"
 #include "qem/simplify.h"
 
 namespace qem::cli {
@@ -27,6 +28,7 @@ struct SimplifyArgs {
   bool lock_border = false, allow_non_manifold = false;
   bool weld = false, no_weld = false, ascii = false;
   bool json = false, quiet = false, force = false;
+  std::string record;  // --record: the contraction sequence (docs/record-format.md)
 };
 
 int run_simplify(const SimplifyArgs& a) {
@@ -79,6 +81,8 @@ int run_simplify(const SimplifyArgs& a) {
 
   Stopwatch t_simplify;
   const double cpu0 = process_cpu_seconds();
+  ContractionLog log;
+  if (!a.record.empty()) opt.record = &log;
   SimplifyResult r = simplify(mesh, opt);
   const double simplify_s = t_simplify.seconds();
   const double simplify_cpu_s = process_cpu_seconds() - cpu0;
@@ -88,6 +92,7 @@ int run_simplify(const SimplifyArgs& a) {
   SaveOptions save;
   save.binary = !a.ascii;
   save_mesh(a.output, r.mesh, save);
+  if (!a.record.empty()) write_record(a.record, make_record(mesh, log));  // atomic, like save_mesh
   const double write_s = t_write.seconds();
 
   if (a.json) {
@@ -151,6 +156,9 @@ const bool registered = register_command(10, [](CLI::App& app) {
   sub->add_flag("--json", args->json, "Print one JSON line with counts, timings, memory and error on stdout");
   sub->add_flag("--quiet,-q", args->quiet, "No progress and no summary on stderr");
   sub->add_flag("--force", args->force, "Allow the output to overwrite the input file");
+  sub->add_option("--record", args->record,
+                  "Also write the contraction sequence to this file, so `qem replay` / `qem lod` can rebuild "
+                  "any face count between the output's and the input's (docs/record-format.md)");
   return [args] { return run_simplify(*args); };
 });
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <unistd.h>
@@ -102,6 +103,11 @@ std::string temp_dir() {
     auto p = std::filesystem::temp_directory_path() / ("qem_tests_" + std::to_string(::getpid()));
     std::filesystem::remove_all(p);
     std::filesystem::create_directories(p);
+    std::atexit([] {  // each test process removes its own folder
+      std::error_code ec;
+      std::filesystem::remove_all(
+          std::filesystem::temp_directory_path() / ("qem_tests_" + std::to_string(::getpid())), ec);
+    });
     return p.string();
   }();
   return dir;

@@ -1,0 +1,197 @@
+// `qem lod INPUT OUTDIR --ratios 0.5,0.25,0.1`: an LOD chain from ONE simplification (GH97 §3:
+// a single run yields M_n ... M_g). The run goes to the coarsest level with a contraction record;
+// every level is then a prefix of that record, rebuilt in one pass, and each file is
+// byte-identical to `qem simplify INPUT FILE --faces <level target>` with the same options.
+// Writes the levels and a manifest.json that `qem view` shows as a chain with a slider.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cli_util.h"
+#include "command.h"
+#include "io/io_common.h"
+#include "qem/error.h"
+#include "qem/io.h"
+#include "qem/progressive.h"
+#include "qem/simplify.h"
+
+namespace qem::cli {
+namespace {
+
+struct LodArgs {
+  std::string input, outdir, format = "ply", name;
+  std::vector<double> ratios;
+  std::vector<std::size_t> faces;
+  double threshold = 0, threshold_rel = 0;
+  std::string weighting = "area", placement = "optimal", inversion = "forbid";
+  double boundary_weight = 1;
+  double max_turn = 75;
+  bool lock_border = false, allow_non_manifold = false;
+  bool weld = false, no_weld = false, ascii = false;
+  bool json = false, quiet = false;
+};
+
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (unsigned char c : s) {
+    if (c == '"' || c == '\\') out += '\\', out += char(c);
+    else if (c < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", c);
+      out += buf;
+    } else out += char(c);
+  }
+  return out + "\"";
+}
+
+SimplifyOptions simplify_options(const LodArgs& a) {
+  static const std::map<std::string, Weighting> weightings{
+      {"area", Weighting::Area}, {"uniform", Weighting::Uniform}, {"angle", Weighting::Angle}};
+  static const std::map<std::string, Placement> placements{{"optimal", Placement::Optimal},
+                                                           {"segment", Placement::Segment},
+                                                           {"midpoint", Placement::Midpoint},
+                                                           {"endpoints", Placement::Endpoints}};
+  static const std::map<std::string, InversionPolicy> inversions{
+      {"forbid", InversionPolicy::Forbid}, {"penalize", InversionPolicy::Penalize}, {"off", InversionPolicy::Ignore}};
+  SimplifyOptions opt;
+  if (a.threshold_rel > 0) opt.threshold = a.threshold_rel, opt.threshold_is_relative = true;
+  else opt.threshold = a.threshold;
+  opt.weighting = weightings.at(a.weighting);
+  opt.placement = placements.at(a.placement);
+  opt.inversion = inversions.at(a.inversion);
+  opt.boundary_weight = a.boundary_weight;
+  opt.max_normal_turn_degrees = a.max_turn;
+  opt.lock_border = a.lock_border;
+  opt.preserve_topology = !a.allow_non_manifold;
+  return opt;
+}
+
+int run_lod(const LodArgs& a) {
+  if (a.ratios.empty() == a.faces.empty()) throw Error("give the levels with either --ratios or --faces");
+  for (double r : a.ratios)
+    if (!(r > 0 && r <= 1)) throw Error("--ratios: every ratio must be in (0, 1], got " + json_number(r));
+  for (std::size_t f : a.faces)
+    if (f == 0) throw Error("--faces: every face count must be positive");
+  Stopwatch total;
+  const double cpu_start = process_cpu_seconds();
+
+  LoadOptions load;
+  if (a.weld) load.weld = Weld::On;
+  if (a.no_weld) load.weld = Weld::Off;
+  Mesh mesh = load_mesh(a.input, load);
+
+  // One run to the coarsest level, recorded. Ratios are taken of the faces the run starts from
+  // (degenerate and duplicate input faces dropped), exactly as `qem simplify --ratio` does.
+  SimplifyOptions opt = simplify_options(a);
+  ContractionLog log;
+  opt.record = &log;
+  if (!a.faces.empty()) opt.target_faces = *std::min_element(a.faces.begin(), a.faces.end());
+  else opt.target_ratio = *std::min_element(a.ratios.begin(), a.ratios.end());
+  const double cpu_simplify0 = process_cpu_seconds();
+  const SimplifyResult result = simplify(mesh, opt);
+  const double simplify_cpu = process_cpu_seconds() - cpu_simplify0;
+  const double cpu_replay0 = process_cpu_seconds();
+  const Record record = make_record(mesh, log);
+  std::vector<std::size_t> targets = a.faces;
+  for (double r : a.ratios) targets.push_back(std::size_t(std::floor(r * double(record.base.face_count()))));
+  std::sort(targets.begin(), targets.end(), std::greater<>());  // finest first, as the manifest lists them
+  targets.erase(std::unique(targets.begin(), targets.end()), targets.end());
+  std::vector<ReplayLevel> levels = replay_levels(record, targets);
+  const double replay_cpu = process_cpu_seconds() - cpu_replay0;
+
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(a.outdir, ec);
+  if (ec) throw Error(a.outdir + ": cannot create the folder: " + ec.message());
+  const std::string stem = a.name.empty() ? fs::path(a.input).stem().string() : a.name;
+  SaveOptions save;
+  save.binary = !a.ascii;
+  save.format = format_from_extension("x." + a.format);
+  const double cpu_write0 = process_cpu_seconds();
+  std::string manifest = "{\n  \"generator\": \"qem lod\",\n  \"source\": " +
+                         json_string(fs::path(a.input).filename().string()) +
+                         ",\n  \"input_faces\": " + std::to_string(record.base.face_count()) +
+                         ",\n  \"input_vertices\": " + std::to_string(record.base.vertex_count()) +
+                         ",\n  \"levels\": [\n";
+  for (std::size_t i = 0; i < levels.size(); ++i) {
+    const ReplayLevel& l = levels[i];
+    const std::string file = stem + "_lod" + std::to_string(i) + "." + a.format;
+    save_mesh((fs::path(a.outdir) / file).string(), l.mesh, save);
+    manifest += "    {\"path\": " + json_string(file) + ", \"faces\": " + std::to_string(l.mesh.face_count()) +
+                ", \"vertices\": " + std::to_string(l.mesh.vertex_count()) + ", \"error\": " +
+                json_number(l.max_error) + ", \"target_faces\": " + std::to_string(l.target_faces) +
+                ", \"contractions\": " + std::to_string(l.contractions) + "}" +
+                (i + 1 < levels.size() ? ",\n" : "\n");
+  }
+  manifest += "  ]\n}\n";
+  io::write_file_atomic((fs::path(a.outdir) / "manifest.json").string(), manifest);
+  const double write_cpu = process_cpu_seconds() - cpu_write0;
+
+  if (a.json)
+    std::printf("{\"tool\":\"qem lod\",\"in_faces\":%zu,\"levels\":%zu,\"simplify_cpu_s\":%s,\"replay_cpu_s\":%s,"
+                "\"write_cpu_s\":%s,\"cpu_s\":%s,\"total_s\":%s,\"peak_rss_mb\":%s}\n",
+                record.base.face_count(), levels.size(), json_number(simplify_cpu).c_str(),
+                json_number(replay_cpu).c_str(), json_number(write_cpu).c_str(),
+                json_number(process_cpu_seconds() - cpu_start).c_str(), json_number(total.seconds()).c_str(),
+                json_number(peak_rss_mb()).c_str());
+  if (!a.quiet) {
+    for (const ReplayLevel& l : levels)
+      std::fprintf(stderr, "qem: level %zu faces, %zu vertices, max error %.4g\n", l.mesh.face_count(),
+                   l.mesh.vertex_count(), l.max_error);
+    std::fprintf(stderr, "qem: %zu levels from one run (%s), simplify %.3f s + replay %.3f s CPU, %.3f s total\n",
+                 levels.size(), result.stop_detail.c_str(), simplify_cpu, replay_cpu, total.seconds());
+  }
+  return 0;
+}
+
+const bool registered = register_command(13, [](CLI::App& app) {
+  auto args = std::make_shared<LodArgs>();
+  CLI::App* sub = app.add_subcommand(
+      "lod", "Write an LOD chain from a single recorded simplification, with a manifest for `qem view`");
+  sub->add_option("input", args->input, "Input mesh (.obj .ply .stl .off)")->required();
+  sub->add_option("outdir", args->outdir, "Folder for the levels and manifest.json (created if needed)")->required();
+  auto* ratios = sub->add_option("--ratios", args->ratios,
+                                 "Levels as fractions of the input faces, comma separated (e.g. 0.5,0.25,0.1)")
+                     ->delimiter(',');
+  sub->add_option("--faces,-f", args->faces, "Levels as face counts, comma separated (e.g. 50000,10000,1000)")
+      ->delimiter(',')
+      ->excludes(ratios);
+  sub->add_option("--format", args->format, "File format of the levels")
+      ->check(CLI::IsMember({"ply", "obj", "stl", "off"}))
+      ->capture_default_str();
+  sub->add_option("--name", args->name, "File name stem of the levels: <name>_lod<i>.<ext> (default: input's stem)");
+  sub->add_option("--threshold,-t", args->threshold,
+                  "Pair threshold t of GH97 3.2 (model units): vertices closer than t are valid pairs");
+  sub->add_option("--threshold-rel", args->threshold_rel, "As --threshold, relative to the bounding-box diagonal");
+  sub->add_option("--weighting", args->weighting, "Plane weighting: area (HG99), uniform (GH97), angle")
+      ->check(CLI::IsMember({"area", "uniform", "angle"}))
+      ->capture_default_str();
+  sub->add_option("--placement", args->placement, "Where the new vertex goes: optimal, segment, midpoint, endpoints")
+      ->check(CLI::IsMember({"optimal", "segment", "midpoint", "endpoints"}))
+      ->capture_default_str();
+  sub->add_option("--boundary-weight", args->boundary_weight,
+                  "Penalty weight of the boundary constraint planes (GH97 6); 0 = off")
+      ->capture_default_str();
+  sub->add_flag("--lock-border", args->lock_border, "Boundary vertices never move");
+  sub->add_option("--inversion", args->inversion, "Contractions that flip a face: forbid, penalize, or off (GH97 6)")
+      ->check(CLI::IsMember({"forbid", "penalize", "off"}))
+      ->capture_default_str();
+  sub->add_option("--max-turn", args->max_turn, "A face normal turning by more than this (degrees, < 90) is a flip")
+      ->capture_default_str();
+  sub->add_flag("--allow-non-manifold", args->allow_non_manifold,
+                "Do not check the link condition: edge collapses may create non-manifold edges");
+  sub->add_flag("--weld", args->weld, "Merge exactly coincident vertices on load (default for STL)");
+  sub->add_flag("--no-weld", args->no_weld, "Never weld on load, not even STL");
+  sub->add_flag("--ascii", args->ascii, "Write PLY / STL as text instead of binary");
+  sub->add_flag("--json", args->json, "Print one JSON line with CPU timings and memory on stdout");
+  sub->add_flag("--quiet,-q", args->quiet, "No summary on stderr");
+  return [args] { return run_lod(*args); };
+});
+
+}  // namespace
+}  // namespace qem::cli

@@ -1,0 +1,122 @@
+// `qem simplify` as a user runs it: JSON line, summary, exit codes, nothing lost on failure.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "qem/io.h"
+#include "test_meshes.h"
+
+using namespace qem;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct CliRun {
+  int exit_code;
+  std::string out;  // stdout and stderr together
+};
+
+CliRun run(const std::string& args) {
+  std::string cmd = std::string(QEM_CLI_PATH) + " " + args + " 2>&1";
+  CliRun r{-1, {}};
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return r;
+  std::array<char, 4096> buf;
+  while (std::size_t n = std::fread(buf.data(), 1, buf.size(), pipe)) r.out.append(buf.data(), n);
+  int status = pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+std::string sphere_file() {
+  static std::string path = [] {
+    std::string p = test::temp_dir() + "/cli_sphere.ply";
+    save_mesh(p, test::icosphere(4));
+    return p;
+  }();
+  return path;
+}
+
+TEST(CliSimplify, JsonLineHasTheHarnessFields) {
+  const std::string out = test::temp_dir() + "/cli_out.ply";
+  CliRun r = run("simplify " + sphere_file() + " " + out + " --faces 500 --json --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  for (const char* field : {"\"tool\":\"qem\"", "\"in_faces\":5120", "\"out_faces\":500", "\"out_vertices\":",
+                            "\"load_s\":", "\"simplify_s\":", "\"write_s\":", "\"peak_rss_mb\":", "\"max_error\":"})
+    EXPECT_NE(r.out.find(field), std::string::npos) << field << " missing in " << r.out;
+  EXPECT_EQ(load_mesh(out).face_count(), 500u);
+}
+
+TEST(CliSimplify, SummaryLineSaysWhyItStopped) {
+  const std::string out = test::temp_dir() + "/cli_tetra.obj";
+  save_mesh(test::temp_dir() + "/tetra.obj", test::tetrahedron());
+  CliRun r = run("simplify " + test::temp_dir() + "/tetra.obj " + out + " --faces 1");
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("no valid contraction left"), std::string::npos) << r.out;
+}
+
+TEST(CliSimplify, SameOutputBytesTwice) {
+  const std::string a = test::temp_dir() + "/cli_a.ply", b = test::temp_dir() + "/cli_b.ply";
+  ASSERT_EQ(run("simplify " + sphere_file() + " " + a + " --ratio 0.2 -q").exit_code, 0);
+  ASSERT_EQ(run("simplify " + sphere_file() + " " + b + " --ratio 0.2 -q").exit_code, 0);
+  EXPECT_EQ(slurp(a), slurp(b));
+}
+
+TEST(CliSimplify, RefusesToOverwriteTheInput) {
+  const std::string in = test::temp_dir() + "/cli_keep.ply";
+  fs::copy_file(sphere_file(), in, fs::copy_options::overwrite_existing);
+  const std::string before = slurp(in);
+  CliRun r = run("simplify " + in + " " + in + " --faces 100");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.out.find("--force"), std::string::npos) << r.out;
+  EXPECT_EQ(slurp(in), before);
+  EXPECT_EQ(run("simplify " + in + " " + in + " --faces 100 --force -q").exit_code, 0);
+  EXPECT_EQ(load_mesh(in).face_count(), 100u);
+}
+
+TEST(CliSimplify, FailedRunLeavesNoOutputAndNamesTheProblem) {
+  const std::string bad = test::temp_dir() + "/cli_bad.obj";
+  std::ofstream(bad) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n";
+  const std::string out = test::temp_dir() + "/cli_never.ply";
+  CliRun r = run("simplify " + bad + " " + out + " --faces 1");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.out.find("cli_bad.obj"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("line 4"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(out));
+  // No leftover temporary files beside the target either.
+  for (const auto& e : fs::directory_iterator(test::temp_dir()))
+    EXPECT_EQ(e.path().filename().string().find("cli_never"), std::string::npos) << e.path();
+}
+
+TEST(CliSimplify, BadOptionsAreRejected) {
+  const std::string out = test::temp_dir() + "/cli_opt.ply";
+  EXPECT_NE(run("simplify " + sphere_file() + " " + out).exit_code, 0);  // no target
+  EXPECT_NE(run("simplify " + sphere_file() + " " + out + " --faces 10 --placement best").exit_code, 0);
+  EXPECT_NE(run("simplify " + sphere_file() + " " + out + " --ratio 1.5").exit_code, 0);
+  EXPECT_NE(run("simplify " + sphere_file() + " " + out + " --faces 10 --max-turn 120").exit_code, 0);
+  EXPECT_NE(run("simplify /nonexistent/x.ply " + out + " --faces 10").exit_code, 0);
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(CliSimplify, HelpDocumentsEveryOption) {
+  CliRun r = run("simplify --help");
+  EXPECT_EQ(r.exit_code, 0);
+  for (const char* opt : {"--faces", "--ratio", "--vertices", "--max-error", "--max-error-rel", "--threshold",
+                          "--threshold-rel", "--weighting", "--placement", "--boundary-weight", "--lock-border",
+                          "--inversion", "--max-turn", "--allow-non-manifold", "--weld", "--json", "--quiet",
+                          "--force"})
+    EXPECT_NE(r.out.find(opt), std::string::npos) << opt;
+}
+
+}  // namespace
