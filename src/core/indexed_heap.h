@@ -2,8 +2,9 @@
 // keyed on cost" of GH97 §4. Indexed rather than lazy, so memory stays at 16 + 4 bytes per pair
 // however many times costs change. Each entry carries its key, so sifting touches only the heap
 // array (no indirection into a cost array: that was the simplifier's main source of cache misses).
-// Ties break on the id, so the order of contractions is fully determined by the input. Four
-// children of 16 bytes fill one 64-byte cache line, and the tree is half as deep as a binary one:
+// Keys are floats: callers round costs to float precision (24 significant bits) before use, so
+// a key compares exactly with the cost it came from. Ties break on the id, so the order of
+// contractions is fully determined by the input. Four children of 8 bytes share one cache line, and the tree is half as deep as a binary one:
 // sift-down, the heap's hot path, then costs about half the cache misses.
 #pragma once
 
@@ -32,7 +33,7 @@ class IndexedHeap {
   /// Appends without ordering; call heapify() once after the last push (Floyd, O(n)).
   void push_unordered(std::uint32_t id, double key) {
     slot_[id] = std::uint32_t(heap_.size());
-    heap_.push_back({key, id});
+    heap_.push_back({float(key), id});
   }
   void heapify() {
     for (std::size_t i = heap_.size() / kArity + 1; i-- > 0;)
@@ -44,13 +45,13 @@ class IndexedHeap {
     std::uint32_t s = slot_[id];
     if (s == kAbsent) {
       s = std::uint32_t(heap_.size());
-      heap_.push_back({key, id});
+      heap_.push_back({float(key), id});
       slot_[id] = s;
       sift_up(s);
       return;
     }
-    double old = heap_[s].key;
-    heap_[s].key = key;
+    float old = heap_[s].key;
+    heap_[s].key = float(key);
     if (key < old) sift_up(s);
     else sift_down(s);
   }
@@ -76,7 +77,7 @@ class IndexedHeap {
 
  private:
   struct Entry {
-    double key;
+    float key;
     std::uint32_t id;
   };
   static bool less(const Entry& a, const Entry& b) { return a.key < b.key || (a.key == b.key && a.id < b.id); }
