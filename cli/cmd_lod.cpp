@@ -39,12 +39,14 @@ struct LodArgs {
 std::string json_string(const std::string& s) {
   std::string out = "\"";
   for (unsigned char c : s) {
-    if (c == '"' || c == '\\') out += '\\', out += char(c);
+    if (c == '"' || c == '\\')
+      out += '\\', out += char(c);
     else if (c < 0x20) {
       char buf[8];
       std::snprintf(buf, sizeof buf, "\\u%04x", c);
       out += buf;
-    } else out += char(c);
+    } else
+      out += char(c);
   }
   return out + "\"";
 }
@@ -56,11 +58,14 @@ SimplifyOptions simplify_options(const LodArgs& a) {
                                                            {"segment", Placement::Segment},
                                                            {"midpoint", Placement::Midpoint},
                                                            {"endpoints", Placement::Endpoints}};
-  static const std::map<std::string, InversionPolicy> inversions{
-      {"forbid", InversionPolicy::Forbid}, {"penalize", InversionPolicy::Penalize}, {"off", InversionPolicy::Ignore}};
+  static const std::map<std::string, InversionPolicy> inversions{{"forbid", InversionPolicy::Forbid},
+                                                                 {"penalize", InversionPolicy::Penalize},
+                                                                 {"off", InversionPolicy::Ignore}};
   SimplifyOptions opt;
-  if (a.threshold_rel > 0) opt.threshold = a.threshold_rel, opt.threshold_is_relative = true;
-  else opt.threshold = a.threshold;
+  if (a.threshold_rel > 0)
+    opt.threshold = a.threshold_rel, opt.threshold_is_relative = true;
+  else
+    opt.threshold = a.threshold;
   opt.weighting = weightings.at(a.weighting);
   opt.placement = placements.at(a.placement);
   opt.inversion = inversions.at(a.inversion);
@@ -90,8 +95,10 @@ int run_lod(const LodArgs& a) {
   SimplifyOptions opt = simplify_options(a);
   ContractionLog log;
   opt.record = &log;
-  if (!a.faces.empty()) opt.target_faces = *std::min_element(a.faces.begin(), a.faces.end());
-  else opt.target_ratio = *std::min_element(a.ratios.begin(), a.ratios.end());
+  if (!a.faces.empty())
+    opt.target_faces = *std::min_element(a.faces.begin(), a.faces.end());
+  else
+    opt.target_ratio = *std::min_element(a.ratios.begin(), a.ratios.end());
   const double cpu_simplify0 = process_cpu_seconds();
   const SimplifyResult result = simplify(mesh, opt);
   const double simplify_cpu = process_cpu_seconds() - cpu_simplify0;
@@ -122,28 +129,31 @@ int run_lod(const LodArgs& a) {
     const ReplayLevel& l = levels[i];
     const std::string file = stem + "_lod" + std::to_string(i) + "." + a.format;
     save_mesh((fs::path(a.outdir) / file).string(), l.mesh, save);
-    manifest += "    {\"path\": " + json_string(file) + ", \"faces\": " + std::to_string(l.mesh.face_count()) +
-                ", \"vertices\": " + std::to_string(l.mesh.vertex_count()) + ", \"error\": " +
-                json_number(l.max_error) + ", \"target_faces\": " + std::to_string(l.target_faces) +
-                ", \"contractions\": " + std::to_string(l.contractions) + "}" +
-                (i + 1 < levels.size() ? ",\n" : "\n");
+    manifest +=
+        "    {\"path\": " + json_string(file) + ", \"faces\": " + std::to_string(l.mesh.face_count()) +
+        ", \"vertices\": " + std::to_string(l.mesh.vertex_count()) +
+        ", \"error\": " + json_number(l.max_error) + ", \"target_faces\": " + std::to_string(l.target_faces) +
+        ", \"contractions\": " + std::to_string(l.contractions) + "}" +
+        (i + 1 < levels.size() ? ",\n" : "\n");
   }
   manifest += "  ]\n}\n";
   io::write_file_atomic((fs::path(a.outdir) / "manifest.json").string(), manifest);
   const double write_cpu = process_cpu_seconds() - cpu_write0;
 
   if (a.json)
-    std::printf("{\"tool\":\"qem lod\",\"in_faces\":%zu,\"levels\":%zu,\"simplify_cpu_s\":%s,\"replay_cpu_s\":%s,"
-                "\"write_cpu_s\":%s,\"cpu_s\":%s,\"total_s\":%s,\"peak_rss_mb\":%s}\n",
-                record.base.face_count(), levels.size(), json_number(simplify_cpu).c_str(),
-                json_number(replay_cpu).c_str(), json_number(write_cpu).c_str(),
-                json_number(process_cpu_seconds() - cpu_start).c_str(), json_number(total.seconds()).c_str(),
-                json_number(peak_rss_mb()).c_str());
+    std::printf(
+        "{\"tool\":\"qem lod\",\"in_faces\":%zu,\"levels\":%zu,\"simplify_cpu_s\":%s,\"replay_cpu_s\":%s,"
+        "\"write_cpu_s\":%s,\"cpu_s\":%s,\"total_s\":%s,\"peak_rss_mb\":%s}\n",
+        record.base.face_count(), levels.size(), json_number(simplify_cpu).c_str(),
+        json_number(replay_cpu).c_str(), json_number(write_cpu).c_str(),
+        json_number(process_cpu_seconds() - cpu_start).c_str(), json_number(total.seconds()).c_str(),
+        json_number(peak_rss_mb()).c_str());
   if (!a.quiet) {
     for (const ReplayLevel& l : levels)
       std::fprintf(stderr, "qem: level %zu faces, %zu vertices, max error %.4g\n", l.mesh.face_count(),
                    l.mesh.vertex_count(), l.max_error);
-    std::fprintf(stderr, "qem: %zu levels from one run (%s), simplify %.3f s + replay %.3f s CPU, %.3f s total\n",
+    std::fprintf(stderr,
+                 "qem: %zu levels from one run (%s), simplify %.3f s + replay %.3f s CPU, %.3f s total\n",
                  levels.size(), result.stop_detail.c_str(), simplify_cpu, replay_cpu, total.seconds());
   }
   return 0;
@@ -154,34 +164,41 @@ const bool registered = register_command(13, [](CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "lod", "Write an LOD chain from a single recorded simplification, with a manifest for `qem view`");
   sub->add_option("input", args->input, "Input mesh (.obj .ply .stl .off)")->required();
-  sub->add_option("outdir", args->outdir, "Folder for the levels and manifest.json (created if needed)")->required();
-  auto* ratios = sub->add_option("--ratios", args->ratios,
-                                 "Levels as fractions of the input faces, comma separated (e.g. 0.5,0.25,0.1)")
-                     ->delimiter(',');
+  sub->add_option("outdir", args->outdir, "Folder for the levels and manifest.json (created if needed)")
+      ->required();
+  auto* ratios =
+      sub->add_option("--ratios", args->ratios,
+                      "Levels as fractions of the input faces, comma separated (e.g. 0.5,0.25,0.1)")
+          ->delimiter(',');
   sub->add_option("--faces,-f", args->faces, "Levels as face counts, comma separated (e.g. 50000,10000,1000)")
       ->delimiter(',')
       ->excludes(ratios);
   sub->add_option("--format", args->format, "File format of the levels")
       ->check(CLI::IsMember({"ply", "obj", "stl", "off"}))
       ->capture_default_str();
-  sub->add_option("--name", args->name, "File name stem of the levels: <name>_lod<i>.<ext> (default: input's stem)");
+  sub->add_option("--name", args->name,
+                  "File name stem of the levels: <name>_lod<i>.<ext> (default: input's stem)");
   sub->add_option("--threshold,-t", args->threshold,
                   "Pair threshold t of GH97 3.2 (model units): vertices closer than t are valid pairs");
-  sub->add_option("--threshold-rel", args->threshold_rel, "As --threshold, relative to the bounding-box diagonal");
+  sub->add_option("--threshold-rel", args->threshold_rel,
+                  "As --threshold, relative to the bounding-box diagonal");
   sub->add_option("--weighting", args->weighting, "Plane weighting: area (HG99), uniform (GH97), angle")
       ->check(CLI::IsMember({"area", "uniform", "angle"}))
       ->capture_default_str();
-  sub->add_option("--placement", args->placement, "Where the new vertex goes: optimal, segment, midpoint, endpoints")
+  sub->add_option("--placement", args->placement,
+                  "Where the new vertex goes: optimal, segment, midpoint, endpoints")
       ->check(CLI::IsMember({"optimal", "segment", "midpoint", "endpoints"}))
       ->capture_default_str();
   sub->add_option("--boundary-weight", args->boundary_weight,
                   "Penalty weight of the boundary constraint planes (GH97 6); 0 = off")
       ->capture_default_str();
   sub->add_flag("--lock-border", args->lock_border, "Boundary vertices never move");
-  sub->add_option("--inversion", args->inversion, "Contractions that flip a face: forbid, penalize, or off (GH97 6)")
+  sub->add_option("--inversion", args->inversion,
+                  "Contractions that flip a face: forbid, penalize, or off (GH97 6)")
       ->check(CLI::IsMember({"forbid", "penalize", "off"}))
       ->capture_default_str();
-  sub->add_option("--max-turn", args->max_turn, "A face normal turning by more than this (degrees, < 90) is a flip")
+  sub->add_option("--max-turn", args->max_turn,
+                  "A face normal turning by more than this (degrees, < 90) is a flip")
       ->capture_default_str();
   sub->add_flag("--allow-non-manifold", args->allow_non_manifold,
                 "Do not check the link condition: edge collapses may create non-manifold edges");

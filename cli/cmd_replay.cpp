@@ -38,9 +38,10 @@ int run_replay(const ReplayArgs& a) {
   save_mesh(a.output, level[0].mesh, save);
   if (!a.quiet) {
     if (target < record.final_faces())
-      std::fprintf(stderr, "qem: note: the record ends at %zu faces, above the target %zu\n", record.final_faces(),
-                   target);
-    std::fprintf(stderr, "qem: %zu -> %zu faces, %zu vertices, %zu of %zu contractions, max error %.4g, %.3f s\n",
+      std::fprintf(stderr, "qem: note: the record ends at %zu faces, above the target %zu\n",
+                   record.final_faces(), target);
+    std::fprintf(stderr,
+                 "qem: %zu -> %zu faces, %zu vertices, %zu of %zu contractions, max error %.4g, %.3f s\n",
                  record.base.face_count(), level[0].mesh.face_count(), level[0].mesh.vertex_count(),
                  level[0].contractions, record.size(), level[0].max_error, total.seconds());
   }
@@ -52,10 +53,12 @@ const bool registered = register_command(12, [](CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "replay", "Rebuild the mesh at any face count from a contraction record (`qem simplify --record`)");
   sub->add_option("record", args->record, "Record file written by `qem simplify --record`")->required();
-  sub->add_option("output", args->output, "Output mesh; format by extension (.obj .ply .stl .off)")->required();
+  sub->add_option("output", args->output, "Output mesh; format by extension (.obj .ply .stl .off)")
+      ->required();
   sub->add_option("--faces,-f", args->faces,
                   "Stop at or below this many faces (as `qem simplify --faces`); default: replay everything");
-  sub->add_option("--ratio,-r", args->ratio, "Stop at or below this fraction of the recorded run's input faces");
+  sub->add_option("--ratio,-r", args->ratio,
+                  "Stop at or below this fraction of the recorded run's input faces");
   sub->add_flag("--ascii", args->ascii, "Write PLY / STL as text instead of binary");
   sub->add_flag("--quiet,-q", args->quiet, "No summary on stderr");
   return [args] { return run_replay(*args); };

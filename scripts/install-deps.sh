@@ -6,11 +6,11 @@ if [ "$(id -u)" != 0 ]; then SUDO=sudo; fi
 export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update
 # build: compiler, CMake; libraries: Eigen (3x3 / eigen solves), CLI11 (command line),
-# fast_float (number parsing in the text readers); tests: GoogleTest, Google Benchmark;
+# fast_float (number parsing in the text readers), nanoflann (k-d tree for threshold pairs); tests: GoogleTest, Google Benchmark;
 # clang + libclang-rt for the libFuzzer targets; chromium for the viewer's browser test.
 $SUDO apt-get install -y --no-install-recommends \
   build-essential cmake g++ python3 \
-  libeigen3-dev libcli11-dev libfast-float-dev \
+  libeigen3-dev libcli11-dev libfast-float-dev libnanoflann-dev \
   libgtest-dev libgmock-dev libbenchmark-dev \
   clang libclang-rt-14-dev \
   chromium

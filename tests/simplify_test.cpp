@@ -278,6 +278,23 @@ TEST(Simplify, ThresholdPairsJoinSeparateParts) {
   EXPECT_EQ(simplify(two, rel).virtual_pairs, 3u);
 }
 
+TEST(Simplify, AggregatedCubesSimplifyPastTheirSeparateLimit) {
+  // GH97 Fig. 3: a 3 x 3 grid of unit cubes 0.1 apart. Alone, each cube stops at a tetrahedron
+  // (36 faces in all); aggregated through threshold pairs, the joints may go non-manifold and the
+  // whole simplifies further.
+  Mesh cubes;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) cubes = test::concatenated(cubes, test::transformed(test::cube(), 1, 1.1 * i, 1.1 * j, 0));
+  SimplifyResult alone = simplify(cubes, faces(12));
+  EXPECT_EQ(alone.mesh.face_count(), 36u);
+  SimplifyOptions o = faces(12);
+  o.threshold = 0.15;
+  SimplifyResult joined = simplify(cubes, o);
+  EXPECT_EQ(joined.stop_reason, StopReason::TargetReached);
+  EXPECT_LE(joined.mesh.face_count(), 12u);
+  EXPECT_EQ(validity_problem(joined.mesh), "");
+}
+
 TEST(Simplify, EveryPolicyGivesAValidMesh) {
   Mesh in = bumpy_sphere(3);
   for (Weighting w : {Weighting::Area, Weighting::Uniform, Weighting::Angle})

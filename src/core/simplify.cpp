@@ -60,6 +60,8 @@ namespace {
 
 using namespace core;
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// Each vertex pairs with at most this many of its nearest vertices within t (see close_pairs).
+constexpr std::size_t kMaxThresholdPairsPerVertex = 8;
 
 // Heap keys are floats (24 significant bits). The same model scaled or moved gives costs that
 // differ only by rounding noise (~1e-16 relative); rounded to float they tie, ties break on the
@@ -137,6 +139,9 @@ class Simplifier {
   std::vector<Vec3> pos_;
   std::vector<Quadric> quadric_;
   std::vector<std::uint8_t> boundary_, moved_, has_blocked_;
+  // Set on both ends of a contracted threshold pair and inherited through merges: the region is
+  // an aggregation joint, non-manifold by design (GH97 §3.2), where the link condition does not apply.
+  std::vector<std::uint8_t> aggregated_;
   std::vector<std::uint32_t> tri_;  // 3 per working face
   std::vector<std::uint32_t> face_source_;    // input face index of each working face
   std::vector<std::uint32_t> source_vertex_;  // input vertex index of each working vertex
@@ -282,6 +287,7 @@ void Simplifier::prepare_input() {
   moved_.assign(n, 0);
   boundary_.assign(n, 0);
   has_blocked_.assign(n, 0);
+  aggregated_.assign(n, 0);
   mark_.assign(n, 0);
   result_.input_faces = faces_alive_;
   result_.input_vertices = vertices_alive_;
@@ -359,8 +365,7 @@ void Simplifier::select_pairs() {
     double t = opt_.threshold_is_relative ? opt_.threshold : opt_.threshold / scale_;
     std::vector<std::uint32_t> candidates;
     for (std::uint32_t v = 0; v < pos_.size(); ++v) candidates.push_back(v);
-    // At most 8 pairs a vertex on average (GH97 §3.2 warns that a large t creates O(n^2) pairs).
-    virtual_pairs = close_pairs(pos_, candidates, t, edges, std::max<std::size_t>(8 * candidates.size(), 100000));
+    virtual_pairs = close_pairs(pos_, candidates, t, edges, kMaxThresholdPairsPerVertex);
   }
   virtual_pairs_ = virtual_pairs.size();
 
@@ -490,7 +495,7 @@ bool Simplifier::is_edge_and_link_ok(std::uint32_t a, std::uint32_t b, bool& is_
     }
   }
   is_edge = shared > 0;
-  if (!is_edge || !opt_.preserve_topology) return true;
+  if (!is_edge || !opt_.preserve_topology || aggregated_[a] || aggregated_[b]) return true;
   if (shared == 2 && boundary_[a] && boundary_[b]) return false;  // would pinch the border
   // Neighbours of b that are also neighbours of a but not opposite corners break the link condition.
   std::size_t common_opposite = 0;
@@ -587,7 +592,8 @@ void Simplifier::contract(std::uint32_t p, const Quadric& q, const Vec3& target)
   // Faces: those containing both ends degenerate and die; b's others now use a. Where the
   // topology check did not run (virtual pairs, or --no-preserve-topology), a face can land on the
   // same three vertices as one of a's: it dies too, so the output never has duplicate faces.
-  const bool may_duplicate = pairs_[p].is_virtual || !opt_.preserve_topology;
+  aggregated_[a] |= aggregated_[b] | pairs_[p].is_virtual;
+  const bool may_duplicate = aggregated_[a] || !opt_.preserve_topology;
   scratch_.clear();
   for (std::uint32_t f : vertex_faces_[a]) {
     if (!face_alive_[f]) continue;

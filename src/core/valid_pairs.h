@@ -20,12 +20,13 @@ struct Edge {
 std::vector<Edge> unique_edges(const std::vector<std::uint32_t>& triangles, const VertexLists& vertex_faces,
                                std::size_t vertex_count);
 
-/// Pairs (i < j) of `candidates` with |p_i - p_j| < t that are not edges, found with a uniform
-/// grid of cell size t (never O(n^2) unless the points crowd into few cells). Sorted, unique.
-/// Throws qem::Error if more than `max_pairs` pairs are found: t is too large for the model.
+/// Pairs (i < j) of `candidates` with |p_i - p_j| < t that are not edges (GH97 §3.2 rule 2), each
+/// vertex pairing with at most its `max_per_vertex` nearest such vertices: GH97 warns that a large
+/// t creates O(n^2) pairs; this keeps the closest ones, which are the ones aggregation needs, and
+/// keeps time and memory linear for any t. Found with a k-d tree (nanoflann). Sorted, unique.
 std::vector<std::pair<std::uint32_t, std::uint32_t>> close_pairs(const std::vector<Vec3>& positions,
                                                                  const std::vector<std::uint32_t>& candidates,
                                                                  double t, const std::vector<Edge>& edges,
-                                                                 std::size_t max_pairs);
+                                                                 std::size_t max_per_vertex);
 
 }  // namespace qem::core

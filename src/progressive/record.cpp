@@ -51,7 +51,8 @@ Record make_record(MeshView input, const ContractionLog& log) {
     for (int k = 0; k < 3; ++k) r.base.indices.push_back(vertex_id[input.indices[3 * std::size_t(f) + k]]);
 
   auto vertex = [&](std::uint32_t v, std::size_t i) {
-    if (v >= nv || vertex_id[v] == kNone) fail("contraction log", "contraction", i, "vertex not used by the run");
+    if (v >= nv || vertex_id[v] == kNone)
+      fail("contraction log", "contraction", i, "vertex not used by the run");
     return vertex_id[v];
   };
   r.kept.resize(nc);
@@ -79,7 +80,8 @@ void validate_record(const Record& r, const std::string& name) {
     throw Error(name + ": base mesh arrays are not whole vertices / triangles");
   if (nv > kNone || nf > kNone) throw Error(name + ": too many vertices or faces for 32-bit ids");
   if (r.removed.size() != nc || r.position.size() != 3 * nc || r.error.size() != nc ||
-      r.dead_begin.size() != nc + 1 || r.dead_begin.front() != 0 || r.dead_begin.back() != r.dead_faces.size())
+      r.dead_begin.size() != nc + 1 || r.dead_begin.front() != 0 ||
+      r.dead_begin.back() != r.dead_faces.size())
     throw Error(name + ": contraction arrays have inconsistent sizes");
   for (std::size_t i = 0; i < r.base.positions.size(); ++i)
     if (!std::isfinite(r.base.positions[i])) fail(name, "vertex", i / 3, "non-finite coordinate");
@@ -100,7 +102,8 @@ void validate_record(const Record& r, const std::string& name) {
     gone[b] = 1;
     for (int k = 0; k < 3; ++k)
       if (!std::isfinite(r.position[3 * i + k])) fail(name, "contraction", i, "non-finite position");
-    if (!(r.error[i] >= 0) || !std::isfinite(r.error[i])) fail(name, "contraction", i, "error is not finite and >= 0");
+    if (!(r.error[i] >= 0) || !std::isfinite(r.error[i]))
+      fail(name, "contraction", i, "error is not finite and >= 0");
     if (r.dead_begin[i + 1] < r.dead_begin[i] || r.dead_begin[i + 1] > r.dead_faces.size())
       fail(name, "contraction", i, "dead face range out of order");
     for (std::uint32_t k = r.dead_begin[i]; k < r.dead_begin[i + 1]; ++k) {

@@ -61,7 +61,8 @@ class Reader {
  private:
   void need(std::size_t n) {
     if (p_.size() - at_ < n)
-      io::fail(name_, "truncated at byte " + std::to_string(at_) + " (dead face counts exceed the header's total)");
+      io::fail(name_,
+               "truncated at byte " + std::to_string(at_) + " (dead face counts exceed the header's total)");
   }
   std::string_view p_;
   std::size_t at_ = 0;
@@ -142,8 +143,9 @@ Record parse_record(std::string_view bytes, const std::string& name) {
     r.error[i] = in.f64();
     const std::uint32_t dead = in.u32();
     if (dead > nd - r.dead_faces.size())
-      io::fail_element(name, "contraction", i, "dead face count " + std::to_string(dead) +
-                                                   " exceeds the header's total of " + std::to_string(nd));
+      io::fail_element(
+          name, "contraction", i,
+          "dead face count " + std::to_string(dead) + " exceeds the header's total of " + std::to_string(nd));
     for (std::uint32_t k = 0; k < dead; ++k) r.dead_faces.push_back(in.u32());
     r.dead_begin[i + 1] = std::uint32_t(r.dead_faces.size());
   }

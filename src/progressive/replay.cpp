@@ -52,7 +52,8 @@ class Replayer {
     for (std::size_t v = 0; v < nv; ++v) {
       if (remap[v] == kNone) continue;
       remap[v] = next++;
-      const double* p = last_move_[v] == kNone ? &r_.base.positions[3 * v] : &r_.position[3 * std::size_t(last_move_[v])];
+      const double* p =
+          last_move_[v] == kNone ? &r_.base.positions[3 * v] : &r_.position[3 * std::size_t(last_move_[v])];
       out.positions.insert(out.positions.end(), p, p + 3);
     }
     for (std::uint32_t& i : out.indices) i = remap[i];
@@ -103,7 +104,8 @@ std::vector<ReplayLevel> replay_levels(const Record& record, std::span<const std
   // Finest level first: contractions only ever go forward.
   std::vector<std::size_t> order(targets.size());
   std::iota(order.begin(), order.end(), std::size_t(0));
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return targets[a] > targets[b]; });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return targets[a] > targets[b]; });
   std::vector<ReplayLevel> levels(targets.size());
   Replayer r(record);
   for (std::size_t i : order) {
