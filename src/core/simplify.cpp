@@ -228,7 +228,8 @@ void Simplifier::prepare_input() {
                    (1.0 / scale_);
 
   // Internal numbering along a Morton curve (see spatial_order.h); source_vertex_ maps back.
-  source_vertex_ = morton_order(input_pos, used);
+  source_vertex_ = morton_order(used.size(), [&](std::size_t i) { return input_pos[used[i]]; });
+  for (std::uint32_t& v : source_vertex_) v = used[v];
   const std::uint32_t n = std::uint32_t(source_vertex_.size());
   std::vector<std::uint32_t> internal(nv, 0);
   pos_.resize(n);

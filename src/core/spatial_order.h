@@ -1,16 +1,49 @@
-// Renumbering vertices along a Morton (Z-order) curve, so that vertices close in space are close
-// in memory. The contraction loop touches a vertex's neighbours, their quadrics, faces and pairs;
-// with an arbitrary input order (e.g. subdivision order) each of those is a cache miss.
+// Ordering points along a Morton (Z-order) curve, so that points close in space are close in
+// memory or in processing order. The simplifier renumbers its vertices this way (its loop touches
+// a vertex's neighbours, their quadrics, faces and pairs: with an arbitrary input order each is a
+// cache miss); the error metric orders its closest-point queries this way (each query then starts
+// next to the previous answer).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <limits>
+#include <utility>
 #include <vector>
 
 #include "core/quadric.h"
 
 namespace qem::core {
 
-/// The ids of `vertices` sorted along a Morton curve over their bounding box; ties keep input order.
-std::vector<std::uint32_t> morton_order(const std::vector<Vec3>& positions, const std::vector<std::uint32_t>& vertices);
+/// Spreads the low 21 bits of x so that two zero bits separate each (for 3D interleaving).
+std::uint64_t spread_bits_3d(std::uint64_t x);
+
+/// Indices 0..n-1 sorted by the Morton code of point_of(i) (a Vec3) over the points' bounding
+/// box, ties by index: the order is fully determined by the input.
+template <class PointOf>
+std::vector<std::uint32_t> morton_order(std::size_t n, PointOf point_of) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  Vec3 lo{kInf, kInf, kInf}, hi{-kInf, -kInf, -kInf};
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 p = point_of(i);
+    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+  }
+  // One scale for all axes keeps the cells cubic.
+  const double extent = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
+  const double scale = extent > 0 ? double((1 << 21) - 1) / extent : 0;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 p = point_of(i);
+    const auto cell = [&](double x, double l) { return std::uint64_t((x - l) * scale); };
+    keyed[i] = {spread_bits_3d(cell(p.x, lo.x)) | spread_bits_3d(cell(p.y, lo.y)) << 1 |
+                    spread_bits_3d(cell(p.z, lo.z)) << 2,
+                std::uint32_t(i)};
+  }
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<std::uint32_t> order(n);
+  for (std::size_t i = 0; i < n; ++i) order[i] = keyed[i].second;
+  return order;
+}
 
 }  // namespace qem::core

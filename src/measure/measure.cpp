@@ -11,7 +11,7 @@
 #include <thread>
 
 #include "measure/bvh.h"
-#include "measure/spatial_order.h"
+#include "core/spatial_order.h"
 #include "measure/surface_sampling.h"
 #include "qem/error.h"
 
@@ -57,7 +57,8 @@ Distances distances(const TriangleBvh& tree, const std::vector<double>& samples,
   const std::size_t ns = samples.size() / 3;
   std::vector<double> points = samples;
   points.insert(points.end(), vertices.begin(), vertices.end());
-  const std::vector<std::uint32_t> order = measure_detail::morton_order(points);
+  const std::vector<std::uint32_t> order = core::morton_order(
+      points.size() / 3, [&](std::size_t i) { return core::Vec3(points[3 * i], points[3 * i + 1], points[3 * i + 2]); });
   std::vector<double> d2(order.size());
   for_chunks(order.size(), threads, [&](std::size_t, std::size_t begin, std::size_t end) {
     std::uint32_t hint = UINT32_MAX;  // reset per chunk: the warm start never crosses chunks
