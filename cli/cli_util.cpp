@@ -1,5 +1,7 @@
 #include "cli_util.h"
 
+#include "qem/error.h"
+
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -33,6 +35,11 @@ double peak_rss_mb() {
 bool same_file(const std::string& a, const std::string& b) {
   std::error_code ec;
   return std::filesystem::exists(a, ec) && std::filesystem::exists(b, ec) && std::filesystem::equivalent(a, b, ec);
+}
+
+void refuse_to_overwrite(const std::string& input, const std::string& output, bool force) {
+  if (!force && same_file(input, output))
+    throw Error("refusing to overwrite the input '" + input + "' with the output (use --force)");
 }
 
 std::string json_number(double x) {

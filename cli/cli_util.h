@@ -27,6 +27,10 @@ double peak_rss_mb();
 /// True if both paths name the same existing file (so writing one would destroy the other).
 bool same_file(const std::string& a, const std::string& b);
 
+/// Throws qem::Error if writing `output` would overwrite `input` and `force` is not set: a run
+/// must never destroy its own input by accident.
+void refuse_to_overwrite(const std::string& input, const std::string& output, bool force);
+
 /// A number for a JSON document: shortest round-trip form, `null` for NaN/inf.
 std::string json_number(double x);
 

@@ -20,10 +20,12 @@ struct ClusterArgs {
   std::vector<int> grid;
   double cell = 0;
   bool cell_relative = false;
+  bool force = false;
 };
 
 int run_cluster(const ClusterArgs& a) {
   const Stopwatch clock;
+  refuse_to_overwrite(a.input, a.output, a.force);
   ClusterOptions o;
   if (!a.grid.empty()) {
     for (int k = 0; k < 3; ++k) o.grid[k] = a.grid[std::size_t(k)];
@@ -65,6 +67,7 @@ const bool registered = register_command(40, [](CLI::App& app) -> std::function<
                   "mean (average of the cell's vertices)")
       ->capture_default_str()
       ->check(CLI::IsMember({"quadric", "mean"}));
+  cmd->add_flag("--force", args->force, "Allow the output to overwrite the input file");
   return [args] { return run_cluster(*args); };
 });
 

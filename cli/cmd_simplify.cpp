@@ -35,8 +35,7 @@ int run_simplify(const SimplifyArgs& a) {
   if (a.faces == 0 && a.ratio == 0 && a.vertices == 0 && a.max_error < 0 && a.max_error_rel < 0)
     throw Error("give a target: --faces, --ratio, --vertices, --max-error or --max-error-rel");
   if (a.ratio < 0 || a.ratio > 1) throw Error("--ratio must be in (0, 1]");
-  if (same_file(a.input, a.output) && !a.force)
-    throw Error("refusing to overwrite the input '" + a.input + "' with the output (use --force)");
+  refuse_to_overwrite(a.input, a.output, a.force);
 
   SimplifyOptions opt;
   opt.target_faces = a.faces;

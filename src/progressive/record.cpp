@@ -36,7 +36,12 @@ Record make_record(MeshView input, const ContractionLog& log) {
     if (f >= nf || (j > 0 && f <= log.initial_faces[j - 1]))
       throw Error("contraction log: initial faces are not increasing input face ids");
     face_id[f] = std::uint32_t(j);
-    for (int k = 0; k < 3; ++k) vertex_id[input.indices[3 * std::size_t(f) + k]] = 0;  // used
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t v = input.indices[3 * std::size_t(f) + k];
+      if (v >= nv)
+        throw Error("contraction log: initial face " + std::to_string(f) + " has a vertex out of range");
+      vertex_id[v] = 0;  // used; numbered below
+    }
   }
   // Base vertices: the used ones, in input order.
   Record r;
