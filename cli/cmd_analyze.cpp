@@ -70,14 +70,15 @@ void write_vertices(const std::string& path, const Mesh& mesh, const Analysis& a
 }
 
 std::string summary_json(const char* name, const stats::Summary& s) {
-  return std::string("\"") + name + "\":{\"count\":" + std::to_string(s.count) + ",\"mean\":" + json_number(s.mean) +
-         ",\"std\":" + json_number(s.stddev) + ",\"min\":" + json_number(s.min) + ",\"median\":" +
-         json_number(s.median) + ",\"max\":" + json_number(s.max) + "}";
+  return std::string("\"") + name + "\":{\"count\":" + std::to_string(s.count) +
+         ",\"mean\":" + json_number(s.mean) + ",\"std\":" + json_number(s.stddev) +
+         ",\"min\":" + json_number(s.min) + ",\"median\":" + json_number(s.median) +
+         ",\"max\":" + json_number(s.max) + "}";
 }
 
 void print_summary(const char* name, const stats::Summary& s) {
-  std::printf("%-30s n=%-8zu mean %-10.4g std %-10.4g min %-10.4g median %-10.4g max %.4g\n", name, s.count, s.mean,
-              s.stddev, s.min, s.median, s.max);
+  std::printf("%-30s n=%-8zu mean %-10.4g std %-10.4g min %-10.4g median %-10.4g max %.4g\n", name, s.count,
+              s.mean, s.stddev, s.min, s.median, s.max);
 }
 
 int run_analyze(const AnalyzeArgs& args) {
@@ -103,14 +104,17 @@ int run_analyze(const AnalyzeArgs& args) {
 
   if (args.json) {
     std::string s = "{\"mesh\":\"" + args.mesh + "\",\"faces\":" + std::to_string(mesh.face_count()) +
-                    ",\"vertices\":" + std::to_string(mesh.vertex_count()) + "," + summary_json("aspect", aspect) + "," +
-                    summary_json("k_min_est", s_kmin) + "," + summary_json("k_mid_est", s_kmid) + "," +
-                    summary_json("curvature_ratio_est", s_cr) + "," + summary_json("quadric_ratio", s_qr);
+                    ",\"vertices\":" + std::to_string(mesh.vertex_count()) + "," +
+                    summary_json("aspect", aspect) + "," + summary_json("k_min_est", s_kmin) + "," +
+                    summary_json("k_mid_est", s_kmid) + "," + summary_json("curvature_ratio_est", s_cr) +
+                    "," + summary_json("quadric_ratio", s_qr);
     if (has_optimal)
-      s += "," + summary_json("optimal_aspect", optimal) + ",\"correlation_optimal_actual\":" + json_number(corr);
+      s += "," + summary_json("optimal_aspect", optimal) +
+           ",\"correlation_optimal_actual\":" + json_number(corr);
     std::printf("%s}\n", s.c_str());
   } else {
-    std::printf("mesh %s: %zu vertices, %zu faces\n", args.mesh.c_str(), mesh.vertex_count(), mesh.face_count());
+    std::printf("mesh %s: %zu vertices, %zu faces\n", args.mesh.c_str(), mesh.vertex_count(),
+                mesh.face_count());
     print_summary("triangle aspect ratio", aspect);
     print_summary("|k| along e_min (estimate)", s_kmin);
     print_summary("|k| along e_mid (estimate)", s_kmid);
@@ -140,14 +144,16 @@ const bool registered = register_command(45, [](CLI::App& app) -> std::function<
   auto args = std::make_shared<AnalyzeArgs>();
   CLI::App* cmd = app.add_subcommand(
       "analyze",
-      "Shape analysis after HG99 4-5: triangle aspect ratios (least-area ellipse), eigen-decomposition of each "
+      "Shape analysis after HG99 4-5: triangle aspect ratios (least-area ellipse), eigen-decomposition of "
+      "each "
       "vertex's area-weighted quadric, the principal curvatures it implies, and (with k1, k2 PLY vertex "
       "properties) the optimal aspect ratio sqrt|k1/k2| per triangle");
   cmd->add_option("mesh", args->mesh, "The mesh to analyse (OBJ, PLY, STL, OFF)")->required();
   cmd->add_flag("--json", args->json, "Print one JSON line of summary statistics instead of a table");
   cmd->add_option("--triangles", args->triangles_csv, "Write per-triangle CSV: area, aspect, optimal_aspect");
-  cmd->add_option("--vertices", args->vertices_csv,
-                  "Write per-vertex CSV: quadric eigenvalues and eigenvectors, curvature estimates (and k1, k2)");
+  cmd->add_option(
+      "--vertices", args->vertices_csv,
+      "Write per-vertex CSV: quadric eigenvalues and eigenvectors, curvature estimates (and k1, k2)");
   cmd->add_option("--ellipsoids", args->ellipsoids,
                   "Write the quadric level-set ellipsoids of every vertex as one mesh (GH97 Fig. 11)");
   cmd->add_option("--ellipsoid-scale", args->ellipsoid_scale, "Size factor of the ellipsoids")

@@ -7,11 +7,11 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "algorithm_options.h"
 #include "cli_util.h"
 #include "command.h"
 #include "io/io_common.h"
@@ -27,13 +27,8 @@ struct LodArgs {
   std::string input, outdir, format = "ply", name;
   std::vector<double> ratios;
   std::vector<std::size_t> faces;
-  double threshold = 0, threshold_rel = 0;
-  std::string weighting = "area", placement = "optimal", inversion = "forbid";
-  double boundary_weight = 1;
-  double max_turn = 75;
-  bool lock_border = false, allow_non_manifold = false;
-  bool weld = false, no_weld = false, ascii = false;
-  bool json = false, quiet = false;
+  AlgorithmArgs algorithm;
+  bool ascii = false, json = false, quiet = false;
 };
 
 std::string json_string(const std::string& s) {
@@ -51,31 +46,6 @@ std::string json_string(const std::string& s) {
   return out + "\"";
 }
 
-SimplifyOptions simplify_options(const LodArgs& a) {
-  static const std::map<std::string, Weighting> weightings{
-      {"area", Weighting::Area}, {"uniform", Weighting::Uniform}, {"angle", Weighting::Angle}};
-  static const std::map<std::string, Placement> placements{{"optimal", Placement::Optimal},
-                                                           {"segment", Placement::Segment},
-                                                           {"midpoint", Placement::Midpoint},
-                                                           {"endpoints", Placement::Endpoints}};
-  static const std::map<std::string, InversionPolicy> inversions{{"forbid", InversionPolicy::Forbid},
-                                                                 {"penalize", InversionPolicy::Penalize},
-                                                                 {"off", InversionPolicy::Ignore}};
-  SimplifyOptions opt;
-  if (a.threshold_rel > 0)
-    opt.threshold = a.threshold_rel, opt.threshold_is_relative = true;
-  else
-    opt.threshold = a.threshold;
-  opt.weighting = weightings.at(a.weighting);
-  opt.placement = placements.at(a.placement);
-  opt.inversion = inversions.at(a.inversion);
-  opt.boundary_weight = a.boundary_weight;
-  opt.max_normal_turn_degrees = a.max_turn;
-  opt.lock_border = a.lock_border;
-  opt.preserve_topology = !a.allow_non_manifold;
-  return opt;
-}
-
 int run_lod(const LodArgs& a) {
   if (a.ratios.empty() == a.faces.empty()) throw Error("give the levels with either --ratios or --faces");
   for (double r : a.ratios)
@@ -85,14 +55,11 @@ int run_lod(const LodArgs& a) {
   Stopwatch total;
   const double cpu_start = process_cpu_seconds();
 
-  LoadOptions load;
-  if (a.weld) load.weld = Weld::On;
-  if (a.no_weld) load.weld = Weld::Off;
-  Mesh mesh = load_mesh(a.input, load);
+  Mesh mesh = load_mesh(a.input, to_load_options(a.algorithm));
 
   // One run to the coarsest level, recorded. Ratios are taken of the faces the run starts from
   // (degenerate and duplicate input faces dropped), exactly as `qem simplify --ratio` does.
-  SimplifyOptions opt = simplify_options(a);
+  SimplifyOptions opt = to_simplify_options(a.algorithm);
   ContractionLog log;
   opt.record = &log;
   if (!a.faces.empty())
@@ -178,32 +145,7 @@ const bool registered = register_command(13, [](CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--name", args->name,
                   "File name stem of the levels: <name>_lod<i>.<ext> (default: input's stem)");
-  sub->add_option("--threshold,-t", args->threshold,
-                  "Pair threshold t of GH97 3.2 (model units): vertices closer than t are valid pairs");
-  sub->add_option("--threshold-rel", args->threshold_rel,
-                  "As --threshold, relative to the bounding-box diagonal");
-  sub->add_option("--weighting", args->weighting, "Plane weighting: area (HG99), uniform (GH97), angle")
-      ->check(CLI::IsMember({"area", "uniform", "angle"}))
-      ->capture_default_str();
-  sub->add_option("--placement", args->placement,
-                  "Where the new vertex goes: optimal, segment, midpoint, endpoints")
-      ->check(CLI::IsMember({"optimal", "segment", "midpoint", "endpoints"}))
-      ->capture_default_str();
-  sub->add_option("--boundary-weight", args->boundary_weight,
-                  "Penalty weight of the boundary constraint planes (GH97 6); 0 = off")
-      ->capture_default_str();
-  sub->add_flag("--lock-border", args->lock_border, "Boundary vertices never move");
-  sub->add_option("--inversion", args->inversion,
-                  "Contractions that flip a face: forbid, penalize, or off (GH97 6)")
-      ->check(CLI::IsMember({"forbid", "penalize", "off"}))
-      ->capture_default_str();
-  sub->add_option("--max-turn", args->max_turn,
-                  "A face normal turning by more than this (degrees, < 90) is a flip")
-      ->capture_default_str();
-  sub->add_flag("--allow-non-manifold", args->allow_non_manifold,
-                "Do not check the link condition: edge collapses may create non-manifold edges");
-  sub->add_flag("--weld", args->weld, "Merge exactly coincident vertices on load (default for STL)");
-  sub->add_flag("--no-weld", args->no_weld, "Never weld on load, not even STL");
+  add_algorithm_options(sub, args->algorithm);
   sub->add_flag("--ascii", args->ascii, "Write PLY / STL as text instead of binary");
   sub->add_flag("--json", args->json, "Print one JSON line with CPU timings and memory on stdout");
   sub->add_flag("--quiet,-q", args->quiet, "No summary on stderr");

@@ -49,8 +49,9 @@ const bool registered = register_command(90, [](CLI::App& app) -> std::function<
                   "Folder with the models (gh_cow.obj, gh_foot_bones.off, gh_bunny_zipper.ply, "
                   "terrain_gcanyon_179k.ply, synth_cubes_10x10.ply, synth_ellipsoid_11k_curv.ply)")
       ->capture_default_str();
-  cmd->add_flag("--quick", args->options.quick,
-                "Fewer samples (20k instead of 1M), models (no bunny/terrain timings), thresholds and repetitions");
+  cmd->add_flag(
+      "--quick", args->options.quick,
+      "Fewer samples (20k instead of 1M), models (no bunny/terrain timings), thresholds and repetitions");
   cmd->add_option("--only", args->only,
                   "Comma-separated subset of gh97_fig5, gh97_fig6, gh97_fig7, gh97_fig15_17, hg99_fig8");
   cmd->add_flag("--quiet", args->quiet, "No progress lines on stderr");

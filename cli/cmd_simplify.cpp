@@ -3,9 +3,9 @@
 
 #include <cmath>
 #include <cstdio>
-#include <map>
 #include <string>
 
+#include "algorithm_options.h"
 #include "cli_util.h"
 #include "command.h"
 #include "qem/error.h"
@@ -21,13 +21,8 @@ struct SimplifyArgs {
   std::size_t faces = 0, vertices = 0;
   double ratio = 0;
   double max_error = -1, max_error_rel = -1;
-  double threshold = 0, threshold_rel = 0;
-  std::string weighting = "area", placement = "optimal", inversion = "forbid";
-  double boundary_weight = 1;
-  double max_turn = 75;
-  bool lock_border = false, allow_non_manifold = false;
-  bool weld = false, no_weld = false, ascii = false;
-  bool json = false, quiet = false, force = false;
+  AlgorithmArgs algorithm;
+  bool ascii = false, json = false, quiet = false, force = false;
   std::string record;  // --record: the contraction sequence (docs/record-format.md)
 };
 
@@ -37,29 +32,12 @@ int run_simplify(const SimplifyArgs& a) {
   if (a.ratio < 0 || a.ratio > 1) throw Error("--ratio must be in (0, 1]");
   refuse_to_overwrite(a.input, a.output, a.force);
 
-  SimplifyOptions opt;
+  SimplifyOptions opt = to_simplify_options(a.algorithm);
   opt.target_faces = a.faces;
   opt.target_ratio = a.ratio;
   opt.target_vertices = a.vertices;
   if (a.max_error >= 0) opt.max_error = a.max_error;
   if (a.max_error_rel >= 0) opt.max_error = a.max_error_rel, opt.max_error_is_relative = true;
-  if (a.threshold_rel > 0) opt.threshold = a.threshold_rel, opt.threshold_is_relative = true;
-  else opt.threshold = a.threshold;
-  static const std::map<std::string, Weighting> weightings{
-      {"area", Weighting::Area}, {"uniform", Weighting::Uniform}, {"angle", Weighting::Angle}};
-  static const std::map<std::string, Placement> placements{{"optimal", Placement::Optimal},
-                                                           {"segment", Placement::Segment},
-                                                           {"midpoint", Placement::Midpoint},
-                                                           {"endpoints", Placement::Endpoints}};
-  static const std::map<std::string, InversionPolicy> inversions{
-      {"forbid", InversionPolicy::Forbid}, {"penalize", InversionPolicy::Penalize}, {"off", InversionPolicy::Ignore}};
-  opt.weighting = weightings.at(a.weighting);
-  opt.placement = placements.at(a.placement);
-  opt.inversion = inversions.at(a.inversion);
-  opt.boundary_weight = a.boundary_weight;
-  opt.max_normal_turn_degrees = a.max_turn;
-  opt.lock_border = a.lock_border;
-  opt.preserve_topology = !a.allow_non_manifold;
 
   const bool show_progress = !a.quiet && !a.json && ::isatty(STDERR_FILENO);
   if (show_progress)
@@ -70,9 +48,7 @@ int run_simplify(const SimplifyArgs& a) {
     };
 
   Stopwatch total;
-  LoadOptions load;
-  if (a.weld) load.weld = Weld::On;
-  if (a.no_weld) load.weld = Weld::Off;
+  LoadOptions load = to_load_options(a.algorithm);
   LoadReport report;
   Stopwatch t_load;
   Mesh mesh = load_mesh(a.input, load, &report);
@@ -126,31 +102,7 @@ const bool registered = register_command(10, [](CLI::App& app) {
                 "Never make a contraction whose error exceeds this distance (model units): the error is "
                 "sqrt(Q(v)/weight), the weighted RMS distance of the new vertex to the planes it represents");
   g->add_option("--max-error-rel", args->max_error_rel, "As --max-error, relative to the bounding-box diagonal");
-  sub->add_option("--threshold,-t", args->threshold,
-                  "Pair threshold t of GH97 3.2 (model units): vertices closer than t are valid pairs, so "
-                  "separate parts can join (0 = edges only)");
-  sub->add_option("--threshold-rel", args->threshold_rel, "As --threshold, relative to the bounding-box diagonal");
-  sub->add_option("--weighting", args->weighting, "Plane weighting: area (HG99), uniform (GH97), angle")
-      ->check(CLI::IsMember({"area", "uniform", "angle"}))
-      ->capture_default_str();
-  sub->add_option("--placement", args->placement,
-                  "Where the new vertex goes: optimal (then segment, then endpoints), segment, midpoint, endpoints")
-      ->check(CLI::IsMember({"optimal", "segment", "midpoint", "endpoints"}))
-      ->capture_default_str();
-  sub->add_option("--boundary-weight", args->boundary_weight,
-                  "Penalty weight of the boundary constraint planes (GH97 6); 0 = off")
-      ->capture_default_str();
-  sub->add_flag("--lock-border", args->lock_border, "Boundary vertices never move");
-  sub->add_option("--inversion", args->inversion,
-                  "Contractions that flip a face: forbid, penalize, or off (GH97 6)")
-      ->check(CLI::IsMember({"forbid", "penalize", "off"}))
-      ->capture_default_str();
-  sub->add_option("--max-turn", args->max_turn, "A face normal turning by more than this (degrees, < 90) is a flip")
-      ->capture_default_str();
-  sub->add_flag("--allow-non-manifold", args->allow_non_manifold,
-                "Do not check the link condition: edge collapses may create non-manifold edges");
-  sub->add_flag("--weld", args->weld, "Merge exactly coincident vertices on load (default for STL)");
-  sub->add_flag("--no-weld", args->no_weld, "Never weld on load, not even STL");
+  add_algorithm_options(sub, args->algorithm);
   sub->add_flag("--ascii", args->ascii, "Write PLY / STL as text instead of binary");
   sub->add_flag("--json", args->json, "Print one JSON line with counts, timings, memory and error on stdout");
   sub->add_flag("--quiet,-q", args->quiet, "No progress and no summary on stderr");

@@ -29,8 +29,10 @@ std::string read_all(const std::string& path) {
 
 TEST(Reproduce, SvgHasAxesSeriesAndLegendAndIsDeterministic) {
   reproduce::Plot plot{"title <1>", "x", "y", true, true, {}, {}, false};
-  plot.series.push_back({"a & b", {1, 10, 100}, {1e-3, 1e-4, 1e-6}, {}, reproduce::Series::Style::LinePoints});
-  plot.series.push_back({"errors", {1, 10, 100}, {2e-3, 2e-4, 2e-6}, {1e-3, 1e-4, 1e-6}, reproduce::Series::Style::Points});
+  plot.series.push_back(
+      {"a & b", {1, 10, 100}, {1e-3, 1e-4, 1e-6}, {}, reproduce::Series::Style::LinePoints});
+  plot.series.push_back(
+      {"errors", {1, 10, 100}, {2e-3, 2e-4, 2e-6}, {1e-3, 1e-4, 1e-6}, reproduce::Series::Style::Points});
   const std::string svg = reproduce::render_svg(plot);
   EXPECT_EQ(svg.rfind("<svg", 0), 0u);
   EXPECT_NE(svg.find("</svg>"), std::string::npos);

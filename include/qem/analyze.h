@@ -50,8 +50,9 @@ struct Analysis {
   /// 0 when the vertex has no face or a zero moment.
   std::vector<double> curvature;
   /// The curvature aspect ratio sqrt(lambda_mid / lambda_min) * sqrt(m_min / m_mid) = |k_mid/k_min|
-  /// and the quadric's own ellipse ratio sqrt(lambda_mid / lambda_min) (HG99 eq. 35-36: equal to
-  /// |k2/k1| for optimally shaped neighbourhoods). 2 per vertex; +inf when lambda_min is 0.
+  /// and the quadric's own ellipse ratio sqrt(lambda_mid / lambda_min). HG99 eq. (35)-(36): for
+  /// optimally shaped neighbourhoods lambda_mid / lambda_min = |k_max / k_min|, so the latter is the
+  /// optimal aspect ratio of eq. (34) read off the quadric alone. 2 per vertex; +inf when lambda_min is 0.
   std::vector<double> quadric_ratio;
   std::vector<std::uint32_t> valence;  ///< incident faces per vertex (0 = unreferenced)
 
@@ -72,7 +73,7 @@ Mesh quadric_ellipsoids(const Mesh& mesh, const Analysis& analysis, double scale
 /// GH97 §3.2 valid pairs: every edge (first, with `edges` set to their count) and every pair of
 /// referenced vertices closer than `threshold` that is not an edge. Pairs are (i < j), sorted.
 std::vector<std::pair<std::uint32_t, std::uint32_t>> valid_pairs(const Mesh& mesh, double threshold,
-                                                                  std::size_t* edges = nullptr);
+                                                                 std::size_t* edges = nullptr);
 
 /// Writes `pairs` as OBJ line elements (`l i j`) over the mesh's vertices, edges in group `edges`
 /// and the others in group `non_edges` (GH97 Fig. 19: red and green). Atomic write.

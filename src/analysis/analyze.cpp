@@ -19,8 +19,8 @@ void check_indices(const Mesh& mesh) {
   std::size_t n = mesh.vertex_count();
   for (std::size_t i = 0; i < mesh.indices.size(); ++i)
     if (mesh.indices[i] >= n)
-      throw Error("analyze: face " + std::to_string(i / 3) + " uses vertex " + std::to_string(mesh.indices[i]) +
-                  " but the mesh has " + std::to_string(n) + " vertices");
+      throw Error("analyze: face " + std::to_string(i / 3) + " uses vertex " +
+                  std::to_string(mesh.indices[i]) + " but the mesh has " + std::to_string(n) + " vertices");
 }
 
 }  // namespace
@@ -131,7 +131,8 @@ Analysis analyze(const Mesh& mesh, const AnalyzeOptions& options) {
   r.quadric_ratio.assign(2 * nv, 0.0);
   for (std::size_t v = 0; v < nv; ++v) {
     for (int i = 0; i < 2; ++i)
-      r.curvature[2 * v + i] = moment[2 * v + i] > 0 ? std::sqrt(r.eigenvalues[3 * v + i] / moment[2 * v + i]) : 0;
+      r.curvature[2 * v + i] =
+          moment[2 * v + i] > 0 ? std::sqrt(r.eigenvalues[3 * v + i] / moment[2 * v + i]) : 0;
     double l0 = r.eigenvalues[3 * v], l1 = r.eigenvalues[3 * v + 1];
     double k0 = r.curvature[2 * v], k1 = r.curvature[2 * v + 1];
     r.quadric_ratio[2 * v] = k0 > 0 ? k1 / k0 : (k1 > 0 ? kInf : 1);

@@ -17,7 +17,8 @@ namespace {
 /// to read an ellipsoid's axes, small enough for one per vertex of a 100k-vertex mesh.
 void unit_sphere(std::vector<double>& pos, std::vector<std::uint32_t>& tri) {
   const double oct[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-  const int faces[8][3] = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+  const int faces[8][3] = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                           {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
   pos.assign(&oct[0][0], &oct[0][0] + 18);
   auto midpoint = [&](int a, int b) {
     // Edge midpoints are shared by two faces: look them up so the sphere is closed.
@@ -26,7 +27,8 @@ void unit_sphere(std::vector<double>& pos, std::vector<std::uint32_t>& tri) {
     double len = std::sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
     for (int k = 0; k < 3; ++k) m[k] /= len;
     for (std::size_t v = 0; v < pos.size() / 3; ++v)
-      if (std::abs(pos[3 * v] - m[0]) + std::abs(pos[3 * v + 1] - m[1]) + std::abs(pos[3 * v + 2] - m[2]) < 1e-12)
+      if (std::abs(pos[3 * v] - m[0]) + std::abs(pos[3 * v + 1] - m[1]) + std::abs(pos[3 * v + 2] - m[2]) <
+          1e-12)
         return std::uint32_t(v);
     pos.insert(pos.end(), m, m + 3);
     return std::uint32_t(pos.size() / 3 - 1);
@@ -43,7 +45,8 @@ void unit_sphere(std::vector<double>& pos, std::vector<std::uint32_t>& tri) {
 }  // namespace
 
 Mesh quadric_ellipsoids(const Mesh& mesh, const Analysis& analysis, double scale) {
-  if (!(scale > 0) || !std::isfinite(scale)) throw Error("ellipsoids: scale must be positive, got " + std::to_string(scale));
+  if (!(scale > 0) || !std::isfinite(scale))
+    throw Error("ellipsoids: scale must be positive, got " + std::to_string(scale));
   // Mean edge length sets the picture's scale, so the ellipsoids look the same on any model size.
   double sum = 0;
   std::size_t count = 0;
@@ -51,7 +54,8 @@ Mesh quadric_ellipsoids(const Mesh& mesh, const Analysis& analysis, double scale
     for (int j = 0; j < 3; ++j) {
       const double* a = &mesh.positions[3 * mesh.indices[3 * f + j]];
       const double* b = &mesh.positions[3 * mesh.indices[3 * f + (j + 1) % 3]];
-      sum += std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+      sum += std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                       (a[2] - b[2]) * (a[2] - b[2]));
       ++count;
     }
   const double shortest = scale * 0.15 * (count ? sum / double(count) : 1);
@@ -86,10 +90,11 @@ Mesh quadric_ellipsoids(const Mesh& mesh, const Analysis& analysis, double scale
 }
 
 std::vector<std::pair<std::uint32_t, std::uint32_t>> valid_pairs(const Mesh& mesh, double threshold,
-                                                                  std::size_t* edge_count) {
+                                                                 std::size_t* edge_count) {
   std::size_t nv = mesh.vertex_count();
   for (std::size_t i = 0; i < mesh.indices.size(); ++i)
-    if (mesh.indices[i] >= nv) throw Error("pairs: face " + std::to_string(i / 3) + " has an out-of-range vertex");
+    if (mesh.indices[i] >= nv)
+      throw Error("pairs: face " + std::to_string(i / 3) + " has an out-of-range vertex");
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
   std::vector<bool> referenced(nv, false);
   for (std::size_t f = 0; f < mesh.face_count(); ++f)
@@ -106,12 +111,13 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> valid_pairs(const Mesh& mes
     edges.reserve(pairs.size());
     for (auto& [a, b] : pairs) edges.push_back({a, b, 1});
     std::vector<core::Vec3> pos(nv);
-    for (std::size_t v = 0; v < nv; ++v) pos[v] = {mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2]};
+    for (std::size_t v = 0; v < nv; ++v)
+      pos[v] = {mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2]};
     std::vector<std::uint32_t> candidates;
     for (std::size_t v = 0; v < nv; ++v)
       if (referenced[v]) candidates.push_back(std::uint32_t(v));
-    // Same cap as a picture can show: beyond this the threshold is too large for the model.
-    auto close = core::close_pairs(pos, candidates, threshold, edges, 50'000'000);
+    // No per-vertex cap: the picture shows every pair within t (the simplifier keeps the nearest).
+    auto close = core::close_pairs(pos, candidates, threshold, edges, candidates.size());
     pairs.insert(pairs.end(), close.begin(), close.end());
   }
   return pairs;

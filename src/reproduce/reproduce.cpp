@@ -79,7 +79,8 @@ class Context {
     auto it = cache_.find(name);
     if (it != cache_.end()) return it->second;
     fs::path path = fs::path(opt_.data_dir) / name;
-    if (!fs::exists(path)) throw Error("reproduce: model '" + path.string() + "' is missing from the data folder");
+    if (!fs::exists(path))
+      throw Error("reproduce: model '" + path.string() + "' is missing from the data folder");
     log("loading " + name);
     return cache_.emplace(name, load_mesh(path.string())).first->second;
   }
@@ -114,6 +115,17 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+/// The simplifier as GH97 ran it: no link-condition test (GH97 has none: pair contraction must be
+/// free to join parts and create non-manifold edges), inversions forbidden (GH97 §6), and the
+/// library's area-weighted quadrics (HG99 §2; GH97 summed unweighted planes).
+SimplifyOptions gh97_options(std::size_t target_faces, double threshold = 0) {
+  SimplifyOptions o;
+  o.target_faces = target_faces;
+  o.threshold = threshold;
+  o.preserve_topology = false;
+  return o;
+}
+
 // --- GH97 Fig. 5: running times to a 10-face approximation ------------------------------------------
 // "Init" cannot be timed from outside the library, so it is measured as a run that stops after one
 // contraction (target = input faces - 1): selecting valid pairs, building the quadrics, choosing
@@ -126,25 +138,26 @@ FigureResult fig5(Context& cx) {
     double t;  // absolute pair threshold, model units (as the paper's t)
     double paper_init, paper_simplify;
   };
-  std::vector<Row> rows = {{"Bunny", "gh_bunny_zipper.ply", 0, 3.3, 12.0},
-                           {"Crater Lake (stand-in: Grand Canyon 179k)", "terrain_gcanyon_179k.ply", 0, 10.6, 36.0},
-                           {"Cow", "gh_cow.obj", 0, 0.22, 0.69},
-                           {"Cube Grid", "synth_cubes_10x10.ply", 0.12, 0.25, 0.17},
-                           {"Foot", "gh_foot_bones.off", 0, 0.16, 0.41},
-                           {"Foot", "gh_foot_bones.off", 0.318, 0.43, 0.76}};
+  std::vector<Row> rows = {
+      {"Bunny", "gh_bunny_zipper.ply", 0, 3.3, 12.0},
+      {"Crater Lake (stand-in: Grand Canyon 179k)", "terrain_gcanyon_179k.ply", 0, 10.6, 36.0},
+      {"Cow", "gh_cow.obj", 0, 0.22, 0.69},
+      {"Cube Grid", "synth_cubes_10x10.ply", 0.12, 0.25, 0.17},
+      {"Foot", "gh_foot_bones.off", 0, 0.16, 0.41},
+      {"Foot", "gh_foot_bones.off", 0.318, 0.43, 0.76}};
   if (cx.quick()) rows = {rows[2], rows[3], rows[5]};
   const int reps = cx.quick() ? 1 : 3;
-  Table table{{"model", "faces", "t", "init (s)", "simplify (s)", "total (s)", "output faces", "paper init (s)",
-               "paper simplify (s)"},
+  Table table{{"model", "faces", "t", "init (s)", "simplify (s)", "total (s)", "output faces",
+               "paper init (s)", "paper simplify (s)"},
               {}};
-  Plot plot{"GH97 Fig. 5: time to a 10-face approximation", "", "seconds", false, false, {}, {}, false};
-  Series init{"init (ours)", {}, {}, {}, Series::Style::Bars}, simp{"simplify (ours)", {}, {}, {}, Series::Style::Bars};
+  Plot plot{"GH97 Fig. 5: time to a 10-face approximation", "", "seconds", false, true, {}, {}, false};
+  Series init{"init (ours)", {}, {}, {}, Series::Style::Bars},
+      simp{"simplify (ours)", {}, {}, {}, Series::Style::Bars};
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const Row& row = rows[i];
     const Mesh& m = cx.model(row.file);
     cx.log("fig5: " + std::string(row.file) + " t=" + num(row.t));
-    SimplifyOptions o;
-    o.threshold = row.t;
+    SimplifyOptions o = gh97_options(10, row.t);
     double t_init = std::numeric_limits<double>::infinity(), t_total = t_init;
     std::size_t out_faces = 0;
     for (int k = 0; k < reps; ++k) {
@@ -171,8 +184,8 @@ FigureResult fig5(Context& cx) {
   plot.series = {init, simp};
   cx.write(r, table, plot,
            "Init = a run stopped after one contraction (target = input faces - 1); simplify = full run to 10 "
-           "faces minus init; minimum of " + std::to_string(reps) +
-               " runs, model already in memory. Paper: SGI Indigo2, R10000 195 MHz.");
+           "faces minus init; minimum of " +
+               std::to_string(reps) + " runs, model already in memory. Paper: SGI Indigo2, R10000 195 MHz.");
   return r;
 }
 
@@ -184,40 +197,62 @@ FigureResult fig6(Context& cx) {
   std::vector<std::size_t> targets = {10, 100, 500, 1000, 2000, 3000};
   const double paper_fixed[] = {0.0062, 0.00032, 2.4e-05, 5.7e-06, 1.2e-06, 3.6e-07};
   const double paper_opt[] = {0.0054, 0.00025, 1.3e-05, 3.4e-06, 7.9e-07, 2.6e-07};
-  Table table{{"faces", "fixed E_i", "optimal E_i", "reduction", "fixed E_i/diag^2", "optimal E_i/diag^2",
-               "paper fixed", "paper optimal", "paper reduction"},
+  // Two configurations: as GH97 (no link-condition test) and the library default (topology kept,
+  // which can stop above the target: the actual face counts are in the first column).
+  Table table{{"faces (actual)", "fixed E_i", "optimal E_i", "reduction", "optimal E_i/diag^2",
+               "fixed, topology kept", "optimal, topology kept", "reduction, topology kept", "paper fixed",
+               "paper optimal", "paper reduction"},
               {}};
   Series sf{"fixed (endpoints/midpoint)", {}, {}, {}, Series::Style::LinePoints};
   Series so{"optimal", {}, {}, {}, Series::Style::LinePoints};
-  Series pf{"paper fixed", {}, {}, {}, Series::Style::Points}, po{"paper optimal", {}, {}, {}, Series::Style::Points};
+  Series pf{"paper fixed (its units)", {}, {}, {}, Series::Style::Points},
+      po{"paper optimal (its units)", {}, {}, {}, Series::Style::Points};
   for (std::size_t i = 0; i < targets.size(); ++i) {
-    double e[2];
-    for (int k = 0; k < 2; ++k) {
-      SimplifyOptions o;
-      o.target_faces = targets[i];
-      o.placement = k == 0 ? Placement::Endpoints : Placement::Optimal;
+    double e[4];
+    std::size_t faces[4];
+    for (int k = 0; k < 4; ++k) {
+      SimplifyOptions o = gh97_options(targets[i]);
+      o.placement = k % 2 == 0 ? Placement::Endpoints : Placement::Optimal;
+      o.preserve_topology = k >= 2;
       Mesh approx = simplify(cow, o).mesh;
+      faces[k] = approx.face_count();
       e[k] = cx.E(cow, approx);
     }
     cx.log("fig6: " + std::to_string(targets[i]) + " faces: fixed " + num(e[0]) + " optimal " + num(e[1]));
     double red = e[0] > 0 ? 100 * (e[0] - e[1]) / e[0] : 0;
+    double red_topo = e[2] > 0 ? 100 * (e[2] - e[3]) / e[2] : 0;
     double pred = 100 * (paper_fixed[i] - paper_opt[i]) / paper_fixed[i];
-    table.rows.push_back({std::to_string(targets[i]), num(e[0]), num(e[1]), num(red, "%.1f%%"),
-                          num(e[0] / (diag * diag)), num(e[1] / (diag * diag)), num(paper_fixed[i]),
+    std::string count = std::to_string(faces[0]);
+    for (int k = 1; k < 4; ++k)
+      if (faces[k] != faces[0]) count += "/" + std::to_string(faces[k]);
+    table.rows.push_back({count, num(e[0]), num(e[1]), num(red, "%.1f%%"), num(e[1] / (diag * diag)),
+                          num(e[2]), num(e[3]), num(red_topo, "%.1f%%"), num(paper_fixed[i]),
                           num(paper_opt[i]), num(pred, "%.1f%%")});
     double x = double(targets[i]);
     sf.x.push_back(x), sf.y.push_back(e[0]), so.x.push_back(x), so.y.push_back(e[1]);
     pf.x.push_back(x), pf.y.push_back(paper_fixed[i]), po.x.push_back(x), po.y.push_back(paper_opt[i]);
     r.values["fixed_" + std::to_string(targets[i])] = e[0];
     r.values["optimal_" + std::to_string(targets[i])] = e[1];
+    r.values["fixed_topology_" + std::to_string(targets[i])] = e[2];
+    r.values["optimal_topology_" + std::to_string(targets[i])] = e[3];
   }
-  Plot plot{"GH97 Fig. 6: E_i on the cow", "faces", "E_i (mean squared distance)", true, true, {}, {sf, so, pf, po},
+  Plot plot{"GH97 Fig. 6: E_i on the cow",
+            "faces",
+            "E_i (mean squared distance)",
+            true,
+            true,
+            {},
+            {sf, so, pf, po},
             false};
-  cx.write(r, table, plot,
-           "E_i of GH97 §6.1 with " + std::to_string(cx.samples()) +
-               " samples (seed 1), area-weighted quadrics (library default), Placement::Endpoints as 'fixed'. "
-               "Our cow's bounding-box diagonal is " + num(diag) + "; the paper's model units are unknown, so "
-               "compare the reduction column and the relative trend.");
+  cx.write(
+      r, table, plot,
+      "E_i of GH97 §6.1 with " + std::to_string(cx.samples()) +
+          " samples (seed 1), area-weighted quadrics (library default), Placement::Endpoints as 'fixed'; "
+          "first columns and plot without the link-condition test (as GH97), then with it. "
+          "Our cow's bounding-box diagonal is " +
+          num(diag) +
+          "; the paper's model units are unknown, so "
+          "compare the reduction column and the relative trend.");
   return r;
 }
 
@@ -231,10 +266,7 @@ FigureResult fig7(Context& cx) {
   Table table{{"t", "t / diag", "E_250", "faces", "virtual pairs", "components"}, {}};
   Series s{"E_250 (ours)", {}, {}, {}, Series::Style::LinePoints};
   for (double t : ts) {
-    SimplifyOptions o;
-    o.target_faces = 250;
-    o.threshold = t;
-    o.preserve_topology = false;  // GH97 has no link-condition test: aggregation must be able to join parts
+    SimplifyOptions o = gh97_options(250, t);
     SimplifyResult res = simplify(foot, o);
     double e = cx.E(foot, res.mesh);
     cx.log("fig7: t=" + num(t) + " E=" + num(e));
@@ -243,18 +275,27 @@ FigureResult fig7(Context& cx) {
     s.x.push_back(t), s.y.push_back(e);
     r.values["E_t" + num(t)] = e;
   }
-  Plot plot{"GH97 Fig. 7: E_250 on the foot", "pair threshold t (model units)", "E_250", false, false, {}, {s}, false};
+  Plot plot{"GH97 Fig. 7: E_250 on the foot",
+            "pair threshold t (model units)",
+            "E_250",
+            false,
+            false,
+            {},
+            {s},
+            false};
   cx.write(r, table, plot,
            "Foot bones (4,204 faces, bounding-box diagonal " + num(diag) +
                "), 250-face approximations, preserve_topology off (as GH97), E_i with " +
-               std::to_string(cx.samples()) + " samples. The paper plots E_250 for t in model units; its "
+               std::to_string(cx.samples()) +
+               " samples. The paper plots E_250 for t in model units; its "
                "Fig. 17 uses t = 0.318.");
   return r;
 }
 
 // --- GH97 Figs. 15-17: clustering vs edge contraction vs pair contraction on the foot ----------------
 FigureResult fig15_17(Context& cx) {
-  FigureResult r{"gh97_fig15_17", "GH97 Figs. 15-17: clustering vs edge vs pair contraction (foot)", "", {}, {}};
+  FigureResult r{
+      "gh97_fig15_17", "GH97 Figs. 15-17: clustering vs edge vs pair contraction (foot)", "", {}, {}};
   const Mesh& foot = cx.model("gh_foot_bones.off");
   MeshInfo orig = mesh_info(foot);
   struct Method {
@@ -266,15 +307,15 @@ FigureResult fig15_17(Context& cx) {
   ClusterOptions co;
   co.grid[0] = 11, co.grid[1] = 4, co.grid[2] = 4;  // the paper's 11 x 4 x 4 grid (long axis = x here)
   methods.push_back({"uniform clustering 11x4x4 (Fig. 15)", cluster(foot, co), "262 faces"});
-  SimplifyOptions o;
-  o.target_faces = 250;
-  o.preserve_topology = false;
+  SimplifyOptions o = gh97_options(250);
   methods.push_back({"edge contraction t=0 (Fig. 16)", simplify(foot, o).mesh, "250 faces"});
   o.threshold = 0.318;
-  methods.push_back({"pair contraction t=0.318 (Fig. 17)", simplify(foot, o).mesh, "250 faces, 61 non-manifold edges"});
+  methods.push_back(
+      {"pair contraction t=0.318 (Fig. 17)", simplify(foot, o).mesh, "250 faces, 61 non-manifold edges"});
   Table table{{"method", "faces", "E_i", "components", "non-manifold edges", "paper"}, {}};
-  table.rows.push_back({"original (Fig. 14)", std::to_string(foot.face_count()), "0", std::to_string(orig.components),
-                        std::to_string(orig.non_manifold_edges), "4,204 faces"});
+  table.rows.push_back({"original (Fig. 14)", std::to_string(foot.face_count()), "0",
+                        std::to_string(orig.components), std::to_string(orig.non_manifold_edges),
+                        "4,204 faces"});
   Plot plot{"GH97 Figs. 15-17: foot at ~250 faces", "", "E_i", false, false, {}, {}, false};
   Series se{"E_i", {}, {}, {}, Series::Style::Bars};
   const char* keys[] = {"cluster", "edge", "pair"};
@@ -284,7 +325,8 @@ FigureResult fig15_17(Context& cx) {
     double e = cx.E(foot, methods[i].mesh);
     cx.log("fig15-17: " + methods[i].name + " E=" + num(e));
     table.rows.push_back({methods[i].name, std::to_string(methods[i].mesh.face_count()), num(e),
-                          std::to_string(info.components), std::to_string(info.non_manifold_edges), methods[i].paper});
+                          std::to_string(info.components), std::to_string(info.non_manifold_edges),
+                          methods[i].paper});
     plot.categories.push_back(cats[i]);
     se.x.push_back(double(i)), se.y.push_back(e);
     r.values[std::string(keys[i]) + "_E"] = e;
@@ -293,16 +335,17 @@ FigureResult fig15_17(Context& cx) {
     r.values[std::string(keys[i]) + "_faces"] = double(methods[i].mesh.face_count());
   }
   plot.series = {se};
-  cx.write(r, table, plot,
-           "Components and non-manifold edges as `qem info` counts them (src/analysis/mesh_info.cpp); E_i with " +
-               std::to_string(cx.samples()) + " samples.");
+  cx.write(
+      r, table, plot,
+      "Components and non-manifold edges as `qem info` counts them (src/analysis/mesh_info.cpp); E_i with " +
+          std::to_string(cx.samples()) + " samples.");
   return r;
 }
 
 // --- HG99 Fig. 8: optimal vs actual aspect ratio on the simplified ellipsoid ---------------------------
 FigureResult hg99_fig8(Context& cx) {
-  FigureResult r{"hg99_fig8", "HG99 Fig. 8: optimal vs actual triangle aspect ratio (ellipsoid, 800 faces)", "", {},
-                 {}};
+  FigureResult r{
+      "hg99_fig8", "HG99 Fig. 8: optimal vs actual triangle aspect ratio (ellipsoid, 800 faces)", "", {}, {}};
   const Mesh& ell = cx.model("synth_ellipsoid_11k_curv.ply");
   const double axes[3] = {1, 2, 3};
   SimplifyOptions o;
@@ -331,8 +374,8 @@ FigureResult hg99_fig8(Context& cx) {
       if (optimal[f] >= lo && optimal[f] < lo + width) act.push_back(a.aspect[f]), opt.push_back(optimal[f]);
     if (act.empty()) continue;
     stats::Summary sa = stats::summarize(act), so = stats::summarize(opt);
-    table.rows.push_back({num(lo, "%.2f") + "-" + num(lo + width, "%.2f"), std::to_string(act.size()), num(sa.mean),
-                          num(sa.stddev), num(so.mean)});
+    table.rows.push_back({num(lo, "%.2f") + "-" + num(lo + width, "%.2f"), std::to_string(act.size()),
+                          num(sa.mean), num(sa.stddev), num(so.mean)});
     buckets.x.push_back(so.mean), buckets.y.push_back(sa.mean), buckets.err.push_back(sa.stddev);
   }
   stats::Summary all_act = stats::summarize(a.aspect), all_opt = stats::summarize(optimal);
@@ -342,14 +385,21 @@ FigureResult hg99_fig8(Context& cx) {
   r.values["mean_optimal"] = all_opt.mean;
   cx.log("hg99 fig8: correlation " + num(corr));
   Plot plot{"HG99 Fig. 8: aspect ratios, ellipsoid at " + std::to_string(approx.face_count()) + " faces",
-            "theoretically optimal aspect ratio sqrt|k1/k2|", "actual aspect ratio", false, false, {},
-            {pts, buckets}, true};
-  cx.write(r, table, plot,
-           "Ellipsoid (axes 1, 2, 3; 11,280 faces) simplified to " + std::to_string(approx.face_count()) +
-               " faces with the default options. Actual = Steiner-circumellipse axis ratio (HG99 §3.2); optimal = "
-               "sqrt|k1/k2| (HG99 eq. 34) from the analytic curvatures at the triangle's centroid projected "
-               "radially onto the ellipsoid. Pearson correlation (all triangles) = " + num(corr, "%.3f") +
-               "; mean actual " + num(all_act.mean) + ", mean optimal " + num(all_opt.mean) + ".");
+            "theoretically optimal aspect ratio sqrt|k1/k2|",
+            "actual aspect ratio",
+            false,
+            false,
+            {},
+            {pts, buckets},
+            true};
+  cx.write(
+      r, table, plot,
+      "Ellipsoid (axes 1, 2, 3; 11,280 faces) simplified to " + std::to_string(approx.face_count()) +
+          " faces with the default options. Actual = Steiner-circumellipse axis ratio (HG99 §3.2); optimal = "
+          "sqrt|k1/k2| (HG99 eq. 34) from the analytic curvatures at the triangle's centroid projected "
+          "radially onto the ellipsoid. Pearson correlation (all triangles) = " +
+          num(corr, "%.3f") + "; mean actual " + num(all_act.mean) + ", mean optimal " + num(all_opt.mean) +
+          ".");
   return r;
 }
 
@@ -368,7 +418,8 @@ void ellipsoid_curvatures(const double axes[3], const double p[3], double& k1, d
     g[i] = h[i] * q[i];
   }
   double g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
-  double gauss = (g[0] * g[0] * h[1] * h[2] + g[1] * g[1] * h[0] * h[2] + g[2] * g[2] * h[0] * h[1]) / (g2 * g2);
+  double gauss =
+      (g[0] * g[0] * h[1] * h[2] + g[1] * g[1] * h[0] * h[2] + g[2] * g[2] * h[0] * h[1]) / (g2 * g2);
   double mean = (g2 * (h[0] + h[1] + h[2]) - (g[0] * g[0] * h[0] + g[1] * g[1] * h[1] + g[2] * g[2] * h[2])) /
                 (2 * g2 * std::sqrt(g2));
   double d = std::sqrt(std::max(0.0, mean * mean - gauss));
@@ -382,7 +433,8 @@ std::vector<FigureResult> run(const Options& options) {
   Context cx(options);
   std::vector<FigureResult> out;
   auto want = [&](const std::string& id) {
-    return options.only.empty() || std::find(options.only.begin(), options.only.end(), id) != options.only.end();
+    return options.only.empty() ||
+           std::find(options.only.begin(), options.only.end(), id) != options.only.end();
   };
   if (want("gh97_fig5")) out.push_back(fig5(cx));
   if (want("gh97_fig6")) out.push_back(fig6(cx));

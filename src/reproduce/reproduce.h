@@ -14,18 +14,18 @@ inline const std::vector<std::string> kFigures = {"gh97_fig5", "gh97_fig6", "gh9
                                                   "hg99_fig8"};
 
 struct Options {
-  std::string data_dir;  ///< folder holding gh_cow.obj, gh_foot_bones.off, ...
-  std::string out_dir;   ///< created if missing
-  bool quick = false;    ///< fewer samples, models and repetitions (seconds instead of minutes)
-  std::vector<std::string> only;                   ///< subset of kFigures (empty = all)
-  std::function<void(const std::string&)> log;     ///< progress lines, may be empty
+  std::string data_dir;           ///< folder holding gh_cow.obj, gh_foot_bones.off, ...
+  std::string out_dir;            ///< created if missing
+  bool quick = false;             ///< fewer samples, models and repetitions (seconds instead of minutes)
+  std::vector<std::string> only;  ///< subset of kFigures (empty = all)
+  std::function<void(const std::string&)> log;  ///< progress lines, may be empty
 };
 
 struct FigureResult {
   std::string id, title;
-  std::string markdown;                 ///< the table (and a short note), as written to <id>.md
-  std::vector<std::string> files;       ///< paths written
-  std::map<std::string, double> values; ///< key numbers, for tests and the summary
+  std::string markdown;                  ///< the table (and a short note), as written to <id>.md
+  std::vector<std::string> files;        ///< paths written
+  std::map<std::string, double> values;  ///< key numbers, for tests and the summary
 };
 
 /// Principal curvatures (k1 >= k2, positive on a convex surface) of the ellipsoid

@@ -29,10 +29,14 @@ std::string tick_label(double v) {
 std::string escape(const std::string& s) {
   std::string out;
   for (char c : s) {
-    if (c == '<') out += "&lt;";
-    else if (c == '>') out += "&gt;";
-    else if (c == '&') out += "&amp;";
-    else out += c;
+    if (c == '<')
+      out += "&lt;";
+    else if (c == '>')
+      out += "&gt;";
+    else if (c == '&')
+      out += "&amp;";
+    else
+      out += c;
   }
   return out;
 }
@@ -59,7 +63,8 @@ struct Axis {
     }
     double span = hi - lo, raw = span / 6, mag = std::pow(10.0, std::floor(std::log10(raw)));
     double step = mag * (raw / mag < 1.5 ? 1 : raw / mag < 3.5 ? 2 : raw / mag < 7.5 ? 5 : 10);
-    for (double v = std::ceil(lo / step) * step; v <= hi + step * 1e-9; v += step) out.push_back(std::abs(v) < step * 1e-9 ? 0 : v);
+    for (double v = std::ceil(lo / step) * step; v <= hi + step * 1e-9; v += step)
+      out.push_back(std::abs(v) < step * 1e-9 ? 0 : v);
     return out;
   }
 };
@@ -114,15 +119,15 @@ std::string render_svg(const Plot& plot, int width, int height) {
   ax.p0 = left, ax.p1 = width - right;
   ay.p0 = height - bottom, ay.p1 = top;
 
-  std::string s = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + std::to_string(width) + "\" height=\"" +
-                  std::to_string(height) + "\" viewBox=\"0 0 " + std::to_string(width) + " " + std::to_string(height) +
-                  "\" font-family=\"sans-serif\" font-size=\"12\">\n";
+  std::string s = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + std::to_string(width) +
+                  "\" height=\"" + std::to_string(height) + "\" viewBox=\"0 0 " + std::to_string(width) +
+                  " " + std::to_string(height) + "\" font-family=\"sans-serif\" font-size=\"12\">\n";
   s += "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
-  s += "<text x=\"" + fmt(width / 2.0) + "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">" + escape(plot.title) +
-       "</text>\n";
+  s += "<text x=\"" + fmt(width / 2.0) + "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">" +
+       escape(plot.title) + "</text>\n";
   // Frame, grid and ticks.
-  s += "<rect x=\"" + fmt(left) + "\" y=\"" + fmt(top) + "\" width=\"" + fmt(width - left - right) + "\" height=\"" +
-       fmt(height - top - bottom) + "\" fill=\"none\" stroke=\"black\"/>\n";
+  s += "<rect x=\"" + fmt(left) + "\" y=\"" + fmt(top) + "\" width=\"" + fmt(width - left - right) +
+       "\" height=\"" + fmt(height - top - bottom) + "\" fill=\"none\" stroke=\"black\"/>\n";
   if (bars) {
     for (std::size_t i = 0; i < plot.categories.size(); ++i)
       s += "<text x=\"" + fmt(ax.map(double(i))) + "\" y=\"" + fmt(height - bottom + 18) +
@@ -130,27 +135,27 @@ std::string render_svg(const Plot& plot, int width, int height) {
   } else {
     for (double v : ax.ticks()) {
       double px = ax.map(v);
-      s += "<line x1=\"" + fmt(px) + "\" y1=\"" + fmt(top) + "\" x2=\"" + fmt(px) + "\" y2=\"" + fmt(height - bottom) +
-           "\" stroke=\"#ddd\"/>\n";
+      s += "<line x1=\"" + fmt(px) + "\" y1=\"" + fmt(top) + "\" x2=\"" + fmt(px) + "\" y2=\"" +
+           fmt(height - bottom) + "\" stroke=\"#ddd\"/>\n";
       s += "<text x=\"" + fmt(px) + "\" y=\"" + fmt(height - bottom + 18) + "\" text-anchor=\"middle\">" +
            tick_label(v) + "</text>\n";
     }
   }
   for (double v : ay.ticks()) {
     double py = ay.map(v);
-    s += "<line x1=\"" + fmt(left) + "\" y1=\"" + fmt(py) + "\" x2=\"" + fmt(width - right) + "\" y2=\"" + fmt(py) +
-         "\" stroke=\"#ddd\"/>\n";
+    s += "<line x1=\"" + fmt(left) + "\" y1=\"" + fmt(py) + "\" x2=\"" + fmt(width - right) + "\" y2=\"" +
+         fmt(py) + "\" stroke=\"#ddd\"/>\n";
     s += "<text x=\"" + fmt(left - 6) + "\" y=\"" + fmt(py + 4) + "\" text-anchor=\"end\">" + tick_label(v) +
          "</text>\n";
   }
-  s += "<text x=\"" + fmt((left + width - right) / 2) + "\" y=\"" + fmt(height - 18.0) + "\" text-anchor=\"middle\">" +
-       escape(plot.x_label) + "</text>\n";
+  s += "<text x=\"" + fmt((left + width - right) / 2) + "\" y=\"" + fmt(height - 18.0) +
+       "\" text-anchor=\"middle\">" + escape(plot.x_label) + "</text>\n";
   s += "<text transform=\"translate(18," + fmt((top + height - bottom) / 2) +
        ") rotate(-90)\" text-anchor=\"middle\">" + escape(plot.y_label) + "</text>\n";
   if (plot.diagonal) {
     double a = std::max(ax.lo, ay.lo), b = std::min(ax.hi, ay.hi);
-    s += "<line x1=\"" + fmt(ax.map(a)) + "\" y1=\"" + fmt(ay.map(a)) + "\" x2=\"" + fmt(ax.map(b)) + "\" y2=\"" +
-         fmt(ay.map(b)) + "\" stroke=\"#888\" stroke-dasharray=\"4 3\"/>\n";
+    s += "<line x1=\"" + fmt(ax.map(a)) + "\" y1=\"" + fmt(ay.map(a)) + "\" x2=\"" + fmt(ax.map(b)) +
+         "\" y2=\"" + fmt(ay.map(b)) + "\" stroke=\"#888\" stroke-dasharray=\"4 3\"/>\n";
   }
 
   // Data. Bars of several series sit side by side within a category.
@@ -160,7 +165,8 @@ std::string render_svg(const Plot& plot, int width, int height) {
     const Series& se = plot.series[k];
     const char* color = kColors[k % 6];
     auto ok = [&](std::size_t i) {
-      return std::isfinite(se.x[i]) && std::isfinite(se.y[i]) && (!ax.log || se.x[i] > 0) && (!ay.log || se.y[i] > 0);
+      return std::isfinite(se.x[i]) && std::isfinite(se.y[i]) && (!ax.log || se.x[i] > 0) &&
+             (!ay.log || se.y[i] > 0);
     };
     if (se.style == Series::Style::Bars) {
       double slot = 0.8 / std::max(1, bar_series), w = slot * (ax.map(1) - ax.map(0));
@@ -177,14 +183,14 @@ std::string render_svg(const Plot& plot, int width, int height) {
         std::string pts;
         for (std::size_t i = 0; i < se.x.size() && i < se.y.size(); ++i)
           if (ok(i)) pts += fmt(ax.map(se.x[i])) + "," + fmt(ay.map(se.y[i])) + " ";
-        s += "<polyline fill=\"none\" stroke=\"" + std::string(color) + "\" stroke-width=\"1.5\" points=\"" + pts +
-             "\"/>\n";
+        s += "<polyline fill=\"none\" stroke=\"" + std::string(color) + "\" stroke-width=\"1.5\" points=\"" +
+             pts + "\"/>\n";
       }
       if (se.style != Series::Style::Line)
         for (std::size_t i = 0; i < se.x.size() && i < se.y.size(); ++i)
           if (ok(i))
-            s += "<circle cx=\"" + fmt(ax.map(se.x[i])) + "\" cy=\"" + fmt(ay.map(se.y[i])) + "\" r=\"3\" fill=\"" +
-                 color + "\"/>\n";
+            s += "<circle cx=\"" + fmt(ax.map(se.x[i])) + "\" cy=\"" + fmt(ay.map(se.y[i])) +
+                 "\" r=\"3\" fill=\"" + color + "\"/>\n";
     }
     for (std::size_t i = 0; i < se.err.size() && i < se.y.size(); ++i) {
       if (!ok(i) || !(se.err[i] > 0)) continue;
@@ -194,18 +200,24 @@ std::string render_svg(const Plot& plot, int width, int height) {
       s += "<line x1=\"" + fmt(px) + "\" y1=\"" + fmt(ay.map(lo)) + "\" x2=\"" + fmt(px) + "\" y2=\"" +
            fmt(ay.map(hi)) + "\" stroke=\"" + color + "\"/>\n";
       for (double yy : {lo, hi})
-        s += "<line x1=\"" + fmt(px - 4) + "\" y1=\"" + fmt(ay.map(yy)) + "\" x2=\"" + fmt(px + 4) + "\" y2=\"" +
-             fmt(ay.map(yy)) + "\" stroke=\"" + color + "\"/>\n";
+        s += "<line x1=\"" + fmt(px - 4) + "\" y1=\"" + fmt(ay.map(yy)) + "\" x2=\"" + fmt(px + 4) +
+             "\" y2=\"" + fmt(ay.map(yy)) + "\" stroke=\"" + color + "\"/>\n";
     }
   }
   // Legend, top right inside the frame.
   double ly = top + 16;
+  std::size_t labelled = 0;
+  for (const Series& se : plot.series) labelled += !se.label.empty();
+  if (labelled)
+    s += "<rect x=\"" + fmt(width - right - 176) + "\" y=\"" + fmt(top + 3) + "\" width=\"172\" height=\"" +
+         fmt(16.0 * double(labelled) + 4) + "\" fill=\"white\" fill-opacity=\"0.85\" stroke=\"#ccc\"/>\n";
   for (std::size_t k = 0; k < plot.series.size(); ++k) {
     if (plot.series[k].label.empty()) continue;
     double lx = width - right - 170;
-    s += "<rect x=\"" + fmt(lx) + "\" y=\"" + fmt(ly - 9) + "\" width=\"12\" height=\"10\" fill=\"" + kColors[k % 6] +
-         "\"/>\n";
-    s += "<text x=\"" + fmt(lx + 18) + "\" y=\"" + fmt(ly) + "\">" + escape(plot.series[k].label) + "</text>\n";
+    s += "<rect x=\"" + fmt(lx) + "\" y=\"" + fmt(ly - 9) + "\" width=\"12\" height=\"10\" fill=\"" +
+         kColors[k % 6] + "\"/>\n";
+    s += "<text x=\"" + fmt(lx + 18) + "\" y=\"" + fmt(ly) + "\">" + escape(plot.series[k].label) +
+         "</text>\n";
     ly += 16;
   }
   s += "</svg>\n";

@@ -1,0 +1,68 @@
+#include "algorithm_options.h"
+
+#include <map>
+
+namespace qem::cli {
+
+void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
+  sub->add_option("--threshold,-t", a.threshold,
+                  "Pair threshold t of GH97 3.2 (model units): vertices closer than t are valid pairs, so "
+                  "separate parts can join (0 = edges only)");
+  sub->add_option("--threshold-rel", a.threshold_rel, "As --threshold, relative to the bounding-box diagonal");
+  sub->add_option("--weighting", a.weighting, "Plane weighting: area (HG99), uniform (GH97), angle")
+      ->check(CLI::IsMember({"area", "uniform", "angle"}))
+      ->capture_default_str();
+  sub->add_option("--placement", a.placement,
+                  "Where the new vertex goes: optimal (then segment, then endpoints), segment, midpoint, endpoints")
+      ->check(CLI::IsMember({"optimal", "segment", "midpoint", "endpoints"}))
+      ->capture_default_str();
+  sub->add_option("--boundary-weight", a.boundary_weight,
+                  "Penalty weight of the boundary constraint planes (GH97 6), times the squared edge length; "
+                  "0 = off")
+      ->capture_default_str();
+  sub->add_flag("--lock-border", a.lock_border, "Boundary vertices never move");
+  sub->add_option("--inversion", a.inversion, "Contractions that flip a face: forbid, penalize, or off (GH97 6)")
+      ->check(CLI::IsMember({"forbid", "penalize", "off"}))
+      ->capture_default_str();
+  sub->add_option("--max-turn", a.max_turn, "A face normal turning by more than this (degrees, < 90) is a flip")
+      ->capture_default_str();
+  sub->add_flag("--allow-non-manifold", a.allow_non_manifold,
+                "Do not check the link condition: edge collapses may create non-manifold edges");
+  sub->add_flag("--weld", a.weld, "Merge exactly coincident vertices on load (default for STL)");
+  sub->add_flag("--no-weld", a.no_weld, "Never weld on load, not even STL");
+}
+
+SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
+  static const std::map<std::string, Weighting> weightings{
+      {"area", Weighting::Area}, {"uniform", Weighting::Uniform}, {"angle", Weighting::Angle}};
+  static const std::map<std::string, Placement> placements{{"optimal", Placement::Optimal},
+                                                           {"segment", Placement::Segment},
+                                                           {"midpoint", Placement::Midpoint},
+                                                           {"endpoints", Placement::Endpoints}};
+  static const std::map<std::string, InversionPolicy> inversions{
+      {"forbid", InversionPolicy::Forbid}, {"penalize", InversionPolicy::Penalize}, {"off", InversionPolicy::Ignore}};
+  SimplifyOptions opt;
+  if (a.threshold_rel > 0) {
+    opt.threshold = a.threshold_rel;
+    opt.threshold_is_relative = true;
+  } else {
+    opt.threshold = a.threshold;
+  }
+  opt.weighting = weightings.at(a.weighting);
+  opt.placement = placements.at(a.placement);
+  opt.inversion = inversions.at(a.inversion);
+  opt.boundary_weight = a.boundary_weight;
+  opt.max_normal_turn_degrees = a.max_turn;
+  opt.lock_border = a.lock_border;
+  opt.preserve_topology = !a.allow_non_manifold;
+  return opt;
+}
+
+LoadOptions to_load_options(const AlgorithmArgs& a) {
+  LoadOptions load;
+  if (a.weld) load.weld = Weld::On;
+  if (a.no_weld) load.weld = Weld::Off;
+  return load;
+}
+
+}  // namespace qem::cli

@@ -1,0 +1,32 @@
+// The simplification options shared by every command that runs the simplifier (`simplify`,
+// `lod`): one definition of their flags, help texts and defaults, one translation to
+// SimplifyOptions / LoadOptions.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "qem/io.h"
+#include "qem/simplify.h"
+
+namespace qem::cli {
+
+struct AlgorithmArgs {
+  double threshold = 0, threshold_rel = 0;
+  std::string weighting = "area", placement = "optimal", inversion = "forbid";
+  double boundary_weight = SimplifyOptions{}.boundary_weight;
+  double max_turn = SimplifyOptions{}.max_normal_turn_degrees;
+  bool lock_border = false, allow_non_manifold = false;
+  bool weld = false, no_weld = false;
+};
+
+/// Adds --threshold(-rel), --weighting, --placement, --boundary-weight, --lock-border, --inversion,
+/// --max-turn, --allow-non-manifold, --weld, --no-weld to `sub`.
+void add_algorithm_options(CLI::App* sub, AlgorithmArgs& args);
+
+/// The algorithm part of SimplifyOptions (stop criteria are left to the caller).
+SimplifyOptions to_simplify_options(const AlgorithmArgs& args);
+
+LoadOptions to_load_options(const AlgorithmArgs& args);
+
+}  // namespace qem::cli
