@@ -19,11 +19,12 @@ struct ReplayArgs {
   std::string record, output;
   std::size_t faces = 0;
   double ratio = 0;
-  bool ascii = false, quiet = false;
+  bool ascii = false, quiet = false, force = false;
 };
 
 int run_replay(const ReplayArgs& a) {
   if (a.ratio < 0 || a.ratio > 1) throw Error("--ratio must be in (0, 1]");
+  refuse_to_overwrite(a.record, a.output, a.force);
   Stopwatch total;
   const Record record = read_record(a.record);
   // No target: the whole run (M_g). --ratio as in `qem simplify`: of the faces the run started from.
@@ -61,6 +62,7 @@ const bool registered = register_command(12, [](CLI::App& app) {
                   "Stop at or below this fraction of the recorded run's input faces");
   sub->add_flag("--ascii", args->ascii, "Write PLY / STL as text instead of binary");
   sub->add_flag("--quiet,-q", args->quiet, "No summary on stderr");
+  sub->add_flag("--force", args->force, "Allow the output to overwrite the record file");
   return [args] { return run_replay(*args); };
 });
 
