@@ -117,7 +117,8 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> valid_pairs(const Mesh& mes
     for (std::size_t v = 0; v < nv; ++v)
       if (referenced[v]) candidates.push_back(std::uint32_t(v));
     // No per-vertex cap: the picture shows every pair within t (the simplifier keeps the nearest).
-    auto close = core::close_pairs(pos, candidates, threshold, edges, candidates.size());
+    // The same pairs the simplifier uses (GH97 Fig. 19).
+    auto close = core::close_pairs(pos, candidates, threshold, edges, core::kMaxThresholdPairsPerVertex);
     pairs.insert(pairs.end(), close.begin(), close.end());
   }
   return pairs;

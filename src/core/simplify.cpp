@@ -60,8 +60,6 @@ namespace {
 
 using namespace core;
 constexpr double kInf = std::numeric_limits<double>::infinity();
-// Each vertex pairs with at most this many of its nearest vertices within t (see close_pairs).
-constexpr std::size_t kMaxThresholdPairsPerVertex = 8;
 
 // Heap keys are floats (24 significant bits). The same model scaled or moved gives costs that
 // differ only by rounding noise (~1e-16 relative); rounded to float they tie, ties break on the

@@ -64,7 +64,7 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> close_pairs(const std::vect
     return it != edges.end() && it->lo == a && it->hi == b;
   };
   // Ask for more than needed: edge neighbours are among the nearest and do not count.
-  const std::size_t ask = std::min(candidates.size(), 2 * max_per_vertex + 8);
+  const std::size_t ask = std::min(candidates.size(), 2 * std::min(max_per_vertex, candidates.size()) + 8);
   std::vector<std::uint32_t> found(ask);
   std::vector<double> dist2(ask);
   std::vector<std::pair<double, std::uint32_t>> near;

@@ -20,6 +20,9 @@ struct Edge {
 std::vector<Edge> unique_edges(const std::vector<std::uint32_t>& triangles, const VertexLists& vertex_faces,
                                std::size_t vertex_count);
 
+/// How many of its nearest vertices within t each vertex pairs with (see close_pairs).
+inline constexpr std::size_t kMaxThresholdPairsPerVertex = 8;
+
 /// Pairs (i < j) of `candidates` with |p_i - p_j| < t that are not edges (GH97 §3.2 rule 2), each
 /// vertex pairing with at most its `max_per_vertex` nearest such vertices: GH97 warns that a large
 /// t creates O(n^2) pairs; this keeps the closest ones, which are the ones aggregation needs, and
