@@ -5,6 +5,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -13,6 +14,7 @@
 #include "qem/error.h"
 #include "qem/io.h"
 #include "qem/measure.h"
+#include "qem/progressive.h"
 #include "view/http_server.h"
 #include "view/lod_manifest.h"
 #include "view/scene.h"
@@ -34,8 +36,47 @@ struct ViewArgs {
   std::size_t samples = 200000;
 };
 
+// True when `path` starts with the magic of a contraction record (docs/record-format.md).
+bool is_record_file(const std::string& path) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return false;
+  char magic[8] = {};
+  const bool ok = std::fread(magic, 1, sizeof magic, f) == sizeof magic;
+  std::fclose(f);
+  return ok && std::memcmp(magic, "QEMREC\x1a\n", sizeof magic) == 0;
+}
+
+// A record becomes a chain (GH97 §3: one run holds M_n ... M_g): the original and then halving
+// face counts down to the record's final mesh, all replayed in one pass.
+view::ViewScene record_scene(const std::string& path) {
+  const Record record = read_record(path);
+  std::vector<std::size_t> targets;
+  for (std::size_t f = record.base.face_count();; f /= 2) {
+    targets.push_back(std::max(f, record.final_faces()));
+    if (f <= record.final_faces()) break;
+  }
+  view::ViewScene scene;
+  scene.mode = view::ViewMode::Chain;
+  const std::string stem = std::filesystem::path(path).stem().string();
+  for (ReplayLevel& l : replay_levels(record, targets)) {
+    view::ViewLevel level;
+    level.name = stem + " @ " + std::to_string(l.mesh.face_count()) + " faces";
+    level.error = l.max_error;
+    level.mesh = std::move(l.mesh);
+    scene.levels.push_back(std::move(level));
+  }
+  scene.title = stem;
+  return scene;
+}
+
 view::ViewScene build_scene(const ViewArgs& a) {
   if (a.chain && a.compare) throw Error("--chain and --compare exclude each other");
+  if (a.inputs.size() == 1 && is_record_file(a.inputs[0])) {
+    if (a.compare) throw Error("--compare needs two meshes, not a record");
+    view::ViewScene scene = record_scene(a.inputs[0]);
+    if (!a.title.empty()) scene.title = a.title;
+    return scene;
+  }
   view::ViewScene scene;
   std::vector<view::ManifestLevel> entries;
   if (a.inputs.size() == 1 && view::is_manifest_path(a.inputs[0])) {
@@ -111,7 +152,8 @@ const bool registered = register_command(80, [](CLI::App& app) -> std::function<
   CLI::App* cmd =
       app.add_subcommand("view", "Show meshes in a local web page (three.js): LOD slider, compare, heat map");
   cmd->add_option("meshes", args->inputs,
-                  "Mesh files (OBJ, PLY, STL, OFF), or one LOD manifest (.json) listing the levels")
+                  "Mesh files (OBJ, PLY, STL, OFF), or one LOD manifest (.json) listing the levels, or one "
+                  "contraction record (`qem simplify --record`): a slider over its face counts")
       ->required();
   cmd->add_flag(
       "--chain", args->chain,
