@@ -96,6 +96,18 @@ std::vector<ParserCase> parser_cases() {
            "0e00000003090000000e0000000d000000030a0000000b0000000f000000030a0000000f0000000e000000"),
        Expect::Either},
 
+      // --- found by fuzz_ply in CI (scripts/fuzz.sh under UBSan): an ASCII face index written as a
+      // huge real (8.5e32) was converted to long long before any range check, which is undefined
+      // behaviour. It must be rejected as "expected a number".
+      {"ply_ascii_index_as_huge_real", FileFormat::Ply,
+       ply_header("ascii", "element vertex 3\n" + ply_xyz + "element face 1\nproperty list uchar int vertex_indices\n") +
+           kTriangleVerts + "3 0 1 8.55556e+32\n",
+       Expect::Reject},
+      {"ply_ascii_index_as_integral_real", FileFormat::Ply,
+       ply_header("ascii", "element vertex 3\n" + ply_xyz + "element face 1\nproperty list uchar int vertex_indices\n") +
+           kTriangleVerts + "3 0 1 2.0\n",
+       Expect::Either},
+
       // --- OBJ ---------------------------------------------------------------------------------
       {"obj_face_without_vertices", FileFormat::Obj, "f 1 2 3\n", Expect::Reject},
       {"obj_index_zero", FileFormat::Obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", Expect::Reject},

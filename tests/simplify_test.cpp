@@ -326,6 +326,8 @@ TEST(Simplify, InvalidInputAndOptionsThrow) {
   nan.positions[4] = std::nan("");
   EXPECT_THROW(simplify(nan, faces(2)), Error);
   EXPECT_THROW(simplify(test::tetrahedron(), SimplifyOptions{}), Error);  // no stop criterion
+  // Found by fuzz_simplify: coordinates near the top of the double range overflowed the frame.
+  EXPECT_THROW(simplify(test::transformed(test::tetrahedron(), 1e307, 0, 0, 0), faces(2)), Error);
   SimplifyOptions o = faces(2);
   o.max_normal_turn_degrees = 95;
   EXPECT_THROW(simplify(test::tetrahedron(), o), Error);

@@ -216,7 +216,11 @@ void Simplifier::prepare_input() {
       hi[k] = std::max(hi[k], in_.positions[3 * v + k]);
     }
   if (!used.empty()) {
-    center_ = {(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2};
+    // Beyond 1e300 the quadrics (squared distances times areas) overflow double precision.
+    for (int k = 0; k < 3; ++k)
+      if (!(std::fabs(lo[k]) <= 1e300 && std::fabs(hi[k]) <= 1e300))
+        throw Error("coordinates beyond 1e300 in magnitude cannot be simplified in double precision");
+    center_ = {lo[0] / 2 + hi[0] / 2, lo[1] / 2 + hi[1] / 2, lo[2] / 2 + hi[2] / 2};
     scale_ = length(Vec3(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]));
     if (!(scale_ > 0) || !std::isfinite(scale_)) scale_ = 1;
   }

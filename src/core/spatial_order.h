@@ -35,7 +35,12 @@ std::vector<std::uint32_t> morton_order(std::size_t n, PointOf point_of) {
   std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(n);
   for (std::size_t i = 0; i < n; ++i) {
     const Vec3 p = point_of(i);
-    const auto cell = [&](double x, double l) { return std::uint64_t((x - l) * scale); };
+    // Clamped before the conversion (NaN, inf and out-of-range doubles must never reach the cast:
+    // undefined behaviour, found by fuzz_simplify with coordinates near 1e308).
+    const auto cell = [&](double x, double l) {
+      const double c = (x - l) * scale;
+      return c >= 0 ? std::uint64_t(std::min(c, double((1 << 21) - 1))) : std::uint64_t(0);
+    };
     keyed[i] = {spread_bits_3d(cell(p.x, lo.x)) | spread_bits_3d(cell(p.y, lo.y)) << 1 |
                     spread_bits_3d(cell(p.z, lo.z)) << 2,
                 std::uint32_t(i)};

@@ -288,8 +288,11 @@ class BodyReader {
     if (ascii_) {
       if (!text_.skip_space()) fail("unexpected end of file (the header declares more data)");
       if (!text_.try_integer(v, false)) {
+        // An integral value written as a real ("3.0"). The range check comes first: converting a
+        // double outside long long's range is undefined behaviour (found by fuzz_ply).
         double d;
-        if (!text_.try_number(d) || d != static_cast<double>(static_cast<long long>(d)))
+        if (!text_.try_number(d) || !(d >= -9.2e18 && d <= 9.2e18) ||
+            d != static_cast<double>(static_cast<long long>(d)))
           fail_expected_number();
         v = static_cast<long long>(d);
       }
