@@ -42,6 +42,23 @@ void refuse_to_overwrite(const std::string& input, const std::string& output, bo
     throw Error("refusing to overwrite the input '" + input + "' with the output (use --force)");
 }
 
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (unsigned char c : s) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += char(c);
+    } else if (c < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", c);
+      out += buf;
+    } else {
+      out += char(c);
+    }
+  }
+  return out + "\"";
+}
+
 std::string json_number(double x) {
   if (!std::isfinite(x)) return "null";
   char buf[64];

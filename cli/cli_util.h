@@ -31,6 +31,9 @@ bool same_file(const std::string& a, const std::string& b);
 /// must never destroy its own input by accident.
 void refuse_to_overwrite(const std::string& input, const std::string& output, bool force);
 
+/// A JSON string literal: quotes, backslashes and control characters escaped (paths may hold them).
+std::string json_string(const std::string& s);
+
 /// A number for a JSON document: shortest round-trip form, `null` for NaN/inf.
 std::string json_number(double x);
 

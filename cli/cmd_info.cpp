@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 
+#include "cli_util.h"
 #include "command.h"
 #include "qem/io.h"
 #include "qem/mesh_info.h"
@@ -27,25 +28,6 @@ const char* format_name(FileFormat f) {
       break;
   }
   return "unknown";
-}
-
-/// JSON string literal (paths may hold quotes, backslashes or control
-/// characters).
-std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (unsigned char c : s) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += char(c);
-    } else if (c < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      out += buf;
-    } else {
-      out += char(c);
-    }
-  }
-  return out + "\"";
 }
 
 /// Shortest text that reads back to the same double (%.17g is exact but noisy).

@@ -31,21 +31,6 @@ struct LodArgs {
   bool ascii = false, json = false, quiet = false;
 };
 
-std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (unsigned char c : s) {
-    if (c == '"' || c == '\\')
-      out += '\\', out += char(c);
-    else if (c < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      out += buf;
-    } else
-      out += char(c);
-  }
-  return out + "\"";
-}
-
 int run_lod(const LodArgs& a) {
   if (a.ratios.empty() == a.faces.empty()) throw Error("give the levels with either --ratios or --faces");
   for (double r : a.ratios)

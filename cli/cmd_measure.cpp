@@ -21,23 +21,6 @@ struct MeasureArgs {
   bool json = false;
 };
 
-std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (unsigned char c : s) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += char(c);
-    } else if (c < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      out += buf;
-    } else {
-      out += char(c);
-    }
-  }
-  return out + "\"";
-}
-
 void print_json(const MeasureArgs& a, const Mesh& original, const Mesh& approx, const MeasureResult& r,
                 double seconds) {
   auto num = [](double x) { return json_number(x); };

@@ -30,29 +30,25 @@ inline std::string validity_problem(const Mesh& m) {
   return {};
 }
 
-/// Edges used by more than two faces.
-inline std::size_t non_manifold_edges(const Mesh& m) {
+/// How many faces use each undirected edge.
+inline std::map<std::pair<std::uint32_t, std::uint32_t>, int> edge_face_counts(const Mesh& m) {
   std::map<std::pair<std::uint32_t, std::uint32_t>, int> count;
   for (std::size_t f = 0; f < m.face_count(); ++f)
-    for (int k = 0; k < 3; ++k) {
-      std::uint32_t a = m.indices[3 * f + k], b = m.indices[3 * f + (k + 1) % 3];
-      ++count[std::minmax(a, b)];
-    }
+    for (int k = 0; k < 3; ++k) ++count[std::minmax(m.indices[3 * f + k], m.indices[3 * f + (k + 1) % 3])];
+  return count;
+}
+
+/// Edges used by more than two faces.
+inline std::size_t non_manifold_edges(const Mesh& m) {
   std::size_t n = 0;
-  for (auto& [e, c] : count) n += c > 2;
+  for (auto& [e, c] : edge_face_counts(m)) n += c > 2;
   return n;
 }
 
 /// Edges used by exactly one face.
 inline std::size_t boundary_edges(const Mesh& m) {
-  std::map<std::pair<std::uint32_t, std::uint32_t>, int> count;
-  for (std::size_t f = 0; f < m.face_count(); ++f)
-    for (int k = 0; k < 3; ++k) {
-      std::uint32_t a = m.indices[3 * f + k], b = m.indices[3 * f + (k + 1) % 3];
-      ++count[std::minmax(a, b)];
-    }
   std::size_t n = 0;
-  for (auto& [e, c] : count) n += c == 1;
+  for (auto& [e, c] : edge_face_counts(m)) n += c == 1;
   return n;
 }
 

@@ -483,15 +483,15 @@ bool Simplifier::flips(std::uint32_t a, std::uint32_t b, const Vec3& target) {
 // collapse must not stack two faces onto the same three vertices, and an interior edge whose two
 // ends both lie on a border must not pinch the border.
 bool Simplifier::is_edge_and_link_ok(std::uint32_t a, std::uint32_t b, bool& is_edge) {
-  const std::uint32_t s_nbr = ++stamp_, s_opp = ++stamp_, s_common = ++stamp_;
-  std::size_t shared = 0, opposite = 0;
+  const std::uint32_t s_nbr = ++stamp_, s_opp = ++stamp_;
+  std::size_t shared = 0;
   for (std::uint32_t f : vertex_faces_[a]) {
     if (!face_alive_[f]) continue;
     const std::uint32_t* t = &tri_[3 * std::size_t(f)];
     if (face_has(f, b)) {
       ++shared;
       for (int k = 0; k < 3; ++k)
-        if (t[k] != a && t[k] != b && mark_[t[k]] != s_opp) mark_[t[k]] = s_opp, ++opposite;
+        if (t[k] != a && t[k] != b) mark_[t[k]] = s_opp;
     } else {
       for (int k = 0; k < 3; ++k)
         if (t[k] != a && mark_[t[k]] != s_opp) mark_[t[k]] = s_nbr;
@@ -501,7 +501,6 @@ bool Simplifier::is_edge_and_link_ok(std::uint32_t a, std::uint32_t b, bool& is_
   if (!is_edge || !opt_.preserve_topology || aggregated_[a] || aggregated_[b]) return true;
   if (shared == 2 && boundary_[a] && boundary_[b]) return false;  // would pinch the border
   // Neighbours of b that are also neighbours of a but not opposite corners break the link condition.
-  std::size_t common_opposite = 0;
   for (std::uint32_t f : vertex_faces_[b]) {
     if (!face_alive_[f] || face_has(f, a)) continue;
     const std::uint32_t* t = &tri_[3 * std::size_t(f)];
@@ -510,10 +509,7 @@ bool Simplifier::is_edge_and_link_ok(std::uint32_t a, std::uint32_t b, bool& is_
       std::uint32_t x = t[k];
       if (x == b) continue;
       if (mark_[x] == s_nbr) return false;
-      if (mark_[x] == s_opp || mark_[x] == s_common) {
-        ++opp_corners;
-        if (mark_[x] == s_opp) mark_[x] = s_common, ++common_opposite;
-      }
+      if (mark_[x] == s_opp) ++opp_corners;
     }
     // A face (b, x, y) with x, y both opposite corners: if a also has a face (a, x, y), the
     // collapse would stack two faces on the same vertices (the tetrahedron case).
@@ -523,7 +519,6 @@ bool Simplifier::is_edge_and_link_ok(std::uint32_t a, std::uint32_t b, bool& is_
         if (face_alive_[g] && face_has(g, x) && face_has(g, y)) return false;
     }
   }
-  (void)common_opposite;
   return true;
 }
 
