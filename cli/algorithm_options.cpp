@@ -16,6 +16,16 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
                   "Where the new vertex goes: optimal (then segment, then endpoints), segment, midpoint, endpoints")
       ->check(CLI::IsMember({"optimal", "segment", "midpoint", "endpoints"}))
       ->capture_default_str();
+  sub->add_option("--scheme", a.scheme,
+                  "Order of contractions: greedy (strictly cheapest first, GH97's heap) or passes (rank, sort, "
+                  "contract each vertex at most once a pass; faster)")
+      ->check(CLI::IsMember({"greedy", "passes"}))
+      ->capture_default_str();
+  sub->add_option("--greedy-below", a.greedy_below,
+                  "With --scheme passes, finish in the greedy order below this many faces (0 = never)")
+      ->capture_default_str();
+  sub->add_option("--threads", a.threads, "Threads for re-costing pairs between passes (0 = all; same result)")
+      ->capture_default_str();
   sub->add_option("--boundary-weight", a.boundary_weight,
                   "Penalty weight of the boundary constraint planes (GH97 6), times the squared edge length; "
                   "0 = off")
@@ -51,6 +61,9 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
   opt.weighting = weightings.at(a.weighting);
   opt.placement = placements.at(a.placement);
   opt.inversion = inversions.at(a.inversion);
+  opt.scheme = a.scheme == "passes" ? Scheme::Passes : Scheme::Greedy;
+  opt.greedy_below_faces = a.greedy_below;
+  opt.threads = a.threads;
   opt.boundary_weight = a.boundary_weight;
   opt.max_normal_turn_degrees = a.max_turn;
   opt.lock_border = a.lock_border;

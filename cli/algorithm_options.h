@@ -14,13 +14,16 @@ namespace qem::cli {
 struct AlgorithmArgs {
   double threshold = 0, threshold_rel = 0;
   std::string weighting = "area", placement = "optimal", inversion = "forbid";
+  std::string scheme = "passes";
+  std::size_t greedy_below = SimplifyOptions{}.greedy_below_faces;
+  unsigned threads = 0;
   double boundary_weight = SimplifyOptions{}.boundary_weight;
   double max_turn = SimplifyOptions{}.max_normal_turn_degrees;
   bool lock_border = false, allow_non_manifold = false;
   bool weld = false, no_weld = false;
 };
 
-/// Adds --threshold(-rel), --weighting, --placement, --boundary-weight, --lock-border, --inversion,
+/// Adds --threshold(-rel), --weighting, --placement, --scheme, --greedy-below, --threads, --boundary-weight, --lock-border, --inversion,
 /// --max-turn, --allow-non-manifold, --weld, --no-weld to `sub`.
 void add_algorithm_options(CLI::App* sub, AlgorithmArgs& args);
 

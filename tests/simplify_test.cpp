@@ -1,5 +1,7 @@
 // Behaviour of qem::simplify on small meshes built in code: stop criteria, boundaries, inversion,
-// topology, messy input, scale invariance, determinism, aggregation (GH97 §3-§6).
+// topology, messy input, scale invariance, determinism, aggregation (GH97 §3-§6). Every test runs
+// under both orders of contraction: the greedy heap and the pass-based scheme (passes to the very
+// end, so these small meshes exercise it too).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -28,13 +30,28 @@ Mesh bumpy_sphere(int level) {
   return m;
 }
 
-SimplifyOptions faces(std::size_t n) {
+Scheme current_scheme = Scheme::Greedy;
+
+/// Default options under the scheme of the running test.
+SimplifyOptions options() {
   SimplifyOptions o;
+  o.scheme = current_scheme;
+  o.greedy_below_faces = 0;
+  return o;
+}
+
+class Simplify : public ::testing::TestWithParam<Scheme> {
+ protected:
+  void SetUp() override { current_scheme = GetParam(); }
+};
+
+SimplifyOptions faces(std::size_t n) {
+  SimplifyOptions o = options();
   o.target_faces = n;
   return o;
 }
 
-TEST(Simplify, ReachesFaceTargetAndKeepsClosedManifoldClosed) {
+TEST_P(Simplify, ReachesFaceTargetAndKeepsClosedManifoldClosed) {
   Mesh in = bumpy_sphere(4);  // 5120 faces
   SimplifyResult r = simplify(in, faces(500));
   EXPECT_EQ(r.stop_reason, StopReason::TargetReached);
@@ -47,22 +64,22 @@ TEST(Simplify, ReachesFaceTargetAndKeepsClosedManifoldClosed) {
   EXPECT_EQ(2 * r.mesh.vertex_count(), r.mesh.face_count() + 4);
 }
 
-TEST(Simplify, RatioAndVertexTargets) {
+TEST_P(Simplify, RatioAndVertexTargets) {
   Mesh in = bumpy_sphere(3);  // 1280 faces, 642 vertices
-  SimplifyOptions o;
+  SimplifyOptions o = options();
   o.target_ratio = 0.25;
   SimplifyResult r = simplify(in, o);
   EXPECT_LE(r.mesh.face_count(), 320u);
   EXPECT_GE(r.mesh.face_count(), 318u);
 
-  SimplifyOptions v;
+  SimplifyOptions v = options();
   v.target_vertices = 100;
   SimplifyResult rv = simplify(in, v);
   EXPECT_LE(rv.mesh.vertex_count(), 100u);
   EXPECT_GE(rv.mesh.vertex_count(), 99u);
 
   // Combined: the first target reached wins.
-  SimplifyOptions both;
+  SimplifyOptions both = options();
   both.target_faces = 1000;
   both.target_vertices = 50;
   SimplifyResult rb = simplify(in, both);
@@ -70,9 +87,9 @@ TEST(Simplify, RatioAndVertexTargets) {
   EXPECT_GT(rb.mesh.vertex_count(), 50u);
 }
 
-TEST(Simplify, MaxErrorBoundsEveryContraction) {
+TEST_P(Simplify, MaxErrorBoundsEveryContraction) {
   Mesh in = test::height_field(30, bump);
-  SimplifyOptions o;
+  SimplifyOptions o = options();
   o.max_error = 0.002;
   SimplifyResult r = simplify(in, o);
   EXPECT_EQ(r.stop_reason, StopReason::ErrorLimit);
@@ -84,7 +101,7 @@ TEST(Simplify, MaxErrorBoundsEveryContraction) {
   SimplifyResult loose = simplify(in, o);
   EXPECT_LT(loose.mesh.face_count(), r.mesh.face_count());
   // Relative to the diagonal: the same limit expressed both ways gives the same result.
-  SimplifyOptions rel;
+  SimplifyOptions rel = options();
   Box box = bounding_box(in);
   rel.max_error = 0.002 / box.diagonal();
   rel.max_error_is_relative = true;
@@ -92,16 +109,16 @@ TEST(Simplify, MaxErrorBoundsEveryContraction) {
   EXPECT_EQ(rr.mesh.indices, r.mesh.indices);
 }
 
-TEST(Simplify, FlatGridCollapsesWithZeroError) {
+TEST_P(Simplify, FlatGridCollapsesWithZeroError) {
   Mesh in = test::grid(10);
-  SimplifyOptions o;
+  SimplifyOptions o = options();
   o.max_error = 1e-9;
   SimplifyResult r = simplify(in, o);
   EXPECT_LE(r.mesh.face_count(), 4u);
   for (std::size_t v = 0; v < r.mesh.vertex_count(); ++v) EXPECT_NEAR(r.mesh.positions[3 * v + 2], 0, 1e-12);
 }
 
-TEST(Simplify, UnreachableTargetStopsCleanly) {
+TEST_P(Simplify, UnreachableTargetStopsCleanly) {
   // A tetrahedron cannot lose a face without becoming non-manifold: the target is unreachable.
   SimplifyResult r = simplify(test::tetrahedron(), faces(1));
   EXPECT_EQ(r.stop_reason, StopReason::NoValidPair);
@@ -114,7 +131,7 @@ TEST(Simplify, UnreachableTargetStopsCleanly) {
   EXPECT_EQ(validity_problem(s.mesh), "");
 }
 
-TEST(Simplify, BoundaryPlanesKeepTheBorderOnTheSquare) {
+TEST_P(Simplify, BoundaryPlanesKeepTheBorderOnTheSquare) {
   // GH97 §6: constraint planes along boundary edges hold the border in place. They are a penalty,
   // not a hard constraint, so measure how far boundary vertices drift from the square's border
   // with and without them.
@@ -142,7 +159,7 @@ TEST(Simplify, BoundaryPlanesKeepTheBorderOnTheSquare) {
   EXPECT_LT(max_drift(simplify(in, o).mesh), max_drift(kept.mesh) + 1e-12) << "a larger weight holds it tighter";
 }
 
-TEST(Simplify, LockBorderKeepsBoundaryVerticesExactly) {
+TEST_P(Simplify, LockBorderKeepsBoundaryVerticesExactly) {
   Mesh in = test::height_field(16, bump);
   SimplifyOptions o = faces(100);
   o.lock_border = true;
@@ -166,7 +183,7 @@ TEST(Simplify, LockBorderKeepsBoundaryVerticesExactly) {
   EXPECT_GT(r.mesh.face_count(), 0u);
 }
 
-TEST(Simplify, InversionCheckKeepsHeightFieldFacingUp) {
+TEST_P(Simplify, InversionCheckKeepsHeightFieldFacingUp) {
   Mesh in = test::height_field(30, [](double x, double y) { return 0.3 * std::sin(9 * x) * std::sin(7 * y); });
   SimplifyResult r = simplify(in, faces(60));
   for (std::size_t f = 0; f < r.mesh.face_count(); ++f) {
@@ -179,7 +196,7 @@ TEST(Simplify, InversionCheckKeepsHeightFieldFacingUp) {
   }
 }
 
-TEST(Simplify, ScaleAndPositionDoNotChangeTheResult) {
+TEST_P(Simplify, ScaleAndPositionDoNotChangeTheResult) {
   Mesh in = bumpy_sphere(3);
   SimplifyResult base = simplify(in, faces(200));
   for (double scale : {1e-3, 1e3}) {
@@ -194,7 +211,7 @@ TEST(Simplify, ScaleAndPositionDoNotChangeTheResult) {
   }
 }
 
-TEST(Simplify, DeterministicOutput) {
+TEST_P(Simplify, DeterministicOutput) {
   Mesh in = bumpy_sphere(4);
   SimplifyResult a = simplify(in, faces(777));
   SimplifyResult b = simplify(in, faces(777));
@@ -202,7 +219,7 @@ TEST(Simplify, DeterministicOutput) {
   EXPECT_EQ(a.mesh.indices, b.mesh.indices);
 }
 
-TEST(Simplify, UnmovedVerticesKeepExactInputCoordinates) {
+TEST_P(Simplify, UnmovedVerticesKeepExactInputCoordinates) {
   Mesh in = bumpy_sphere(3);
   SimplifyResult r = simplify(in, faces(1200));  // a few contractions only
   std::size_t exact = 0;
@@ -215,7 +232,7 @@ TEST(Simplify, UnmovedVerticesKeepExactInputCoordinates) {
   EXPECT_GE(exact, r.mesh.vertex_count() - 2 * (in.face_count() - r.mesh.face_count()));
 }
 
-TEST(Simplify, MessyInputIsCleanedNotCrashedOn) {
+TEST_P(Simplify, MessyInputIsCleanedNotCrashedOn) {
   Mesh in = bumpy_sphere(2);
   const std::size_t nv = in.vertex_count();
   in.positions.insert(in.positions.end(), {9, 9, 9, -9, -9, -9});  // unreferenced vertices
@@ -230,7 +247,7 @@ TEST(Simplify, MessyInputIsCleanedNotCrashedOn) {
   EXPECT_LE(r.mesh.face_count(), 60u);
 }
 
-TEST(Simplify, NonManifoldInputSupported) {
+TEST_P(Simplify, NonManifoldInputSupported) {
   // Two cubes sharing an edge (a non-manifold edge) and a fin glued on a sphere's edge.
   Mesh cubes = test::concatenated(test::cube(), test::transformed(test::cube(), 1, 1, 1, 0));
   // Weld the shared edge: cube 2's (0,0,z) corners are cube 1's (1,1,z) corners.
@@ -247,7 +264,7 @@ TEST(Simplify, NonManifoldInputSupported) {
   EXPECT_GT(r.mesh.face_count(), 0u);
 }
 
-TEST(Simplify, ThresholdPairsJoinSeparateParts) {
+TEST_P(Simplify, ThresholdPairsJoinSeparateParts) {
   // Two tetrahedra facing each other across a gap of 0.05 (GH97 §3.2, Fig. 3). Edges only: each
   // is stuck at 4 faces. With pairs closer than t, the facing corners contract, the two facing
   // triangles land on the same vertices with opposite orientations and cancel: one closed
@@ -278,7 +295,7 @@ TEST(Simplify, ThresholdPairsJoinSeparateParts) {
   EXPECT_EQ(simplify(two, rel).virtual_pairs, 3u);
 }
 
-TEST(Simplify, AggregatedCubesSimplifyPastTheirSeparateLimit) {
+TEST_P(Simplify, AggregatedCubesSimplifyPastTheirSeparateLimit) {
   // GH97 Fig. 3: a 3 x 3 grid of unit cubes 0.1 apart. Alone, each cube stops at a tetrahedron
   // (36 faces in all); aggregated through threshold pairs, the joints may go non-manifold and the
   // whole simplifies further.
@@ -295,7 +312,7 @@ TEST(Simplify, AggregatedCubesSimplifyPastTheirSeparateLimit) {
   EXPECT_EQ(validity_problem(joined.mesh), "");
 }
 
-TEST(Simplify, EveryPolicyGivesAValidMesh) {
+TEST_P(Simplify, EveryPolicyGivesAValidMesh) {
   Mesh in = bumpy_sphere(3);
   for (Weighting w : {Weighting::Area, Weighting::Uniform, Weighting::Angle})
     for (Placement p : {Placement::Optimal, Placement::Segment, Placement::Midpoint, Placement::Endpoints})
@@ -308,7 +325,7 @@ TEST(Simplify, EveryPolicyGivesAValidMesh) {
       }
 }
 
-TEST(Simplify, OptimalPlacementBeatsFixedPlacement) {
+TEST_P(Simplify, OptimalPlacementBeatsFixedPlacement) {
   // GH97 Fig. 6: optimal placement has lower error than endpoints/midpoint.
   Mesh in = bumpy_sphere(4);
   SimplifyOptions o = faces(300);
@@ -318,7 +335,7 @@ TEST(Simplify, OptimalPlacementBeatsFixedPlacement) {
   EXPECT_LT(optimal.max_error, fixed.max_error);
 }
 
-TEST(Simplify, InvalidInputAndOptionsThrow) {
+TEST_P(Simplify, InvalidInputAndOptionsThrow) {
   Mesh bad = test::tetrahedron();
   bad.indices[5] = 99;
   EXPECT_THROW(simplify(bad, faces(2)), Error);
@@ -333,7 +350,7 @@ TEST(Simplify, InvalidInputAndOptionsThrow) {
   EXPECT_THROW(simplify(test::tetrahedron(), o), Error);
 }
 
-TEST(Simplify, EmptyAndTinyInputs) {
+TEST_P(Simplify, EmptyAndTinyInputs) {
   SimplifyResult empty = simplify(Mesh{}, faces(10));
   EXPECT_EQ(empty.mesh.face_count(), 0u);
   EXPECT_EQ(empty.stop_reason, StopReason::AlreadyBelowTarget);
@@ -342,3 +359,6 @@ TEST(Simplify, EmptyAndTinyInputs) {
 }
 
 }  // namespace
+
+INSTANTIATE_TEST_SUITE_P(Schemes, Simplify, ::testing::Values(Scheme::Greedy, Scheme::Passes),
+                         [](const ::testing::TestParamInfo<Scheme>& info) { return std::string(to_string(info.param)); });

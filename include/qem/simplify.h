@@ -28,6 +28,15 @@ enum class Placement {
   Endpoints,  ///< the better endpoint or the midpoint ("fixed placement" of GH97 Fig. 6)
 };
 
+/// The order in which contractions are made.
+enum class Scheme {
+  /// Strictly cheapest first, one at a time, from an updatable heap: exactly GH97 §4.
+  Greedy,
+  /// In passes (the scheme of meshoptimizer): rank every candidate, sort them, and contract the
+  /// cheap ones in order, each vertex at most once a pass; then re-rank. Far fewer cache misses.
+  Passes,
+};
+
 /// What happens to a contraction that would flip a neighbouring face (GH97 §6).
 enum class InversionPolicy { Forbid, Penalize, Ignore };
 
@@ -42,6 +51,7 @@ enum class StopReason {
 const char* to_string(StopReason reason);
 const char* to_string(Weighting w);
 const char* to_string(Placement p);
+const char* to_string(Scheme s);
 
 /// The whole contraction sequence of one run (GH97 §3: M_n, M_n-1, ..., M_g), in input vertex and
 /// face indices, so that any intermediate mesh can be rebuilt (see qem/progressive.h).
@@ -84,6 +94,13 @@ struct SimplifyOptions {
   double max_normal_turn_degrees = 75;
   /// Refuse edge collapses that break the link condition (non-manifold edges, duplicate faces).
   bool preserve_topology = true;
+  Scheme scheme = Scheme::Passes;
+  /// Scheme::Passes finishes in the greedy order once the mesh has at most this many faces: the
+  /// heap is then small enough to stay in cache, and the last contractions shape a coarse result
+  /// the most (0 = passes to the end).
+  std::size_t greedy_below_faces = 20000;
+  /// Threads for the parts that split without changing the result (0 = all hardware threads).
+  unsigned threads = 0;
 
   /// If set, every contraction is appended to this log (cleared first).
   ContractionLog* record = nullptr;
@@ -110,5 +127,10 @@ struct SimplifyResult {
 /// move keep their exact input coordinates. Deterministic: the same input and options give the
 /// same output. Throws qem::Error on invalid options or indices.
 SimplifyResult simplify(MeshView input, const SimplifyOptions& options);
+
+/// The same, consuming the input: its index array is released (left empty) as soon as the
+/// simplifier holds its own copy of the faces, which lowers the peak memory on large meshes.
+/// The positions are kept: unmoved vertices are copied from them at the end.
+SimplifyResult simplify(Mesh&& input, const SimplifyOptions& options);
 
 }  // namespace qem

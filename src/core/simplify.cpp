@@ -16,10 +16,12 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <thread>
 
 #include "core/indexed_heap.h"
 #include "core/placement.h"
 #include "core/quadric.h"
+#include "core/radix_sort.h"
 #include "core/spatial_order.h"
 #include "core/valid_pairs.h"
 #include "core/vertex_lists.h"
@@ -55,6 +57,13 @@ const char* to_string(Placement p) {
   }
   return "?";
 }
+const char* to_string(Scheme s) {
+  switch (s) {
+    case Scheme::Greedy: return "greedy";
+    case Scheme::Passes: return "passes";
+  }
+  return "?";
+}
 
 namespace {
 
@@ -78,6 +87,8 @@ enum PairState : std::uint8_t {
 class Simplifier {
  public:
   Simplifier(MeshView input, const SimplifyOptions& options) : in_(input), opt_(options) {}
+  /// The input's index array, released once prepare_input has copied the faces (simplify(Mesh&&)).
+  std::vector<std::uint32_t>* consumed_indices = nullptr;
 
   SimplifyResult run();
 
@@ -88,6 +99,13 @@ class Simplifier {
   void compute_quadrics();
   void select_pairs();
   void resolve_targets();
+
+  // --- the two orders of contraction ------------------------------------------------------------
+  void run_greedy();
+  void run_passes();
+  bool try_contract(std::uint32_t p);
+  bool report_progress(std::size_t start_faces);
+  void recost_dirty_pairs();
 
   // --- the contraction loop ------------------------------------------------------------------
   bool pair_cost(std::uint32_t p, double& cost);
@@ -100,6 +118,9 @@ class Simplifier {
   void record_contraction(double error);
   bool kill_if_coincident(std::uint32_t f, std::size_t own);
   void unblock_around(std::uint32_t v);
+  void forget(std::uint32_t p) {
+    if (!passes_) heap_.remove(p);
+  }
   bool done() const { return faces_alive_ <= target_faces_ || vertices_alive_ <= target_vertices_; }
   double normalized_error(double q_error, double weight) const {
     return weight > 0 ? std::sqrt(q_error / weight) : std::sqrt(q_error);
@@ -129,6 +150,7 @@ class Simplifier {
 
   MeshView in_;
   const SimplifyOptions& opt_;
+  bool passes_ = opt_.scheme == Scheme::Passes;
 
   // Normalised frame: p_work = (p_in - center_) / scale_.
   Vec3 center_;
@@ -157,8 +179,14 @@ class Simplifier {
   // always does after a contraction, since quadrics only grow) is not sifted down the heap; the
   // pair is re-keyed when it reaches the top. Keys are lower bounds and the popped pair's key is
   // verified current, so the order is exactly GH97's greedy order at a fraction of the heap work.
-  std::vector<double> cost_;
+  // Costs are rounded to float (round_key), so float storage is exact.
+  std::vector<float> cost_;
   IndexedHeap heap_;
+  // Passes: a pair whose cost must be recomputed before the next ranking, and the pass in which
+  // each vertex last took part in a contraction (each vertex contracts at most once a pass, so
+  // every other cost ranked in the pass stays exact).
+  std::vector<std::uint8_t> dirty_;
+  std::vector<std::uint32_t> touched_in_pass_;
 
   // Stamps for set membership without clearing (one array, fresh stamp per query).
   std::vector<std::uint32_t> mark_;
@@ -173,6 +201,8 @@ class Simplifier {
   std::size_t blocked_by_error_ = 0, blocked_by_topology_ = 0, blocked_by_inversion_ = 0;
   std::size_t virtual_pairs_ = 0;
   std::uint32_t last_kept_ = 0, last_removed_ = 0;
+  std::size_t next_progress_ = 0;
+  double max_error_norm_done_ = 0;
 
   SimplifyResult result_;
 };
@@ -224,22 +254,21 @@ void Simplifier::prepare_input() {
     scale_ = length(Vec3(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]));
     if (!(scale_ > 0) || !std::isfinite(scale_)) scale_ = 1;
   }
-  std::vector<Vec3> input_pos(nv);
-  for (std::uint32_t v : used)
-    input_pos[v] = (Vec3(in_.positions[3 * v], in_.positions[3 * v + 1], in_.positions[3 * v + 2]) - center_) *
-                   (1.0 / scale_);
+  auto normalized = [&](std::uint32_t v) {
+    return (Vec3(in_.positions[3 * v], in_.positions[3 * v + 1], in_.positions[3 * v + 2]) - center_) * (1.0 / scale_);
+  };
 
   // Internal numbering along a Morton curve (see spatial_order.h); source_vertex_ maps back.
-  source_vertex_ = morton_order(used.size(), [&](std::size_t i) { return input_pos[used[i]]; });
+  source_vertex_ = morton_order(used.size(), [&](std::size_t i) { return normalized(used[i]); });
   for (std::uint32_t& v : source_vertex_) v = used[v];
+  std::vector<std::uint32_t>().swap(used);
   const std::uint32_t n = std::uint32_t(source_vertex_.size());
   std::vector<std::uint32_t> internal(nv, 0);
   pos_.resize(n);
   for (std::uint32_t i = 0; i < n; ++i) {
     internal[source_vertex_[i]] = i;
-    pos_[i] = input_pos[source_vertex_[i]];
+    pos_[i] = normalized(source_vertex_[i]);
   }
-  std::vector<Vec3>().swap(input_pos);
 
   // Faces bucketed by their lowest internal vertex (a counting sort: neighbouring faces end up
   // together in memory). Duplicates (same three vertices, either orientation) share a bucket:
@@ -446,14 +475,19 @@ bool Simplifier::pair_cost(std::uint32_t p, double& cost) {
 }
 
 void Simplifier::cost_pair(std::uint32_t p) {
+  if (passes_) {  // ranked again at the start of the next pass
+    pairs_[p].state = kInHeap;
+    dirty_[p] = 1;
+    return;
+  }
   double c;
   if (!pair_cost(p, c)) {
     pairs_[p].state = kLocked;
-    heap_.remove(p);
+    forget(p);
     return;
   }
   pairs_[p].state = kInHeap;
-  cost_[p] = c;
+  cost_[p] = float(c);
   if (!heap_.contains(p) || c < heap_.key_of(p)) heap_.update(p, c);
 }
 
@@ -622,7 +656,7 @@ void Simplifier::contract(std::uint32_t p, const Quadric& q, const Vec3& target)
   // Pairs: GH97 §4 "pair sets merge": b's pairs now start at a; the contracted pair and any pair
   // that now duplicates another (same two vertices) are removed.
   pairs_[p].state = kDead;
-  heap_.remove(p);
+  forget(p);
   const std::uint32_t s = ++stamp_;
   mark_[a] = s;
   scratch2_.clear();
@@ -635,7 +669,7 @@ void Simplifier::contract(std::uint32_t p, const Quadric& q, const Vec3& target)
       std::uint32_t o = v[0] == a ? v[1] : v[0];
       if (mark_[o] == s) {  // duplicate of a pair already kept (or a degenerate (a, a) pair)
         pairs_[r].state = kDead;
-        heap_.remove(r);
+        forget(r);
         continue;
       }
       mark_[o] = s;
@@ -652,10 +686,192 @@ void Simplifier::contract(std::uint32_t p, const Quadric& q, const Vec3& target)
   unblock_around(a);
 }
 
+// Passes: the cost of every pair marked dirty, on all threads (each pair is independent, so the
+// result does not depend on the thread count).
+void Simplifier::recost_dirty_pairs() {
+  const std::size_t np = pairs_.size();
+  auto sweep = [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::uint32_t p = std::uint32_t(i);
+      if (pairs_[p].state != kInHeap || !dirty_[p]) continue;
+      dirty_[p] = 0;
+      double c;
+      if (pair_cost(p, c)) cost_[p] = float(c);
+      else pairs_[p].state = kLocked;
+    }
+  };
+  const unsigned threads = opt_.threads > 0 ? opt_.threads : std::max(1u, std::thread::hardware_concurrency());
+  const std::size_t chunks = np < 65536 ? 1 : std::min<std::size_t>(threads, 64);
+  std::vector<std::thread> workers;
+  for (std::size_t t = 1; t < chunks; ++t) workers.emplace_back(sweep, np * t / chunks, np * (t + 1) / chunks);
+  sweep(0, np / chunks);
+  for (std::thread& w : workers) w.join();
+}
+
+// ---------------------------------------------------------------------------------------------
+// The order of contractions
+// ---------------------------------------------------------------------------------------------
+
+// Checks pair p against the topology, inversion and error limits and contracts it if it passes;
+// otherwise it is blocked (retried when its neighbourhood changes) or, an edge whose faces all
+// died, dropped.
+bool Simplifier::try_contract(std::uint32_t p) {
+  const std::uint32_t a = pairs_[p].v[0], b = pairs_[p].v[1];
+  bool is_edge = false;
+  if (!is_edge_and_link_ok(a, b, is_edge)) {
+    ++blocked_by_topology_;
+    block(p);
+    return false;
+  }
+  if (!is_edge && !pairs_[p].is_virtual) {
+    // An edge pair whose faces all died: at t = 0 only edges are valid pairs (GH97 §3.2).
+    pairs_[p].state = kDead;
+    return false;
+  }
+  Quadric q;
+  Placed placed;
+  placement_for(p, q, placed);
+  if (opt_.inversion == InversionPolicy::Forbid && flips(a, b, placed.position)) {
+    ++blocked_by_inversion_;
+    block(p);
+    return false;
+  }
+  double err = normalized_error(placed.error, q.weight);
+  if (err > max_error_norm_) {
+    ++blocked_by_error_;
+    block(p);
+    return false;
+  }
+  max_error_norm_done_ = std::max(max_error_norm_done_, err);
+  contract(p, q, placed.position);
+  ++result_.contractions;
+  if (opt_.record) record_contraction(err * scale_);
+  return true;
+}
+
+// Calls the progress callback every few thousand contractions; false if the caller cancelled.
+bool Simplifier::report_progress(std::size_t start_faces) {
+  if (!opt_.progress || result_.contractions < next_progress_) return true;
+  next_progress_ = result_.contractions + 4096;
+  const std::size_t span = start_faces > target_faces_ ? start_faces - target_faces_ : 1;
+  if (opt_.progress(double(start_faces - faces_alive_) / double(span))) return true;
+  result_.stop_reason = StopReason::Cancelled;
+  return false;
+}
+
+// GH97 §4 steps 3-5: every pair in a heap keyed by its cost; repeatedly contract the cheapest.
+void Simplifier::run_greedy() {
+  heap_.reset(pairs_.size());
+  cost_.assign(pairs_.size(), 0);
+  for (std::uint32_t p = 0; p < pairs_.size(); ++p) {
+    if (pairs_[p].state != kInHeap) continue;
+    double c;
+    if (pair_cost(p, c)) heap_.push_unordered(p, c), cost_[p] = float(c);
+    else pairs_[p].state = kLocked;
+  }
+  heap_.heapify();
+
+  const std::size_t start_faces = faces_alive_;
+  while (!done()) {
+    if (heap_.empty()) {
+      result_.stop_reason = blocked_by_error_ > 0 ? StopReason::ErrorLimit : StopReason::NoValidPair;
+      return;
+    }
+    if (!report_progress(start_faces)) return;
+    const std::uint32_t top = heap_.top();
+    if (cost_[top] > heap_.top_key()) {  // stale key: re-key and look again
+      heap_.update(top, cost_[top]);
+      continue;
+    }
+    try_contract(heap_.pop());
+  }
+}
+
+// The pass-based order (the scheme of meshoptimizer's simplifier, with GH97's costs and checks).
+// Each pass re-costs the pairs whose ends changed (one sweep in memory order, on all threads),
+// sorts every candidate by cost (radix sort), and chooses, cheapest first, pairs whose two ends
+// have not yet been chosen this pass, up to a quarter of the candidates and at most 1.5 times the
+// cost at that quarter (the rule of meshoptimizer). No two chosen pairs share a vertex, so each
+// one's cost is still exact when it is made, as in the greedy order; what differs is that the new
+// vertex's own pairs wait for the next pass. The chosen pairs are made in memory order within
+// bands of rising cost, which keeps the caches warm.
+void Simplifier::run_passes() {
+  constexpr double kPassCostSlack = 1.5;
+  constexpr double kPassShare = 0.25;
+  constexpr std::size_t kBands = 8;
+  const std::size_t np = pairs_.size();
+  cost_.assign(np, 0);
+  dirty_.assign(np, 1);
+  touched_in_pass_.assign(pos_.size(), 0);
+  std::vector<std::uint32_t> order, scratch, selected;
+  const std::size_t start_faces = faces_alive_;
+  for (std::uint32_t pass = 1; !done(); ++pass) {
+    if (faces_alive_ <= opt_.greedy_below_faces) {
+      passes_ = false;
+      run_greedy();
+      return;
+    }
+    recost_dirty_pairs();
+    order.clear();
+    order.reserve(np);
+    for (std::uint32_t p = 0; p < np; ++p)
+      if (pairs_[p].state == kInHeap) order.push_back(p);
+    if (order.empty()) {
+      result_.stop_reason = blocked_by_error_ > 0 ? StopReason::ErrorLimit : StopReason::NoValidPair;
+      return;
+    }
+    radix_sort_by_float_key(order, scratch, [&](std::uint32_t p) { return cost_[p]; });
+
+    // This pass's share of the candidates, and the cost it may reach. Neither depends on the
+    // target, so every target sees the same sequence of contractions, cut at a different point:
+    // a contraction record replays to exactly the mesh a direct run to that size gives.
+    const std::size_t share = std::max<std::size_t>(1, std::size_t(double(order.size()) * kPassShare));
+    const double cost_goal = share < order.size() ? kPassCostSlack * cost_[order[share]] : kInf;
+
+    // Choose this pass's contractions cheapest first, each vertex at most once...
+    selected.clear();
+    for (std::uint32_t p : order) {
+      if (selected.size() >= share) break;
+      if (cost_[p] > cost_goal && selected.size() > share / 10) break;
+      const std::uint32_t a = pairs_[p].v[0], b = pairs_[p].v[1];
+      if (touched_in_pass_[a] == pass || touched_in_pass_[b] == pass) continue;
+      touched_in_pass_[a] = touched_in_pass_[b] = pass;
+      selected.push_back(p);
+    }
+    // ...then make them in memory order (pair ids follow the Morton order of their ends), so the
+    // contractions walk the mesh's arrays instead of jumping across them in cost order. No
+    // chosen pair shares an end with another, so each one's cost is still exact when it is made;
+    // the topology and inversion checks run on the mesh as it is at that moment.
+    // The choice is made in kBands bands of rising cost, each band in memory order: a run that
+    // reaches its target during a pass has made the cheapest of the pass's contractions, spread
+    // over the whole mesh, as the greedy order would.
+    const std::size_t n = selected.size();
+    for (std::size_t band = 0; band < kBands; ++band)
+      std::sort(selected.begin() + n * band / kBands, selected.begin() + n * (band + 1) / kBands);
+    for (std::uint32_t p : selected) {
+      if (done()) break;
+      if (pairs_[p].state != kInHeap) continue;
+      if (opt_.inversion == InversionPolicy::Penalize) {  // the penalty depends on the neighbours
+        double c;
+        if (!pair_cost(p, c) || float(c) != cost_[p]) {
+          dirty_[p] = 1;
+          continue;
+        }
+      }
+      if (!report_progress(start_faces)) return;
+      try_contract(p);
+    }
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 
 SimplifyResult Simplifier::run() {
   prepare_input();
+  if (consumed_indices) {
+    in_.indices = {};
+    std::vector<std::uint32_t>().swap(*consumed_indices);
+  }
   resolve_targets();
   if (opt_.record) {
     *opt_.record = ContractionLog{};
@@ -673,79 +889,16 @@ SimplifyResult Simplifier::run() {
   select_pairs();
   result_.virtual_pairs = virtual_pairs_;
 
-  // Initial costs and the heap (GH97 §4 steps 3-4).
-  heap_.reset(pairs_.size());
-  cost_.assign(pairs_.size(), 0);
-  for (std::uint32_t p = 0; p < pairs_.size(); ++p) {
-    double c;
-    if (pair_cost(p, c)) heap_.push_unordered(p, c), cost_[p] = c;
-    else pairs_[p].state = kLocked;
-  }
-  heap_.heapify();
-
-  const std::size_t start_faces = faces_alive_;
-  const std::size_t span = start_faces > target_faces_ ? start_faces - target_faces_ : 1;
-  std::size_t next_progress = 0;
-  double max_error_norm_done = 0;
   result_.stop_reason = StopReason::TargetReached;
-
-  while (!done()) {
-    if (heap_.empty()) {
-      result_.stop_reason = blocked_by_error_ > 0 ? StopReason::ErrorLimit : StopReason::NoValidPair;
-      break;
-    }
-    if (opt_.progress && result_.contractions >= next_progress) {
-      next_progress = result_.contractions + 4096;
-      if (!opt_.progress(double(start_faces - faces_alive_) / double(span))) {
-        result_.stop_reason = StopReason::Cancelled;
-        break;
-      }
-    }
-    const std::uint32_t top = heap_.top();
-    if (cost_[top] > heap_.top_key()) {  // stale key: re-key and look again
-      heap_.update(top, cost_[top]);
-      continue;
-    }
-    const std::uint32_t p = heap_.pop();
-    const std::uint32_t a = pairs_[p].v[0], b = pairs_[p].v[1];
-
-    bool is_edge = false;
-    if (!is_edge_and_link_ok(a, b, is_edge)) {
-      ++blocked_by_topology_;
-      block(p);
-      continue;
-    }
-    if (!is_edge && !pairs_[p].is_virtual) {
-      // An edge pair whose faces all died: at t = 0 only edges are valid pairs (GH97 §3.2).
-      pairs_[p].state = kDead;
-      continue;
-    }
-    Quadric q;
-    Placed placed;
-    placement_for(p, q, placed);
-    if (opt_.inversion == InversionPolicy::Forbid && flips(a, b, placed.position)) {
-      ++blocked_by_inversion_;
-      block(p);
-      continue;
-    }
-    double err = normalized_error(placed.error, q.weight);
-    if (err > max_error_norm_) {
-      ++blocked_by_error_;
-      block(p);
-      continue;
-    }
-    max_error_norm_done = std::max(max_error_norm_done, err);
-    contract(p, q, placed.position);
-    ++result_.contractions;
-    if (opt_.record) record_contraction(err * scale_);
-  }
+  if (passes_) run_passes();
+  else run_greedy();
   if (opt_.progress && result_.stop_reason != StopReason::Cancelled) opt_.progress(1.0);
 
   result_.rejected_topology = blocked_by_topology_;
   result_.rejected_inversion = blocked_by_inversion_;
   result_.rejected_error = blocked_by_error_;
-  result_.max_error_relative = max_error_norm_done;
-  result_.max_error = max_error_norm_done * scale_;
+  result_.max_error_relative = max_error_norm_done_;
+  result_.max_error = max_error_norm_done_ * scale_;
   switch (result_.stop_reason) {
     case StopReason::TargetReached: result_.stop_detail = "target reached"; break;
     case StopReason::ErrorLimit:
@@ -795,6 +948,12 @@ SimplifyResult Simplifier::build_output() {
 
 SimplifyResult simplify(MeshView input, const SimplifyOptions& options) {
   Simplifier s(input, options);
+  return s.run();
+}
+
+SimplifyResult simplify(Mesh&& input, const SimplifyOptions& options) {
+  Simplifier s(input, options);
+  s.consumed_indices = &input.indices;
   return s.run();
 }
 

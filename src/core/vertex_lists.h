@@ -1,12 +1,15 @@
 // Per-vertex lists (incident faces, valid pairs) in one flat arena, so the contraction loop never
 // allocates per element. A list that outgrows its slot moves to the end of the arena with room to
-// grow; the old slot is abandoned (its size is bounded by the total work, see GH97 §4's "pair sets
-// merge on contraction").
+// grow; the old slot is abandoned, and when the arena is full the lists are slid together again.
 #pragma once
 
 #include <cstdint>
+#include <cstring>
 #include <span>
+#include <stdexcept>
 #include <vector>
+
+#include "core/radix_sort.h"
 
 namespace qem::core {
 
@@ -20,11 +23,12 @@ class VertexLists {
     capacity_.resize(n);
     std::size_t total = 0;
     for (std::size_t v = 0; v < n; ++v) {
-      begin_[v] = total;
+      begin_[v] = std::uint32_t(total);
       capacity_[v] = sizes[v];
       total += sizes[v];
     }
-    data_.reserve(total + total / 4);
+    if (total + total / 4 + 64 >= 0xffffffffu) throw std::length_error("vertex lists beyond 32-bit offsets");
+    data_.reserve(total + total / 4 + 64);
     data_.assign(total, 0);
   }
   void push_initial(std::uint32_t v, std::uint32_t item) { data_[begin_[v] + size_[v]++] = item; }
@@ -44,9 +48,14 @@ class VertexLists {
   }
   void assign(std::uint32_t v, const std::uint32_t* items, std::size_t n) {
     if (n > capacity_[v]) {
-      begin_[v] = data_.size();
-      capacity_[v] = std::uint32_t(n + n / 2 + 2);
-      data_.resize(data_.size() + capacity_[v]);
+      const std::uint32_t room = std::uint32_t(n + n / 2 + 2);
+      // The arena is full of abandoned slots: slide the lists together rather than grow it,
+      // so its memory stays at its first size for the whole run.
+      if (data_.size() + room > data_.capacity()) compact();
+      if (data_.size() + room >= 0xffffffffu) throw std::length_error("vertex lists beyond 32-bit offsets");
+      begin_[v] = std::uint32_t(data_.size());
+      capacity_[v] = room;
+      data_.resize(data_.size() + room);
     }
     std::uint32_t* dst = data_.data() + begin_[v];
     for (std::size_t i = 0; i < n; ++i) dst[i] = items[i];
@@ -54,13 +63,26 @@ class VertexLists {
   }
   void clear(std::uint32_t v) { size_[v] = 0; }
 
-  std::size_t memory_bytes() const {
-    return data_.capacity() * 4 + begin_.capacity() * 8 + (size_.capacity() + capacity_.capacity()) * 4;
+  /// Moves every list down to close the gaps left by abandoned slots, in place, in arena order;
+  /// each keeps exactly its size as capacity.
+  void compact() {
+    std::vector<std::uint32_t> by_begin(begin_.size()), scratch;
+    for (std::uint32_t v = 0; v < by_begin.size(); ++v) by_begin[v] = v;
+    radix_sort_by_key(by_begin, scratch, [&](std::uint32_t v) { return begin_[v]; });
+    std::uint32_t end = 0;
+    for (std::uint32_t v : by_begin) {
+      // begin_[v] >= end: the lists are visited in arena order, so the move only goes down.
+      std::memmove(data_.data() + end, data_.data() + begin_[v], size_[v] * sizeof(std::uint32_t));
+      begin_[v] = end;
+      capacity_[v] = size_[v];
+      end += size_[v];
+    }
+    data_.resize(end);
   }
 
  private:
   std::vector<std::uint32_t> data_;
-  std::vector<std::size_t> begin_;
+  std::vector<std::uint32_t> begin_;
   std::vector<std::uint32_t> size_;
   std::vector<std::uint32_t> capacity_;
 };
