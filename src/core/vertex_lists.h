@@ -34,6 +34,13 @@ class VertexLists {
   void push_initial(std::uint32_t v, std::uint32_t item) { data_[begin_[v] + size_[v]++] = item; }
 
   std::span<const std::uint32_t> operator[](std::uint32_t v) const { return {data_.data() + begin_[v], size_[v]}; }
+  /// Hints the cache that the list of v is about to be read: its slot, or (once the slot is
+  /// cached) its items.
+  void prefetch_slot(std::uint32_t v) const {
+    __builtin_prefetch(&begin_[v]);
+    __builtin_prefetch(&size_[v]);
+  }
+  void prefetch_items(std::uint32_t v) const { __builtin_prefetch(data_.data() + begin_[v]); }
 
   /// Replaces the list of v by items[0..n), which must not point into this arena. If it does not
   /// fit, it takes the slot of `donor` (a list being emptied, e.g. the contracted vertex) if that
