@@ -835,6 +835,10 @@ void Simplifier::run_passes() {
       run_greedy();
       return;
     }
+    // Dead faces and pairs linger in the lists of vertices that were not contracted; dropping
+    // them keeps each contraction's loops (and cache misses) to the live neighbourhood.
+    vertex_faces_.filter([&](std::uint32_t f) { return face_alive_[f] != 0; });
+    vertex_pairs_.filter([&](std::uint32_t p) { return pairs_[p].state != kDead; });
     recost_dirty_pairs();
     order.clear();
     order.reserve(np);
@@ -854,7 +858,9 @@ void Simplifier::run_passes() {
 
     // Choose this pass's contractions cheapest first, each vertex at most once...
     selected.clear();
-    for (std::uint32_t p : order) {
+    for (std::size_t i = 0; i < order.size(); ++i) {
+      const std::uint32_t p = order[i];
+      if (i + 16 < order.size()) __builtin_prefetch(&pairs_[order[i + 16]]);  // cost order: scattered
       if (selected.size() >= share) break;
       if (cost_[p] > cost_goal && selected.size() > share / 10) break;
       const std::uint32_t a = pairs_[p].v[0], b = pairs_[p].v[1];
@@ -862,13 +868,12 @@ void Simplifier::run_passes() {
       touched_in_pass_[a] = touched_in_pass_[b] = pass;
       selected.push_back(p);
     }
-    // ...then make them in memory order (pair ids follow the Morton order of their ends), so the
-    // contractions walk the mesh's arrays instead of jumping across them in cost order. No
-    // chosen pair shares an end with another, so each one's cost is still exact when it is made;
-    // the topology and inversion checks run on the mesh as it is at that moment.
-    // The choice is made in kBands bands of rising cost, each band in memory order: a run that
-    // reaches its target during a pass has made the cheapest of the pass's contractions, spread
-    // over the whole mesh, as the greedy order would.
+    // ...then make them in kBands bands of rising cost, each band in memory order (pair ids
+    // follow the Morton order of their ends), so the contractions walk the mesh's arrays instead
+    // of jumping across them in cost order, and a run that reaches its target during a pass has
+    // made the cheapest of the pass's contractions, spread over the whole mesh. No chosen pair
+    // shares an end with another, so each one's cost is still exact when it is made; the
+    // topology and inversion checks run on the mesh as it is at that moment.
     const std::size_t n = selected.size();
     for (std::size_t band = 0; band < kBands; ++band)
       std::sort(selected.begin() + n * band / kBands, selected.begin() + n * (band + 1) / kBands);

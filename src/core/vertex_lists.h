@@ -70,6 +70,18 @@ class VertexLists {
   }
   void clear(std::uint32_t v) { size_[v] = 0; }
 
+  /// Drops, from every list, the items for which keep(item) is false (order kept).
+  template <class Keep>
+  void filter(Keep keep) {
+    for (std::size_t v = 0; v < begin_.size(); ++v) {
+      std::uint32_t* items = data_.data() + begin_[v];
+      std::uint32_t kept = 0;
+      for (std::uint32_t i = 0; i < size_[v]; ++i)
+        if (keep(items[i])) items[kept++] = items[i];
+      size_[v] = kept;
+    }
+  }
+
   /// Moves every list down to close the gaps left by abandoned slots, in place, in arena order;
   /// each keeps exactly its size as capacity.
   void compact() {
