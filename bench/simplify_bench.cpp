@@ -32,6 +32,14 @@ void run_simplify(benchmark::State& state, const qem::SimplifyOptions& base) {
 
 void BM_Simplify(benchmark::State& state) { run_simplify(state, {}); }
 
+// The strict greedy order (GH97's heap) against the default pass-based order: the gap is what the
+// passes save (the two give the same error within a few percent, docs/benchmarks.md).
+void BM_SimplifyGreedy(benchmark::State& state) {
+  qem::SimplifyOptions o;
+  o.scheme = qem::Scheme::Greedy;
+  run_simplify(state, o);
+}
+
 // GH97's original settings (uniform plane weights, §5) against the default area weighting (HG99 §2):
 // the cost of the quadric set-up itself is the same, so this shows any difference in the queue work.
 void BM_SimplifyUniform(benchmark::State& state) {
@@ -57,6 +65,7 @@ void sizes(benchmark::internal::Benchmark* b) {
 }  // namespace
 
 BENCHMARK(BM_Simplify)->Apply(sizes);
+BENCHMARK(BM_SimplifyGreedy)->Apply(sizes);
 BENCHMARK(BM_SimplifyUniform)
     ->Args({7, 10})
     ->ArgNames({"level", "permille"})
