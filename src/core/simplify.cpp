@@ -107,6 +107,7 @@ class Simplifier {
   bool report_progress(std::size_t start_faces);
   void prefetch_for_contraction(const std::vector<std::uint32_t>& pairs, std::size_t i) const;
   void recost_dirty_pairs();
+  void renumber_densely();
 
   // --- the contraction loop ------------------------------------------------------------------
   bool pair_cost(std::uint32_t p, double& cost);
@@ -709,6 +710,70 @@ void Simplifier::recost_dirty_pairs() {
   for (std::thread& w : workers) w.join();
 }
 
+// Passes: once half the vertices are gone, the survivors, live faces and live pairs are numbered
+// densely again, each in its old order, so later passes sweep small dense arrays instead of
+// sparse ones (fewer cache misses per contraction). Every relative order is kept (list contents,
+// tie-breaks on ids, output order), so the result is exactly the same. Expects the vertex lists
+// to hold live items only.
+void Simplifier::renumber_densely() {
+  static constexpr std::uint32_t kGone = 0xffffffffu;
+  auto numbering = [](std::size_t n, auto keep) {
+    std::vector<std::uint32_t> to(n, kGone);
+    std::uint32_t next = 0;
+    for (std::size_t i = 0; i < n; ++i)
+      if (keep(i)) to[i] = next++;
+    return std::pair{std::move(to), next};
+  };
+  auto squeeze = [](auto& array, const std::vector<std::uint32_t>& to, std::uint32_t count) {
+    for (std::size_t i = 0; i < to.size(); ++i)
+      if (to[i] != kGone) array[to[i]] = array[i];
+    array.resize(count);
+  };
+  const auto [vertex_to, vertex_count] = numbering(
+      pos_.size(), [&](std::size_t v) { return !vertex_faces_[std::uint32_t(v)].empty() || !vertex_pairs_[std::uint32_t(v)].empty(); });
+  const auto [face_to, face_count] = numbering(face_alive_.size(), [&](std::size_t f) { return face_alive_[f] != 0; });
+  const auto [pair_to, pair_count] = numbering(pairs_.size(), [&](std::size_t p) { return pairs_[p].state != kDead; });
+
+  for (std::uint32_t f = 0; f < face_to.size(); ++f) {
+    if (face_to[f] == kGone) continue;
+    for (int k = 0; k < 3; ++k) tri_[3 * std::size_t(face_to[f]) + k] = vertex_to[tri_[3 * std::size_t(f) + k]];
+    face_source_[face_to[f]] = face_source_[f];
+  }
+  tri_.resize(3 * std::size_t(face_count));
+  face_source_.resize(face_count);
+  face_alive_.assign(face_count, 1);
+
+  for (PairRecord& r : pairs_)
+    if (r.state != kDead) r.v[0] = vertex_to[r.v[0]], r.v[1] = vertex_to[r.v[1]];
+  squeeze(pairs_, pair_to, pair_count);
+  squeeze(cost_, pair_to, pair_count);
+  squeeze(dirty_, pair_to, pair_count);
+
+  auto renumber_lists = [&](VertexLists& lists, const std::vector<std::uint32_t>& item_to) {
+    std::vector<std::uint32_t> sizes(vertex_count);
+    for (std::uint32_t v = 0; v < vertex_to.size(); ++v)
+      if (vertex_to[v] != kGone) sizes[vertex_to[v]] = std::uint32_t(lists[v].size());
+    VertexLists dense;
+    dense.layout(sizes);
+    for (std::uint32_t v = 0; v < vertex_to.size(); ++v)
+      if (vertex_to[v] != kGone)
+        for (std::uint32_t item : lists[v]) dense.push_initial(vertex_to[v], item_to[item]);
+    lists = std::move(dense);
+  };
+  renumber_lists(vertex_faces_, face_to);
+  renumber_lists(vertex_pairs_, pair_to);
+
+  squeeze(pos_, vertex_to, vertex_count);
+  squeeze(quadric_, vertex_to, vertex_count);
+  squeeze(boundary_, vertex_to, vertex_count);
+  squeeze(moved_, vertex_to, vertex_count);
+  squeeze(has_blocked_, vertex_to, vertex_count);
+  squeeze(aggregated_, vertex_to, vertex_count);
+  squeeze(source_vertex_, vertex_to, vertex_count);
+  squeeze(touched_in_pass_, vertex_to, vertex_count);
+  mark_.assign(vertex_count, 0);
+}
+
 // ---------------------------------------------------------------------------------------------
 // The order of contractions
 // ---------------------------------------------------------------------------------------------
@@ -828,9 +893,8 @@ void Simplifier::run_passes() {
   constexpr double kPassCostSlack = 1.5;
   constexpr double kPassShare = 0.25;
   constexpr std::size_t kBands = 8;
-  const std::size_t np = pairs_.size();
-  cost_.assign(np, 0);
-  dirty_.assign(np, 1);
+  cost_.assign(pairs_.size(), 0);
+  dirty_.assign(pairs_.size(), 1);
   touched_in_pass_.assign(pos_.size(), 0);
   std::vector<std::uint32_t> order, scratch, selected;
   const std::size_t start_faces = faces_alive_;
@@ -844,10 +908,11 @@ void Simplifier::run_passes() {
     // them keeps each contraction's loops (and cache misses) to the live neighbourhood.
     vertex_faces_.filter([&](std::uint32_t f) { return face_alive_[f] != 0; });
     vertex_pairs_.filter([&](std::uint32_t p) { return pairs_[p].state != kDead; });
+    if (2 * vertices_alive_ < pos_.size()) renumber_densely();
     recost_dirty_pairs();
     order.clear();
-    order.reserve(np);
-    for (std::uint32_t p = 0; p < np; ++p)
+    order.reserve(pairs_.size());
+    for (std::uint32_t p = 0; p < pairs_.size(); ++p)
       if (pairs_[p].state == kInHeap) order.push_back(p);
     if (order.empty()) {
       result_.stop_reason = blocked_by_error_ > 0 ? StopReason::ErrorLimit : StopReason::NoValidPair;
