@@ -7,6 +7,7 @@
 #include <cmath>
 #include <map>
 #include <set>
+#include <vector>
 
 #include "mesh_checks.h"
 #include "qem/error.h"
@@ -356,6 +357,32 @@ TEST_P(Simplify, EmptyAndTinyInputs) {
   EXPECT_EQ(empty.stop_reason, StopReason::AlreadyBelowTarget);
   SimplifyResult one = simplify(test::tetrahedron(), faces(10));
   EXPECT_EQ(one.mesh.face_count(), 4u);
+}
+
+TEST_P(Simplify, ProgressRisesToOneAndCancelStops) {
+  const Mesh in = bumpy_sphere(6);  // 81920 faces: several thousand contractions between reports
+  SimplifyOptions o = faces(2000);
+  o.greedy_below_faces = 20000;  // under Passes: passes, then the greedy tail, as by default
+  std::vector<double> seen;
+  o.progress = [&](double f) {
+    seen.push_back(f);
+    return true;
+  };
+  SimplifyResult r = simplify(in, o);
+  ASSERT_GE(seen.size(), 3u);
+  EXPECT_EQ(seen.back(), 1.0);
+  for (std::size_t i = 1; i < seen.size(); ++i) {
+    EXPECT_GE(seen[i], seen[i - 1]) << "report " << i;
+    EXPECT_LE(seen[i], 1.0);
+  }
+  EXPECT_EQ(r.stop_reason, StopReason::TargetReached);
+
+  int calls = 0;
+  o.progress = [&](double) { return ++calls < 3; };
+  SimplifyResult cancelled = simplify(in, o);
+  EXPECT_EQ(cancelled.stop_reason, StopReason::Cancelled);
+  EXPECT_GT(cancelled.mesh.face_count(), 2000u);
+  EXPECT_EQ(validity_problem(cancelled.mesh), "");
 }
 
 }  // namespace

@@ -104,7 +104,7 @@ class Simplifier {
   void run_greedy();
   void run_passes();
   bool try_contract(std::uint32_t p);
-  bool report_progress(std::size_t start_faces);
+  bool report_progress();
   void prefetch_for_contraction(const std::vector<std::uint32_t>& pairs, std::size_t i) const;
   void recost_dirty_pairs();
   void renumber_densely();
@@ -839,11 +839,12 @@ void Simplifier::prefetch_for_contraction(const std::vector<std::uint32_t>& pair
 }
 
 // Calls the progress callback every few thousand contractions; false if the caller cancelled.
-bool Simplifier::report_progress(std::size_t start_faces) {
+bool Simplifier::report_progress() {
   if (!opt_.progress || result_.contractions < next_progress_) return true;
   next_progress_ = result_.contractions + 4096;
-  const std::size_t span = start_faces > target_faces_ ? start_faces - target_faces_ : 1;
-  if (opt_.progress(double(start_faces - faces_alive_) / double(span))) return true;
+  const std::size_t start = result_.input_faces;
+  const std::size_t span = start > target_faces_ ? start - target_faces_ : 1;
+  if (opt_.progress(double(start - faces_alive_) / double(span))) return true;
   result_.stop_reason = StopReason::Cancelled;
   return false;
 }
@@ -860,13 +861,12 @@ void Simplifier::run_greedy() {
   }
   heap_.heapify();
 
-  const std::size_t start_faces = faces_alive_;
   while (!done()) {
     if (heap_.empty()) {
       result_.stop_reason = blocked_by_error_ > 0 ? StopReason::ErrorLimit : StopReason::NoValidPair;
       return;
     }
-    if (!report_progress(start_faces)) return;
+    if (!report_progress()) return;
     const std::uint32_t top = heap_.top();
     if (cost_[top] > heap_.top_key()) {  // stale key: re-key and look again
       heap_.update(top, cost_[top]);
@@ -897,7 +897,6 @@ void Simplifier::run_passes() {
   dirty_.assign(pairs_.size(), 1);
   touched_in_pass_.assign(pos_.size(), 0);
   std::vector<std::uint32_t> order, scratch, selected;
-  const std::size_t start_faces = faces_alive_;
   for (std::uint32_t pass = 1; !done(); ++pass) {
     if (faces_alive_ <= opt_.greedy_below_faces) {
       passes_ = false;
@@ -959,7 +958,7 @@ void Simplifier::run_passes() {
           continue;
         }
       }
-      if (!report_progress(start_faces)) return;
+      if (!report_progress()) return;
       try_contract(p);
     }
   }
