@@ -717,61 +717,67 @@ void Simplifier::recost_dirty_pairs() {
 // to hold live items only.
 void Simplifier::renumber_densely() {
   static constexpr std::uint32_t kGone = 0xffffffffu;
+  // Named members, not structured bindings: clang 14 (Debian 12, the fuzz
+  // build) cannot capture structured bindings in a lambda.
+  struct Numbering {
+    std::vector<std::uint32_t> to;
+    std::uint32_t count;
+  };
   auto numbering = [](std::size_t n, auto keep) {
     std::vector<std::uint32_t> to(n, kGone);
     std::uint32_t next = 0;
     for (std::size_t i = 0; i < n; ++i)
       if (keep(i)) to[i] = next++;
-    return std::pair{std::move(to), next};
+    return Numbering{std::move(to), next};
   };
   auto squeeze = [](auto& array, const std::vector<std::uint32_t>& to, std::uint32_t count) {
     for (std::size_t i = 0; i < to.size(); ++i)
       if (to[i] != kGone) array[to[i]] = array[i];
     array.resize(count);
   };
-  const auto [vertex_to, vertex_count] = numbering(
+  const Numbering vertices = numbering(
       pos_.size(), [&](std::size_t v) { return !vertex_faces_[std::uint32_t(v)].empty() || !vertex_pairs_[std::uint32_t(v)].empty(); });
-  const auto [face_to, face_count] = numbering(face_alive_.size(), [&](std::size_t f) { return face_alive_[f] != 0; });
-  const auto [pair_to, pair_count] = numbering(pairs_.size(), [&](std::size_t p) { return pairs_[p].state != kDead; });
+  const Numbering faces = numbering(face_alive_.size(), [&](std::size_t f) { return face_alive_[f] != 0; });
+  const Numbering pairs = numbering(pairs_.size(), [&](std::size_t p) { return pairs_[p].state != kDead; });
 
-  for (std::uint32_t f = 0; f < face_to.size(); ++f) {
-    if (face_to[f] == kGone) continue;
-    for (int k = 0; k < 3; ++k) tri_[3 * std::size_t(face_to[f]) + k] = vertex_to[tri_[3 * std::size_t(f) + k]];
-    face_source_[face_to[f]] = face_source_[f];
+  for (std::uint32_t f = 0; f < faces.to.size(); ++f) {
+    if (faces.to[f] == kGone) continue;
+    for (int k = 0; k < 3; ++k) tri_[3 * std::size_t(faces.to[f]) + k] = vertices.to[tri_[3 * std::size_t(f) + k]];
+    face_source_[faces.to[f]] = face_source_[f];
   }
-  tri_.resize(3 * std::size_t(face_count));
-  face_source_.resize(face_count);
-  face_alive_.assign(face_count, 1);
+  tri_.resize(3 * std::size_t(faces.count));
+  face_source_.resize(faces.count);
+  face_alive_.assign(faces.count, 1);
 
   for (PairRecord& r : pairs_)
-    if (r.state != kDead) r.v[0] = vertex_to[r.v[0]], r.v[1] = vertex_to[r.v[1]];
-  squeeze(pairs_, pair_to, pair_count);
-  squeeze(cost_, pair_to, pair_count);
-  squeeze(dirty_, pair_to, pair_count);
+    if (r.state != kDead) r.v[0] = vertices.to[r.v[0]], r.v[1] = vertices.to[r.v[1]];
+  squeeze(pairs_, pairs.to, pairs.count);
+  squeeze(cost_, pairs.to, pairs.count);
+  squeeze(dirty_, pairs.to, pairs.count);
 
   auto renumber_lists = [&](VertexLists& lists, const std::vector<std::uint32_t>& item_to) {
-    std::vector<std::uint32_t> sizes(vertex_count);
-    for (std::uint32_t v = 0; v < vertex_to.size(); ++v)
-      if (vertex_to[v] != kGone) sizes[vertex_to[v]] = std::uint32_t(lists[v].size());
+    std::vector<std::uint32_t> sizes(vertices.count);
+    for (std::uint32_t v = 0; v < vertices.to.size(); ++v)
+      if (vertices.to[v] != kGone) sizes[vertices.to[v]] = std::uint32_t(lists[v].size());
     VertexLists dense;
     dense.layout(sizes);
-    for (std::uint32_t v = 0; v < vertex_to.size(); ++v)
-      if (vertex_to[v] != kGone)
-        for (std::uint32_t item : lists[v]) dense.push_initial(vertex_to[v], item_to[item]);
+    for (std::uint32_t v = 0; v < vertices.to.size(); ++v)
+      if (vertices.to[v] != kGone)
+        for (std::uint32_t item : lists[v]) dense.push_initial(vertices.to[v], item_to[item]);
     lists = std::move(dense);
   };
-  renumber_lists(vertex_faces_, face_to);
-  renumber_lists(vertex_pairs_, pair_to);
+  renumber_lists(vertex_faces_, faces.to);
+  renumber_lists(vertex_pairs_, pairs.to);
 
-  squeeze(pos_, vertex_to, vertex_count);
-  squeeze(quadric_, vertex_to, vertex_count);
-  squeeze(boundary_, vertex_to, vertex_count);
-  squeeze(moved_, vertex_to, vertex_count);
-  squeeze(has_blocked_, vertex_to, vertex_count);
-  squeeze(aggregated_, vertex_to, vertex_count);
-  squeeze(source_vertex_, vertex_to, vertex_count);
-  squeeze(touched_in_pass_, vertex_to, vertex_count);
-  mark_.assign(vertex_count, 0);
+  squeeze(pos_, vertices.to, vertices.count);
+  squeeze(quadric_, vertices.to, vertices.count);
+  squeeze(boundary_, vertices.to, vertices.count);
+  squeeze(moved_, vertices.to, vertices.count);
+  squeeze(has_blocked_, vertices.to, vertices.count);
+  squeeze(aggregated_, vertices.to, vertices.count);
+  squeeze(source_vertex_, vertices.to, vertices.count);
+  squeeze(touched_in_pass_, vertices.to, vertices.count);
+  mark_.assign(vertices.count, 0);
 }
 
 // ---------------------------------------------------------------------------------------------
