@@ -24,7 +24,7 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
   sub->add_option("--greedy-below", a.greedy_below,
                   "With --scheme passes, finish in the greedy order below this many faces (0 = never)")
       ->capture_default_str();
-  sub->add_option("--threads", a.threads, "Threads for re-costing pairs between passes (0 = all; same result)")
+  sub->add_option("--threads", a.threads, "Threads for the passes: re-costing pairs, and making contractions region by region (0 = all; same result)")
       ->capture_default_str();
   sub->add_option("--boundary-weight", a.boundary_weight,
                   "Penalty weight of the boundary constraint planes (GH97 6), times the squared edge length; "

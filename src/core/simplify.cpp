@@ -5,17 +5,23 @@
 //   build_adjacency      per-vertex face lists
 //   compute_quadrics     GH97 §5 fundamental quadrics, weighted (HG99 §2), + boundary planes (GH97 §6)
 //   select_pairs         GH97 §3.2: edges + pairs closer than t
-//   cost every pair, heap them, then repeatedly: pop the cheapest, check it (topology, inversion,
-//   error limit), contract it, re-cost the pairs of the new vertex.
+//   run_greedy           cost every pair, heap them, then repeatedly: pop the cheapest, check it
+//                        (topology, inversion, error limit), contract it, re-cost the new vertex's pairs
+//   run_passes           the default: rank all pairs, make the cheapest independent ones, repeat;
+//                        each band of a pass is made region by region (make_band), on all threads
 //
 // Everything runs in a normalised frame (centred, bounding-box diagonal 1), so every tolerance is
 // relative and the result does not depend on the model's position or scale; vertices that never
 // move are written back with their exact input coordinates.
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
+#include <exception>
+#include <future>
 #include <limits>
 #include <string>
+#include <system_error>
 #include <thread>
 
 #include "core/indexed_heap.h"
@@ -97,28 +103,50 @@ class Simplifier {
   void prepare_input();
   void build_adjacency();
   void compute_quadrics();
-  void select_pairs();
+  void select_pairs(std::vector<Edge> edges);
   void resolve_targets();
+
+  // What one thread needs to make contractions: its own scratch space, stamps and counters (the
+  // shared counters absorb them), and, in a band made on several threads, the stretches of the
+  // vertex-list arenas its moved lists go to. Threads work on disjoint parts of the mesh (see
+  // make_band), so nothing else they write is shared.
+  struct Worker {
+    std::uint32_t stamp = 0;  // last stamp used in mark_; every stamp is used once in a run
+    std::vector<std::uint32_t> scratch, scratch2;
+    std::size_t faces_killed = 0, vertices_removed = 0, contractions = 0;
+    std::size_t blocked_topology = 0, blocked_inversion = 0, blocked_error = 0;
+    double max_error = 0;
+    std::uint32_t last_kept = 0, last_removed = 0;  // of the last contraction made
+    VertexLists::Tail* face_tail = nullptr;  // null: moved lists go to the arena's end
+    VertexLists::Tail* pair_tail = nullptr;
+  };
+  void absorb(Worker& w);
 
   // --- the two orders of contraction ------------------------------------------------------------
   void run_greedy();
   void run_passes();
-  bool try_contract(std::uint32_t p);
+  bool make_band(const std::uint32_t* band, std::size_t count);
+  void find_region_cut();
+  bool ready_to_contract(std::uint32_t p);
+  bool try_contract(std::uint32_t p, Worker& w);
   bool report_progress();
-  void prefetch_for_contraction(const std::vector<std::uint32_t>& pairs, std::size_t i) const;
+  void prefetch_for_contraction(const std::uint32_t* pairs, std::size_t count, std::size_t i) const;
   void recost_dirty_pairs();
   void renumber_densely();
+  unsigned thread_count() const {
+    return opt_.threads > 0 ? opt_.threads : std::max(1u, std::thread::hardware_concurrency());
+  }
 
   // --- the contraction loop ------------------------------------------------------------------
   bool pair_cost(std::uint32_t p, double& cost);
   void cost_pair(std::uint32_t p);
-  bool is_edge_and_link_ok(std::uint32_t a, std::uint32_t b, bool& is_edge);
+  bool is_edge_and_link_ok(std::uint32_t a, std::uint32_t b, bool& is_edge, Worker& w);
   bool flips(std::uint32_t a, std::uint32_t b, const Vec3& target);
   bool placement_for(std::uint32_t p, Quadric& q, Placed& placed);
-  void contract(std::uint32_t p, const Quadric& q, const Vec3& target);
+  void contract(std::uint32_t p, const Quadric& q, const Vec3& target, Worker& w);
   void block(std::uint32_t p);
-  void record_contraction(double error);
-  bool kill_if_coincident(std::uint32_t f, std::size_t own);
+  void record_contraction(double error, const Worker& w);
+  bool kill_if_coincident(std::uint32_t f, std::size_t own, Worker& w);
   void unblock_around(std::uint32_t v);
   void forget(std::uint32_t p) {
     if (!passes_) heap_.remove(p);
@@ -127,9 +155,9 @@ class Simplifier {
   double normalized_error(double q_error, double weight) const {
     return weight > 0 ? std::sqrt(q_error / weight) : std::sqrt(q_error);
   }
-  void kill_face(std::uint32_t f) {
+  void kill_face(std::uint32_t f, Worker& w) {
     face_alive_[f] = 0;
-    --faces_alive_;
+    ++w.faces_killed;
     if (opt_.record) opt_.record->dead_faces.push_back(face_source_[f]);
   }
   bool face_has(std::uint32_t f, std::uint32_t v) const {
@@ -192,8 +220,17 @@ class Simplifier {
 
   // Stamps for set membership without clearing (one array, fresh stamp per query).
   std::vector<std::uint32_t> mark_;
-  std::uint32_t stamp_ = 0;
-  std::vector<std::uint32_t> scratch_, scratch2_;
+  Worker main_;  // the worker of every contraction made on the calling thread
+
+  // Passes: the vertices split into kRegions ranges of ids (ids follow the Morton order, so each
+  // range is a compact part of the surface). cut_ marks every vertex with a pair to another
+  // region; near_cut_ marks the cut and its neighbours (or more: a superset is safe).
+  static constexpr std::uint32_t kRegions = 8;
+  std::uint64_t region_scale_ = 0;  // floor(2^40 kRegions / vertex count): no division per lookup
+  std::uint32_t region_of(std::uint32_t v) const { return std::uint32_t((v * region_scale_) >> 40); }
+  std::vector<std::uint8_t> cut_, near_cut_;
+  void mark_cut(std::uint32_t v);
+  void update_cut_after(std::uint32_t survivor);
 
   std::size_t faces_alive_ = 0, vertices_alive_ = 0;
   std::size_t target_faces_ = 0, target_vertices_ = 0;
@@ -202,7 +239,6 @@ class Simplifier {
   std::size_t dropped_degenerate_ = 0, dropped_duplicate_ = 0;
   std::size_t blocked_by_error_ = 0, blocked_by_topology_ = 0, blocked_by_inversion_ = 0;
   std::size_t virtual_pairs_ = 0;
-  std::uint32_t last_kept_ = 0, last_removed_ = 0;
   std::size_t next_progress_ = 0;
   double max_error_norm_done_ = 0;
 
@@ -366,9 +402,8 @@ void Simplifier::compute_quadrics() {
   }
 }
 
-void Simplifier::select_pairs() {
-  std::vector<Edge> edges = unique_edges(tri_, vertex_faces_, pos_.size());
-
+// `edges`: unique_edges of the working mesh.
+void Simplifier::select_pairs(std::vector<Edge> edges) {
   // Boundary edges (one incident face): mark their vertices, and add GH97 §6's constraint plane
   // through the edge, perpendicular to its face, weighted by the penalty. The weight grows with
   // the squared edge length so that it stays in proportion to the area-weighted face quadrics at
@@ -518,8 +553,8 @@ bool Simplifier::flips(std::uint32_t a, std::uint32_t b, const Vec3& target) {
 // adjacent to both a and b must be exactly the opposite corners of the faces on edge ab, the
 // collapse must not stack two faces onto the same three vertices, and an interior edge whose two
 // ends both lie on a border must not pinch the border.
-bool Simplifier::is_edge_and_link_ok(std::uint32_t a, std::uint32_t b, bool& is_edge) {
-  const std::uint32_t s_nbr = ++stamp_, s_opp = ++stamp_;
+bool Simplifier::is_edge_and_link_ok(std::uint32_t a, std::uint32_t b, bool& is_edge, Worker& w) {
+  const std::uint32_t s_nbr = ++w.stamp, s_opp = ++w.stamp;
   std::size_t shared = 0;
   for (std::uint32_t f : vertex_faces_[a]) {
     if (!face_alive_[f]) continue;
@@ -558,32 +593,32 @@ bool Simplifier::is_edge_and_link_ok(std::uint32_t a, std::uint32_t b, bool& is_
   return true;
 }
 
-// Face f (now on a) against a's own faces scratch_[0..own): on the same three vertices with the
+// Face f (now on a) against a's own faces w.scratch[0..own): on the same three vertices with the
 // same orientation it is a duplicate and dies; with the opposite orientation the two are the
 // touching walls of two aggregated parts (GH97 §3.2, Fig. 3) and both die, like glued faces.
-bool Simplifier::kill_if_coincident(std::uint32_t f, std::size_t own) {
+bool Simplifier::kill_if_coincident(std::uint32_t f, std::size_t own, Worker& w) {
   const std::uint32_t* t = &tri_[3 * std::size_t(f)];
   for (std::size_t i = 0; i < own; ++i) {
-    const std::uint32_t g = scratch_[i];
+    const std::uint32_t g = w.scratch[i];
     if (!face_alive_[g] || !(face_has(g, t[0]) && face_has(g, t[1]) && face_has(g, t[2]))) continue;
     const std::uint32_t* u = &tri_[3 * std::size_t(g)];
     int k = 0;
     while (u[k] != t[0]) ++k;
     const bool same_orientation = u[(k + 1) % 3] == t[1];
-    kill_face(f);
-    if (!same_orientation) kill_face(g);
+    kill_face(f, w);
+    if (!same_orientation) kill_face(g, w);
     return true;
   }
   return false;
 }
 
-// Appends the contraction just made to the log; `last_kept_` / `last_removed_` are set by
+// Appends the contraction just made to the log; `w.last_kept` / `w.last_removed` are set by
 // contract(), the dead faces were appended by kill_face().
-void Simplifier::record_contraction(double error) {
+void Simplifier::record_contraction(double error, const Worker& w) {
   ContractionLog& log = *opt_.record;
-  log.kept.push_back(source_vertex_[last_kept_]);
-  log.removed.push_back(source_vertex_[last_removed_]);
-  const Vec3 p = output_position(last_kept_);
+  log.kept.push_back(source_vertex_[w.last_kept]);
+  log.removed.push_back(source_vertex_[w.last_removed]);
+  const Vec3 p = output_position(w.last_kept);
   log.position.insert(log.position.end(), {p.x, p.y, p.z});
   log.error.push_back(error);
   log.dead_begin.push_back(std::uint32_t(log.dead_faces.size()));
@@ -610,58 +645,60 @@ void Simplifier::unblock_around(std::uint32_t v) {
 // Contraction (GH97 §4 step 5): (a, b) -> a at `target`.
 // ---------------------------------------------------------------------------------------------
 
-void Simplifier::contract(std::uint32_t p, const Quadric& q, const Vec3& target) {
+void Simplifier::contract(std::uint32_t p, const Quadric& q, const Vec3& target, Worker& w) {
   std::uint32_t a = pairs_[p].v[0], b = pairs_[p].v[1];
   // When the target is one of the ends (endpoint placement, a locked border vertex), that end
   // survives, so its exact input coordinates reach the output untouched.
   const auto same = [](const Vec3& x, const Vec3& y) { return x.x == y.x && x.y == y.y && x.z == y.z; };
   if (same(target, pos_[b]) && !same(target, pos_[a])) std::swap(a, b);
   moved_[a] |= !same(target, pos_[a]);
-  last_kept_ = a, last_removed_ = b;
+  w.last_kept = a, w.last_removed = b;
   pos_[a] = target;
   quadric_[a] = q;
   boundary_[a] |= boundary_[b];
-  --vertices_alive_;
+  ++w.vertices_removed;
 
   // Faces: those containing both ends degenerate and die; b's others now use a. Where the
   // topology check did not run (virtual pairs, or --no-preserve-topology), a face can land on the
   // same three vertices as one of a's: it dies too, so the output never has duplicate faces.
   aggregated_[a] |= aggregated_[b] | pairs_[p].is_virtual;
   const bool may_duplicate = aggregated_[a] || !opt_.preserve_topology;
-  scratch_.clear();
+  std::vector<std::uint32_t>& faces = w.scratch;
+  faces.clear();
   for (std::uint32_t f : vertex_faces_[a]) {
     if (!face_alive_[f]) continue;
     if (face_has(f, b)) {
-      kill_face(f);
+      kill_face(f, w);
       continue;
     }
-    scratch_.push_back(f);
+    faces.push_back(f);
   }
-  const std::size_t own = scratch_.size();
+  const std::size_t own = faces.size();
   for (std::uint32_t f : vertex_faces_[b]) {
     if (!face_alive_[f]) continue;
     std::uint32_t* t = &tri_[3 * std::size_t(f)];
     for (int k = 0; k < 3; ++k)
       if (t[k] == b) t[k] = a;
-    if (may_duplicate && kill_if_coincident(f, own)) continue;
-    scratch_.push_back(f);
+    if (may_duplicate && kill_if_coincident(f, own, w)) continue;
+    faces.push_back(f);
   }
   if (may_duplicate) {  // drop the partners that cancelled
     std::size_t kept = 0;
-    for (std::uint32_t f : scratch_)
-      if (face_alive_[f]) scratch_[kept++] = f;
-    scratch_.resize(kept);
+    for (std::uint32_t f : faces)
+      if (face_alive_[f]) faces[kept++] = f;
+    faces.resize(kept);
   }
-  vertex_faces_.assign(a, scratch_.data(), scratch_.size(), b);
+  vertex_faces_.assign(a, faces.data(), faces.size(), b, w.face_tail);
   vertex_faces_.clear(b);
 
   // Pairs: GH97 §4 "pair sets merge": b's pairs now start at a; the contracted pair and any pair
   // that now duplicates another (same two vertices) are removed.
   pairs_[p].state = kDead;
   forget(p);
-  const std::uint32_t s = ++stamp_;
+  const std::uint32_t s = ++w.stamp;
   mark_[a] = s;
-  scratch2_.clear();
+  std::vector<std::uint32_t>& pairs = w.scratch2;
+  pairs.clear();
   for (int end = 0; end < 2; ++end) {
     for (std::uint32_t r : vertex_pairs_[end == 0 ? a : b]) {
       if (pairs_[r].state == kDead) continue;
@@ -676,10 +713,10 @@ void Simplifier::contract(std::uint32_t p, const Quadric& q, const Vec3& target)
       }
       mark_[o] = s;
       if (v[0] > v[1]) std::swap(v[0], v[1]);
-      scratch2_.push_back(r);
+      pairs.push_back(r);
     }
   }
-  vertex_pairs_.assign(a, scratch2_.data(), scratch2_.size(), b);
+  vertex_pairs_.assign(a, pairs.data(), pairs.size(), b, w.pair_tail);
   vertex_pairs_.clear(b);
 
   // GH97 §4 step 5: update the costs of all valid pairs involving the new vertex.
@@ -702,8 +739,7 @@ void Simplifier::recost_dirty_pairs() {
       else pairs_[p].state = kLocked;
     }
   };
-  const unsigned threads = opt_.threads > 0 ? opt_.threads : std::max(1u, std::thread::hardware_concurrency());
-  const std::size_t chunks = np < 65536 ? 1 : std::min<std::size_t>(threads, 64);
+  const std::size_t chunks = np < 65536 ? 1 : std::min<std::size_t>(thread_count(), 64);
   std::vector<std::thread> workers;
   for (std::size_t t = 1; t < chunks; ++t) workers.emplace_back(sweep, np * t / chunks, np * (t + 1) / chunks);
   sweep(0, np / chunks);
@@ -737,23 +773,6 @@ void Simplifier::renumber_densely() {
   };
   const Numbering vertices = numbering(
       pos_.size(), [&](std::size_t v) { return !vertex_faces_[std::uint32_t(v)].empty() || !vertex_pairs_[std::uint32_t(v)].empty(); });
-  const Numbering faces = numbering(face_alive_.size(), [&](std::size_t f) { return face_alive_[f] != 0; });
-  const Numbering pairs = numbering(pairs_.size(), [&](std::size_t p) { return pairs_[p].state != kDead; });
-
-  for (std::uint32_t f = 0; f < faces.to.size(); ++f) {
-    if (faces.to[f] == kGone) continue;
-    for (int k = 0; k < 3; ++k) tri_[3 * std::size_t(faces.to[f]) + k] = vertices.to[tri_[3 * std::size_t(f) + k]];
-    face_source_[faces.to[f]] = face_source_[f];
-  }
-  tri_.resize(3 * std::size_t(faces.count));
-  face_source_.resize(faces.count);
-  face_alive_.assign(faces.count, 1);
-
-  for (PairRecord& r : pairs_)
-    if (r.state != kDead) r.v[0] = vertices.to[r.v[0]], r.v[1] = vertices.to[r.v[1]];
-  squeeze(pairs_, pairs.to, pairs.count);
-  squeeze(cost_, pairs.to, pairs.count);
-  squeeze(dirty_, pairs.to, pairs.count);
 
   auto renumber_lists = [&](VertexLists& lists, const std::vector<std::uint32_t>& item_to) {
     std::vector<std::uint32_t> sizes(vertices.count);
@@ -766,8 +785,27 @@ void Simplifier::renumber_densely() {
         for (std::uint32_t item : lists[v]) dense.push_initial(vertices.to[v], item_to[item]);
     lists = std::move(dense);
   };
-  renumber_lists(vertex_faces_, faces.to);
+  // One arena at a time (each is rebuilt beside the old one), each numbering freed once used:
+  // on large meshes this is the peak of the run's memory.
+  Numbering pairs = numbering(pairs_.size(), [&](std::size_t p) { return pairs_[p].state != kDead; });
+  for (PairRecord& r : pairs_)
+    if (r.state != kDead) r.v[0] = vertices.to[r.v[0]], r.v[1] = vertices.to[r.v[1]];
+  squeeze(pairs_, pairs.to, pairs.count);
+  squeeze(cost_, pairs.to, pairs.count);
+  squeeze(dirty_, pairs.to, pairs.count);
   renumber_lists(vertex_pairs_, pairs.to);
+  std::vector<std::uint32_t>().swap(pairs.to);
+
+  Numbering faces = numbering(face_alive_.size(), [&](std::size_t f) { return face_alive_[f] != 0; });
+  for (std::uint32_t f = 0; f < faces.to.size(); ++f) {
+    if (faces.to[f] == kGone) continue;
+    for (int k = 0; k < 3; ++k) tri_[3 * std::size_t(faces.to[f]) + k] = vertices.to[tri_[3 * std::size_t(f) + k]];
+    face_source_[faces.to[f]] = face_source_[f];
+  }
+  tri_.resize(3 * std::size_t(faces.count));
+  face_source_.resize(faces.count);
+  face_alive_.assign(faces.count, 1);
+  renumber_lists(vertex_faces_, faces.to);
 
   squeeze(pos_, vertices.to, vertices.count);
   squeeze(quadric_, vertices.to, vertices.count);
@@ -787,11 +825,11 @@ void Simplifier::renumber_densely() {
 // Checks pair p against the topology, inversion and error limits and contracts it if it passes;
 // otherwise it is blocked (retried when its neighbourhood changes) or, an edge whose faces all
 // died, dropped.
-bool Simplifier::try_contract(std::uint32_t p) {
+bool Simplifier::try_contract(std::uint32_t p, Worker& w) {
   const std::uint32_t a = pairs_[p].v[0], b = pairs_[p].v[1];
   bool is_edge = false;
-  if (!is_edge_and_link_ok(a, b, is_edge)) {
-    ++blocked_by_topology_;
+  if (!is_edge_and_link_ok(a, b, is_edge, w)) {
+    ++w.blocked_topology;
     block(p);
     return false;
   }
@@ -804,30 +842,44 @@ bool Simplifier::try_contract(std::uint32_t p) {
   Placed placed;
   placement_for(p, q, placed);
   if (opt_.inversion == InversionPolicy::Forbid && flips(a, b, placed.position)) {
-    ++blocked_by_inversion_;
+    ++w.blocked_inversion;
     block(p);
     return false;
   }
   double err = normalized_error(placed.error, q.weight);
   if (err > max_error_norm_) {
-    ++blocked_by_error_;
+    ++w.blocked_error;
     block(p);
     return false;
   }
-  max_error_norm_done_ = std::max(max_error_norm_done_, err);
-  contract(p, q, placed.position);
-  ++result_.contractions;
-  if (opt_.record) record_contraction(err * scale_);
+  w.max_error = std::max(w.max_error, err);
+  contract(p, q, placed.position, w);
+  ++w.contractions;
+  if (opt_.record) record_contraction(err * scale_, w);
   return true;
+}
+
+// Moves a worker's counts into the run's totals (after each contraction on the calling thread,
+// after each band for the others).
+void Simplifier::absorb(Worker& w) {
+  faces_alive_ -= w.faces_killed;
+  vertices_alive_ -= w.vertices_removed;
+  result_.contractions += w.contractions;
+  blocked_by_topology_ += w.blocked_topology;
+  blocked_by_inversion_ += w.blocked_inversion;
+  blocked_by_error_ += w.blocked_error;
+  max_error_norm_done_ = std::max(max_error_norm_done_, w.max_error);
+  w.faces_killed = w.vertices_removed = w.contractions = 0;
+  w.blocked_topology = w.blocked_inversion = w.blocked_error = 0;
 }
 
 // The contractions of a pass are known in advance, so the memory they will touch is requested a
 // few contractions ahead, in stages (a pair's ends must be in cache before their data can be
 // located): the loop then waits far less on memory.
-void Simplifier::prefetch_for_contraction(const std::vector<std::uint32_t>& pairs, std::size_t i) const {
+void Simplifier::prefetch_for_contraction(const std::uint32_t* pairs, std::size_t count, std::size_t i) const {
   constexpr std::size_t kRecord = 12, kSlots = 8, kItems = 4;
-  if (i + kRecord < pairs.size()) __builtin_prefetch(&pairs_[pairs[i + kRecord]]);
-  if (i + kSlots < pairs.size()) {
+  if (i + kRecord < count) __builtin_prefetch(&pairs_[pairs[i + kRecord]]);
+  if (i + kSlots < count) {
     for (std::uint32_t v : pairs_[pairs[i + kSlots]].v) {
       vertex_faces_.prefetch_slot(v);
       vertex_pairs_.prefetch_slot(v);
@@ -836,7 +888,7 @@ void Simplifier::prefetch_for_contraction(const std::vector<std::uint32_t>& pair
       __builtin_prefetch(reinterpret_cast<const char*>(&quadric_[v]) + 64);
     }
   }
-  if (i + kItems < pairs.size()) {
+  if (i + kItems < count) {
     for (std::uint32_t v : pairs_[pairs[i + kItems]].v) {
       vertex_faces_.prefetch_items(v);
       vertex_pairs_.prefetch_items(v);
@@ -878,7 +930,8 @@ void Simplifier::run_greedy() {
       heap_.update(top, cost_[top]);
       continue;
     }
-    try_contract(heap_.pop());
+    try_contract(heap_.pop(), main_);
+    absorb(main_);
   }
 }
 
@@ -911,8 +964,13 @@ void Simplifier::run_passes() {
     }
     // Dead faces and pairs linger in the lists of vertices that were not contracted; dropping
     // them keeps each contraction's loops (and cache misses) to the live neighbourhood.
+    // The two are independent: side by side when there are threads.
+    auto filter_pairs = [&] { vertex_pairs_.filter([&](std::uint32_t p) { return pairs_[p].state != kDead; }); };
+    std::future<void> pairs_filtered;
+    if (thread_count() > 1) pairs_filtered = std::async(std::launch::async, filter_pairs);
+    else filter_pairs();
     vertex_faces_.filter([&](std::uint32_t f) { return face_alive_[f] != 0; });
-    vertex_pairs_.filter([&](std::uint32_t p) { return pairs_[p].state != kDead; });
+    if (pairs_filtered.valid()) pairs_filtered.get();
     if (2 * vertices_alive_ < pos_.size()) renumber_densely();
     recost_dirty_pairs();
     order.clear();
@@ -952,22 +1010,178 @@ void Simplifier::run_passes() {
     const std::size_t n = selected.size();
     for (std::size_t band = 0; band < kBands; ++band)
       std::sort(selected.begin() + n * band / kBands, selected.begin() + n * (band + 1) / kBands);
-    for (std::size_t i = 0; i < n; ++i) {
-      if (done()) break;
-      prefetch_for_contraction(selected, i);
-      const std::uint32_t p = selected[i];
-      if (pairs_[p].state != kInHeap) continue;
-      if (opt_.inversion == InversionPolicy::Penalize) {  // the penalty depends on the neighbours
-        double c;
-        if (!pair_cost(p, c) || float(c) != cost_[p]) {
-          dirty_[p] = 1;
-          continue;
-        }
-      }
-      if (!report_progress()) return;
-      try_contract(p);
+    find_region_cut();
+    for (std::size_t band = 0; band < kBands && !done(); ++band) {
+      const std::size_t begin = n * band / kBands, end = n * (band + 1) / kBands;
+      if (!make_band(selected.data() + begin, end - begin)) return;
     }
   }
+}
+
+// Whether pair p, chosen for this pass, is still to be made. With --inversion penalize its cost
+// depends on the neighbours, which may have moved since it was ranked: then it waits.
+bool Simplifier::ready_to_contract(std::uint32_t p) {
+  if (pairs_[p].state != kInHeap) return false;
+  if (opt_.inversion == InversionPolicy::Penalize) {
+    double c;
+    if (!pair_cost(p, c) || float(c) != cost_[p]) {
+      dirty_[p] = 1;
+      return false;
+    }
+  }
+  return true;
+}
+
+// Marks the vertices that have a pair whose other end lies in another region (the ends of the
+// pairs that cross a region border), and their neighbours. Called once a pass (the vertex ids
+// change between passes); make_band keeps it up to date.
+void Simplifier::find_region_cut() {
+  region_scale_ = (std::uint64_t(kRegions) << 40) / std::max<std::size_t>(pos_.size(), 1);
+  cut_.assign(pos_.size(), 0);
+  near_cut_.assign(pos_.size(), 0);
+  for (const PairRecord& r : pairs_)
+    if (r.state != kDead && region_of(r.v[0]) != region_of(r.v[1])) mark_cut(r.v[0]), mark_cut(r.v[1]);
+}
+
+void Simplifier::mark_cut(std::uint32_t v) {
+  if (cut_[v]) return;
+  cut_[v] = near_cut_[v] = 1;
+  for (std::uint32_t r : vertex_pairs_[v])
+    if (pairs_[r].state != kDead) near_cut_[pairs_[r].v[0] == v ? pairs_[r].v[1] : pairs_[r].v[0]] = 1;
+}
+
+// After a contraction in the border group, whose survivor took over the other end's pairs: a pair
+// it now has into another region puts both ends on the cut, and the survivor's new neighbours
+// next to the cut (or on it) are marked near it. (Contractions inside a region change neither.)
+void Simplifier::update_cut_after(std::uint32_t a) {
+  const std::uint32_t region = region_of(a);
+  for (std::uint32_t r : vertex_pairs_[a]) {
+    if (pairs_[r].state == kDead) continue;
+    const std::uint32_t o = pairs_[r].v[0] == a ? pairs_[r].v[1] : pairs_[r].v[0];
+    if (region_of(o) != region) mark_cut(a), mark_cut(o);
+    if (cut_[o]) near_cut_[a] = 1;
+  }
+  if (!cut_[a]) return;
+  for (std::uint32_t r : vertex_pairs_[a])
+    if (pairs_[r].state != kDead) near_cut_[pairs_[r].v[0] == a ? pairs_[r].v[1] : pairs_[r].v[0]] = 1;
+}
+
+// Makes `count` chosen pairs (one band of a pass), in a fixed schedule that does not depend on the
+// thread count: first, region by region, the pairs that lie inside a region, then the pairs near
+// or across region borders, each group in the band's order. A pair is inside its region when
+// neither end is on the cut or next to it. Everything its contraction reads or writes (the faces
+// and pairs of its ends, their neighbours' flags and pairs) is then within two steps of its ends,
+// so inside its region; and contractions inside a region never create a pair to another one, so
+// this stays true through the band. So the regions can be made at the same time on several
+// threads, with exactly the result of making them one after another. That is done unless the
+// band could reach the target (the run must stop at exactly the same contraction) or the
+// contractions are recorded; then they are made one after another, in the same schedule.
+// Returns false if the caller cancelled.
+bool Simplifier::make_band(const std::uint32_t* band, std::size_t count) {
+  // Each pair to its region or to the border group. The arena stretches of a region get the
+  // most room its contractions' moved lists can take.
+  std::array<std::vector<std::uint32_t>, kRegions> inside;
+  std::vector<std::uint32_t> border;
+  std::vector<std::size_t> face_room(kRegions, 0), pair_room(kRegions, 0);
+  std::vector<std::size_t> face_room_compacted(kRegions, 0), pair_room_compacted(kRegions, 0);
+  std::size_t faces_at_stake = 0;
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::uint32_t p = band[i], a = pairs_[p].v[0], b = pairs_[p].v[1];
+    const std::uint32_t region = region_of(a);
+    if (near_cut_[a] || near_cut_[b] || region_of(b) != region) {
+      border.push_back(p);
+      continue;
+    }
+    inside[region].push_back(p);
+    face_room[region] += vertex_faces_.growth_bound(a, b, true);
+    pair_room[region] += vertex_pairs_.growth_bound(a, b, true);
+    face_room_compacted[region] += vertex_faces_.growth_bound(a, b, false);
+    pair_room_compacted[region] += vertex_pairs_.growth_bound(a, b, false);
+    faces_at_stake += vertex_faces_[a].size() + vertex_faces_[b].size();  // it removes only faces of its ends
+  }
+  // The two arenas are independent: when they must be slid together, that is done side by side.
+  std::vector<VertexLists::Tail> face_tails, pair_tails;
+  auto carve_pairs = [&] { vertex_pairs_.carve(pair_room, pair_room_compacted, pair_tails); };
+  if (thread_count() > 1) {
+    std::future<void> pairs_carved = std::async(std::launch::async, carve_pairs);
+    vertex_faces_.carve(face_room, face_room_compacted, face_tails);
+    pairs_carved.get();
+  } else {
+    vertex_faces_.carve(face_room, face_room_compacted, face_tails);
+    carve_pairs();
+  }
+
+  // Disjoint stamp ranges (each contraction takes 3 stamps), so every stamp stays unique.
+  std::array<std::uint32_t, kRegions> first_stamp;
+  for (std::uint32_t r = 0; r < kRegions; ++r) {
+    first_stamp[r] = main_.stamp;
+    main_.stamp += std::uint32_t(3 * inside[r].size());
+  }
+
+  const std::size_t inside_count = count - border.size();
+  const bool parallel = thread_count() > 1 && !opt_.record && faces_alive_ > target_faces_ + faces_at_stake &&
+                        vertices_alive_ > target_vertices_ + inside_count;
+  // Returns false if the caller cancelled.
+  auto make_region = [&](std::uint32_t r, Worker& w, bool one_by_one) {
+    w.stamp = first_stamp[r];
+    w.face_tail = &face_tails[r];
+    w.pair_tail = &pair_tails[r];
+    const std::vector<std::uint32_t>& pairs = inside[r];
+    for (std::size_t i = 0; i < pairs.size(); ++i) {
+      if (one_by_one && done()) break;
+      if (one_by_one && !report_progress()) return false;
+      prefetch_for_contraction(pairs.data(), pairs.size(), i);
+      if (!ready_to_contract(pairs[i])) continue;
+      try_contract(pairs[i], w);
+      if (one_by_one) absorb(w);
+    }
+    return true;
+  };
+
+  bool go_on = true;
+  if (parallel) {
+    const unsigned threads = std::min<unsigned>(thread_count(), kRegions);
+    std::vector<Worker> workers(threads);
+    std::vector<std::exception_ptr> failures(threads);
+    std::atomic<std::uint32_t> next_region{0};
+    auto work = [&](unsigned t) {
+      try {
+        for (std::uint32_t r; (r = next_region.fetch_add(1)) < kRegions;) make_region(r, workers[t], false);
+      } catch (...) {
+        failures[t] = std::current_exception();
+      }
+    };
+    std::vector<std::thread> helpers;
+    try {
+      for (unsigned t = 1; t < threads; ++t) helpers.emplace_back(work, t);
+    } catch (const std::system_error&) {
+      // No more threads to be had: this one takes the regions left (same result).
+    }
+    work(0);
+    for (std::thread& h : helpers) h.join();
+    for (unsigned t = 0; t < threads; ++t) {
+      if (failures[t]) std::rethrow_exception(failures[t]);
+      absorb(workers[t]);
+    }
+    go_on = report_progress();
+  } else {
+    const std::uint32_t stamp = main_.stamp;
+    for (std::uint32_t r = 0; r < kRegions && go_on; ++r) go_on = make_region(r, main_, true);
+    main_.stamp = stamp;
+  }
+  main_.face_tail = main_.pair_tail = nullptr;
+
+  // The border group, one by one.
+  for (std::size_t i = 0; i < border.size() && go_on; ++i) {
+    if (done()) break;
+    if (!report_progress()) return false;
+    prefetch_for_contraction(border.data(), border.size(), i);
+    if (!ready_to_contract(border[i]) || !try_contract(border[i], main_)) continue;
+    absorb(main_);
+    update_cut_after(main_.last_kept);
+  }
+  absorb(main_);
+  return go_on;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -991,8 +1205,17 @@ SimplifyResult Simplifier::run() {
     return build_output();
   }
   build_adjacency();
-  compute_quadrics();
-  select_pairs();
+  // The quadrics and the edges are independent: found side by side when there are threads.
+  std::vector<Edge> edges;
+  if (thread_count() > 1) {
+    std::future<void> quadrics = std::async(std::launch::async, [this] { compute_quadrics(); });
+    edges = unique_edges(tri_, vertex_faces_, pos_.size());
+    quadrics.get();
+  } else {
+    compute_quadrics();
+    edges = unique_edges(tri_, vertex_faces_, pos_.size());
+  }
+  select_pairs(std::move(edges));
   result_.virtual_pairs = virtual_pairs_;
 
   result_.stop_reason = StopReason::TargetReached;

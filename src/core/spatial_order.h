@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/quadric.h"
+#include "core/radix_sort.h"
 
 namespace qem::core {
 
@@ -32,7 +33,7 @@ std::vector<std::uint32_t> morton_order(std::size_t n, PointOf point_of) {
   // One scale for all axes keeps the cells cubic.
   const double extent = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
   const double scale = extent > 0 ? double((1 << 21) - 1) / extent : 0;
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(n);
+  std::vector<std::uint64_t> code(n);
   for (std::size_t i = 0; i < n; ++i) {
     const Vec3 p = point_of(i);
     // Clamped before the conversion (NaN, inf and out-of-range doubles must never reach the cast:
@@ -41,13 +42,22 @@ std::vector<std::uint32_t> morton_order(std::size_t n, PointOf point_of) {
       const double c = (x - l) * scale;
       return c >= 0 ? std::uint64_t(std::min(c, double((1 << 21) - 1))) : std::uint64_t(0);
     };
-    keyed[i] = {spread_bits_3d(cell(p.x, lo.x)) | spread_bits_3d(cell(p.y, lo.y)) << 1 |
-                    spread_bits_3d(cell(p.z, lo.z)) << 2,
-                std::uint32_t(i)};
+    code[i] = spread_bits_3d(cell(p.x, lo.x)) | spread_bits_3d(cell(p.y, lo.y)) << 1 |
+              spread_bits_3d(cell(p.z, lo.z)) << 2;
   }
-  std::sort(keyed.begin(), keyed.end());
-  std::vector<std::uint32_t> order(n);
-  for (std::size_t i = 0; i < n; ++i) order[i] = keyed[i].second;
+  // Sorted by (code, index): a stable radix sort on the code's top 32 of 63 bits (linear time; the
+  // comparison sort of (code, index) it replaces took about 0.1 s of the set-up on a 655k-vertex
+  // mesh), then each run of equal top bits, almost always a single point, by its full code.
+  std::vector<std::uint32_t> order(n), scratch;
+  for (std::size_t i = 0; i < n; ++i) order[i] = std::uint32_t(i);
+  radix_sort_by_key(order, scratch, [&](std::uint32_t i) { return std::uint32_t(code[i] >> 31); });
+  for (std::size_t begin = 0, end; begin < n; begin = end) {
+    end = begin + 1;
+    while (end < n && code[order[end]] >> 31 == code[order[begin]] >> 31) ++end;
+    if (end - begin > 1)
+      std::sort(order.begin() + std::ptrdiff_t(begin), order.begin() + std::ptrdiff_t(end),
+                [&](std::uint32_t a, std::uint32_t b) { return code[a] != code[b] ? code[a] < code[b] : a < b; });
+  }
   return order;
 }
 
