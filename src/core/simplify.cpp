@@ -942,7 +942,8 @@ void Simplifier::run_greedy() {
 // cost at that quarter (the rule of meshoptimizer). No two chosen pairs share a vertex, so each
 // one's cost is still exact when it is made, as in the greedy order; what differs is that the new
 // vertex's own pairs wait for the next pass. The chosen pairs are made in memory order within
-// bands of rising cost, which keeps the caches warm.
+// bands of rising cost, which keeps the caches warm, and each band region by region on all
+// threads (make_band).
 void Simplifier::run_passes() {
   // Measured on the bunny, armadillo, igea and the 1.3M sphere (docs/benchmarks.md): a slack of
   // 1.2 or a share of 0.15 or 0.35 moved E by a few percent either way, case by case, with no
@@ -1006,7 +1007,8 @@ void Simplifier::run_passes() {
     // of jumping across them in cost order, and a run that reaches its target during a pass has
     // made the cheapest of the pass's contractions, spread over the whole mesh. No chosen pair
     // shares an end with another, so each one's cost is still exact when it is made; the
-    // topology and inversion checks run on the mesh as it is at that moment.
+    // topology and inversion checks run on the mesh as it is at that moment (make_band says in
+    // which order within a band).
     const std::size_t n = selected.size();
     for (std::size_t band = 0; band < kBands; ++band)
       std::sort(selected.begin() + n * band / kBands, selected.begin() + n * (band + 1) / kBands);
