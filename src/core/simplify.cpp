@@ -136,6 +136,19 @@ class Simplifier {
   unsigned thread_count() const {
     return opt_.threads > 0 ? opt_.threads : std::max(1u, std::thread::hardware_concurrency());
   }
+  // Two independent pieces of work: side by side when there are threads (the first on a helper
+  // thread), else one after the other. Either way the result is the same.
+  template <class First, class Second>
+  void side_by_side(First first, Second second) {
+    if (thread_count() < 2) {
+      first();
+      second();
+      return;
+    }
+    std::future<void> first_done = std::async(std::launch::async, first);
+    second();
+    first_done.get();
+  }
 
   // --- the contraction loop ------------------------------------------------------------------
   bool pair_cost(std::uint32_t p, double& cost);
@@ -159,6 +172,9 @@ class Simplifier {
     face_alive_[f] = 0;
     ++w.faces_killed;
     if (opt_.record) opt_.record->dead_faces.push_back(face_source_[f]);
+  }
+  std::uint32_t other_end(std::uint32_t p, std::uint32_t v) const {
+    return pairs_[p].v[0] == v ? pairs_[p].v[1] : pairs_[p].v[0];
   }
   bool face_has(std::uint32_t f, std::uint32_t v) const {
     const std::uint32_t* t = &tri_[3 * std::size_t(f)];
@@ -230,6 +246,7 @@ class Simplifier {
   std::uint32_t region_of(std::uint32_t v) const { return std::uint32_t((v * region_scale_) >> 40); }
   std::vector<std::uint8_t> cut_, near_cut_;
   void mark_cut(std::uint32_t v);
+  void mark_neighbours_near(std::uint32_t v);
   void update_cut_after(std::uint32_t survivor);
 
   std::size_t faces_alive_ = 0, vertices_alive_ = 0;
@@ -633,7 +650,7 @@ void Simplifier::block(std::uint32_t p) {
 void Simplifier::unblock_around(std::uint32_t v) {
   for (std::uint32_t p : vertex_pairs_[v]) {
     if (pairs_[p].state == kDead) continue;
-    std::uint32_t o = pairs_[p].v[0] == v ? pairs_[p].v[1] : pairs_[p].v[0];
+    std::uint32_t o = other_end(p, v);
     if (!has_blocked_[o]) continue;
     has_blocked_[o] = 0;
     for (std::uint32_t q : vertex_pairs_[o])
@@ -965,13 +982,8 @@ void Simplifier::run_passes() {
     }
     // Dead faces and pairs linger in the lists of vertices that were not contracted; dropping
     // them keeps each contraction's loops (and cache misses) to the live neighbourhood.
-    // The two are independent: side by side when there are threads.
-    auto filter_pairs = [&] { vertex_pairs_.filter([&](std::uint32_t p) { return pairs_[p].state != kDead; }); };
-    std::future<void> pairs_filtered;
-    if (thread_count() > 1) pairs_filtered = std::async(std::launch::async, filter_pairs);
-    else filter_pairs();
-    vertex_faces_.filter([&](std::uint32_t f) { return face_alive_[f] != 0; });
-    if (pairs_filtered.valid()) pairs_filtered.get();
+    side_by_side([&] { vertex_pairs_.filter([&](std::uint32_t p) { return pairs_[p].state != kDead; }); },
+                 [&] { vertex_faces_.filter([&](std::uint32_t f) { return face_alive_[f] != 0; }); });
     if (2 * vertices_alive_ < pos_.size()) renumber_densely();
     recost_dirty_pairs();
     order.clear();
@@ -1048,8 +1060,12 @@ void Simplifier::find_region_cut() {
 void Simplifier::mark_cut(std::uint32_t v) {
   if (cut_[v]) return;
   cut_[v] = near_cut_[v] = 1;
+  mark_neighbours_near(v);
+}
+
+void Simplifier::mark_neighbours_near(std::uint32_t v) {
   for (std::uint32_t r : vertex_pairs_[v])
-    if (pairs_[r].state != kDead) near_cut_[pairs_[r].v[0] == v ? pairs_[r].v[1] : pairs_[r].v[0]] = 1;
+    if (pairs_[r].state != kDead) near_cut_[other_end(r, v)] = 1;
 }
 
 // After a contraction in the border group, whose survivor took over the other end's pairs: a pair
@@ -1059,13 +1075,11 @@ void Simplifier::update_cut_after(std::uint32_t a) {
   const std::uint32_t region = region_of(a);
   for (std::uint32_t r : vertex_pairs_[a]) {
     if (pairs_[r].state == kDead) continue;
-    const std::uint32_t o = pairs_[r].v[0] == a ? pairs_[r].v[1] : pairs_[r].v[0];
+    const std::uint32_t o = other_end(r, a);
     if (region_of(o) != region) mark_cut(a), mark_cut(o);
     if (cut_[o]) near_cut_[a] = 1;
   }
-  if (!cut_[a]) return;
-  for (std::uint32_t r : vertex_pairs_[a])
-    if (pairs_[r].state != kDead) near_cut_[pairs_[r].v[0] == a ? pairs_[r].v[1] : pairs_[r].v[0]] = 1;
+  if (cut_[a]) mark_neighbours_near(a);
 }
 
 // Makes `count` chosen pairs (one band of a pass), in a fixed schedule that does not depend on the
@@ -1103,15 +1117,8 @@ bool Simplifier::make_band(const std::uint32_t* band, std::size_t count) {
   }
   // The two arenas are independent: when they must be slid together, that is done side by side.
   std::vector<VertexLists::Tail> face_tails, pair_tails;
-  auto carve_pairs = [&] { vertex_pairs_.carve(pair_room, pair_room_compacted, pair_tails); };
-  if (thread_count() > 1) {
-    std::future<void> pairs_carved = std::async(std::launch::async, carve_pairs);
-    vertex_faces_.carve(face_room, face_room_compacted, face_tails);
-    pairs_carved.get();
-  } else {
-    vertex_faces_.carve(face_room, face_room_compacted, face_tails);
-    carve_pairs();
-  }
+  side_by_side([&] { vertex_pairs_.carve(pair_room, pair_room_compacted, pair_tails); },
+               [&] { vertex_faces_.carve(face_room, face_room_compacted, face_tails); });
 
   // Disjoint stamp ranges (each contraction takes 3 stamps), so every stamp stays unique.
   std::array<std::uint32_t, kRegions> first_stamp;
@@ -1207,16 +1214,9 @@ SimplifyResult Simplifier::run() {
     return build_output();
   }
   build_adjacency();
-  // The quadrics and the edges are independent: found side by side when there are threads.
+  // The quadrics and the edges are independent: found side by side.
   std::vector<Edge> edges;
-  if (thread_count() > 1) {
-    std::future<void> quadrics = std::async(std::launch::async, [this] { compute_quadrics(); });
-    edges = unique_edges(tri_, vertex_faces_, pos_.size());
-    quadrics.get();
-  } else {
-    compute_quadrics();
-    edges = unique_edges(tri_, vertex_faces_, pos_.size());
-  }
+  side_by_side([this] { compute_quadrics(); }, [&] { edges = unique_edges(tri_, vertex_faces_, pos_.size()); });
   select_pairs(std::move(edges));
   result_.virtual_pairs = virtual_pairs_;
 
