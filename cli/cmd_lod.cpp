@@ -29,6 +29,7 @@ struct LodArgs {
   std::vector<std::size_t> faces;
   AlgorithmArgs algorithm;
   bool ascii = false, json = false, quiet = false;
+  bool double_values = false;  // --double
 };
 
 int run_lod(const LodArgs& a) {
@@ -40,7 +41,8 @@ int run_lod(const LodArgs& a) {
   Stopwatch total;
   const double cpu_start = process_cpu_seconds();
 
-  Mesh mesh = load_mesh(a.input, to_load_options(a.algorithm));
+  LoadReport report;
+  Mesh mesh = load_mesh(a.input, to_load_options(a.algorithm), &report);
 
   // One run to the coarsest level, recorded. Ratios are taken of the faces the run starts from
   // (degenerate and duplicate input faces dropped), exactly as `qem simplify --ratio` does.
@@ -70,6 +72,7 @@ int run_lod(const LodArgs& a) {
   const std::string stem = a.name.empty() ? fs::path(a.input).stem().string() : a.name;
   SaveOptions save;
   save.binary = !a.ascii;
+  save.double_precision = a.double_values || report.double_precision;
   save.format = format_from_extension("x." + a.format);
   const double cpu_write0 = process_cpu_seconds();
   std::string manifest = "{\n  \"generator\": \"qem lod\",\n  \"source\": " +
@@ -132,6 +135,8 @@ const bool registered = register_command(13, [](CLI::App& app) {
                   "File name stem of the levels: <name>_lod<i>.<ext> (default: input's stem)");
   add_algorithm_options(sub, args->algorithm);
   sub->add_flag("--ascii", args->ascii, "Write PLY / STL as text instead of binary");
+  sub->add_flag("--double", args->double_values,
+                "Write PLY values as double (default: double when the input is a PLY that stores doubles, as georeferenced scans do; float otherwise)");
   sub->add_flag("--json", args->json, "Print one JSON line with CPU timings and memory on stdout");
   sub->add_flag("--quiet,-q", args->quiet, "No summary on stderr");
   return [args] { return run_lod(*args); };

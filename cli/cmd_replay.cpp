@@ -20,6 +20,7 @@ struct ReplayArgs {
   std::size_t faces = 0;
   double ratio = 0;
   bool ascii = false, quiet = false, force = false;
+  bool double_values = false;  // --double
 };
 
 int run_replay(const ReplayArgs& a) {
@@ -36,6 +37,7 @@ int run_replay(const ReplayArgs& a) {
   const std::vector<ReplayLevel> level = replay_levels(record, targets);
   SaveOptions save;
   save.binary = !a.ascii;
+  save.double_precision = a.double_values;
   save_mesh(a.output, level[0].mesh, save);
   if (!a.quiet) {
     if (target < record.final_faces())
@@ -61,6 +63,7 @@ const bool registered = register_command(12, [](CLI::App& app) {
   sub->add_option("--ratio,-r", args->ratio,
                   "Stop at or below this fraction of the recorded run's input faces");
   sub->add_flag("--ascii", args->ascii, "Write PLY / STL as text instead of binary");
+  sub->add_flag("--double", args->double_values, "Write PLY values as double instead of float");
   sub->add_flag("--quiet,-q", args->quiet, "No summary on stderr");
   sub->add_flag("--force", args->force, "Allow the output to overwrite the record file");
   return [args] { return run_replay(*args); };

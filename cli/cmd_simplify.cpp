@@ -24,6 +24,7 @@ struct SimplifyArgs {
   double max_error = -1, max_error_rel = -1;
   AlgorithmArgs algorithm;
   bool ascii = false, json = false, quiet = false, force = false;
+  bool double_values = false;  // --double
   std::string record;  // --record: the contraction sequence (docs/record-format.md)
 };
 
@@ -69,6 +70,7 @@ int run_simplify(const SimplifyArgs& a) {
   Stopwatch t_write;
   SaveOptions save;
   save.binary = !a.ascii;
+  save.double_precision = a.double_values || report.double_precision;
   save_mesh(a.output, r.mesh, save);
   if (!a.record.empty()) write_record(a.record, make_record(mesh, log));  // atomic, like save_mesh
   const double write_s = t_write.seconds();
@@ -107,6 +109,8 @@ const bool registered = register_command(10, [](CLI::App& app) {
   g->add_option("--max-error-rel", args->max_error_rel, "As --max-error, relative to the bounding-box diagonal");
   add_algorithm_options(sub, args->algorithm);
   sub->add_flag("--ascii", args->ascii, "Write PLY / STL as text instead of binary");
+  sub->add_flag("--double", args->double_values,
+                "Write PLY values as double (default: double when the input is a PLY that stores doubles, as georeferenced scans do; float otherwise)");
   sub->add_flag("--json", args->json, "Print one JSON line with counts, timings, memory and error on stdout");
   sub->add_flag("--quiet,-q", args->quiet, "No progress and no summary on stderr");
   sub->add_flag("--force", args->force, "Allow the output to overwrite the input file");

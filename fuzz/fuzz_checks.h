@@ -45,9 +45,8 @@ inline std::string check_mesh(const Mesh& m) {
 }
 
 /// Parses `bytes` as `format`. A qem::Error from the reader is the documented rejection and gives
-/// "". Otherwise the mesh must pass check_mesh, and what the writers write (a writer may refuse
-/// with qem::Error, e.g. a PLY property name it cannot write) must read back with the same face
-/// count. Returns "" or what is wrong; exceptions other than qem::Error propagate.
+/// "". Otherwise the mesh must pass check_mesh, and what the writers write must read back with the
+/// same face count (and the same coordinates, where the variant is lossless). Returns "" or what is wrong; exceptions other than qem::Error propagate.
 inline std::string check_parse(std::string_view bytes, FileFormat format) {
   LoadOptions options;
   options.format = format;
@@ -60,14 +59,26 @@ inline std::string check_parse(std::string_view bytes, FileFormat format) {
   }
   std::string problem = check_mesh(mesh);
   if (!problem.empty()) return problem;
-  const bool has_binary = format == FileFormat::Ply || format == FileFormat::Stl;
-  for (bool binary : {false, true}) {
-    if (binary && !has_binary) break;
+  // Every variant the format has: text and binary, and for PLY float and double values. A writer
+  // may refuse with qem::Error (a PLY property name it cannot write, a coordinate beyond float
+  // range).
+  std::vector<SaveOptions> variants;
+  for (bool binary : {false, true})
+    for (bool double_precision : {false, true}) {
+      if (binary && format != FileFormat::Ply && format != FileFormat::Stl) continue;
+      if (double_precision && format != FileFormat::Ply) continue;
+      SaveOptions o;
+      o.format = format;
+      o.binary = binary;
+      o.double_precision = double_precision;
+      variants.push_back(o);
+    }
+  for (const SaveOptions& o : variants) {
     std::string out;
     try {
-      out = serialize_mesh(mesh, format, binary);
+      out = serialize_mesh(mesh, o);
     } catch (const Error&) {
-      return "";
+      continue;
     }
     Mesh again;
     try {
@@ -78,6 +89,11 @@ inline std::string check_parse(std::string_view bytes, FileFormat format) {
     if (again.face_count() != mesh.face_count())
       return "a write/read round trip changed the face count from " + std::to_string(mesh.face_count()) +
              " to " + std::to_string(again.face_count());
+    // A double PLY, OBJ and OFF keep every coordinate exactly (shortest round-trip text or the
+    // raw bits); float formats keep them to float precision.
+    if (o.double_precision || format == FileFormat::Obj || format == FileFormat::Off) {
+      if (again.positions != mesh.positions) return "a lossless write/read round trip changed a coordinate";
+    }
   }
   return "";
 }

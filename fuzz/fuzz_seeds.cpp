@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "qem/error.h"
 #include "qem/io.h"
 #include "qem/mesh.h"
 
@@ -95,11 +96,24 @@ void serialised_seeds(const fs::path& out) {
                             {qem::FileFormat::Off, "off", false}};
   for (const Format& f : formats)
     for (const Named& m : meshes)
-      for (bool binary : {false, true}) {
-        if (binary && !f.has_binary) continue;
-        std::string file = std::string("seed_") + m.name + (binary ? "_binary" : "_ascii");
-        write_file(out / f.dir / file, qem::serialize_mesh(m.mesh, f.format, binary));
-      }
+      for (bool binary : {false, true})
+        for (bool double_precision : {false, true}) {
+          if (binary && !f.has_binary) continue;
+          if (double_precision && f.format != qem::FileFormat::Ply) continue;
+          qem::SaveOptions o;
+          o.format = f.format;
+          o.binary = binary;
+          o.double_precision = double_precision;
+          std::string bytes;
+          try {
+            bytes = qem::serialize_mesh(m.mesh, o);
+          } catch (const qem::Error&) {
+            continue;  // the float writers refuse odd()'s 1e300: no such file can exist
+          }
+          std::string file = std::string("seed_") + m.name + (binary ? "_binary" : "_ascii") +
+                             (double_precision ? "_double" : "");
+          write_file(out / f.dir / file, bytes);
+        }
 }
 
 /// Big-endian binary PLY with an extra property, uchar counts and a quad, built byte by byte.

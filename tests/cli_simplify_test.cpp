@@ -99,6 +99,32 @@ TEST(CliSimplify, FailedRunLeavesNoOutputAndNamesTheProblem) {
     EXPECT_EQ(e.path().filename().string().find("cli_never"), std::string::npos) << e.path();
 }
 
+TEST(CliSimplify, DoublePlyInputGivesDoublePlyOutput) {
+  // Georeferenced coordinates (UTM northings near 5e6 m) lose centimetres in float: a PLY that
+  // stores doubles is written back with doubles, and --double asks for them on any input.
+  Mesh m = test::icosphere(3);
+  for (std::size_t i = 0; i < m.positions.size(); i += 3) m.positions[i + 1] += 5123456.789;
+  const std::string in = test::temp_dir() + "/cli_utm.ply", out = test::temp_dir() + "/cli_utm_out.ply";
+  SaveOptions o;
+  o.double_precision = true;
+  save_mesh(in, m, o);
+  ASSERT_EQ(run("simplify " + in + " " + out + " --faces 200 --quiet").exit_code, 0);
+  LoadReport report;
+  Mesh simplified = load_mesh(out, {}, &report);
+  EXPECT_TRUE(report.double_precision);
+  EXPECT_EQ(simplified.face_count(), 200u);
+  bool sub_float_detail = false;  // some coordinate that float would have rounded
+  for (double c : simplified.positions) sub_float_detail |= double(float(c)) != c;
+  EXPECT_TRUE(sub_float_detail);
+
+  ASSERT_EQ(run("simplify " + sphere_file() + " " + out + " --faces 200 --quiet").exit_code, 0);
+  load_mesh(out, {}, &report);
+  EXPECT_FALSE(report.double_precision);
+  ASSERT_EQ(run("simplify " + sphere_file() + " " + out + " --faces 200 --quiet --double").exit_code, 0);
+  load_mesh(out, {}, &report);
+  EXPECT_TRUE(report.double_precision);
+}
+
 TEST(CliSimplify, BadOptionsAreRejected) {
   const std::string out = test::temp_dir() + "/cli_opt.ply";
   EXPECT_NE(run("simplify " + sphere_file() + " " + out).exit_code, 0);  // no target
@@ -115,7 +141,7 @@ TEST(CliSimplify, HelpDocumentsEveryOption) {
   for (const char* opt : {"--faces", "--ratio", "--vertices", "--max-error", "--max-error-rel", "--threshold",
                           "--threshold-rel", "--weighting", "--placement", "--boundary-weight", "--lock-border",
                           "--inversion", "--max-turn", "--allow-non-manifold", "--weld", "--json", "--quiet",
-                          "--force"})
+                          "--force", "--double"})
     EXPECT_NE(r.out.find(opt), std::string::npos) << opt;
 }
 

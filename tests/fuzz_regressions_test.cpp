@@ -108,6 +108,20 @@ std::vector<ParserCase> parser_cases() {
            kTriangleVerts + "3 0 1 2.0\n",
        Expect::Either},
 
+      // --- found by fuzz_ply in CI: an ASCII PLY declaring double coordinates held one beyond the
+      // float range, and the default float writer wrote "inf", which the reader then refused. The
+      // float writer must refuse it (qem::Error); the double writer must keep it exactly.
+      {"ply_double_coordinate_beyond_float", FileFormat::Ply,
+       ply_header("ascii", "element vertex 3\nproperty double x\nproperty double y\nproperty double z\n"
+                           "element face 1\nproperty list uchar int vertex_indices\n") +
+           "1e300 0 0\n1 0 0\n0 1 -1.7976931348623157e308\n3 0 1 2\n",
+       Expect::Either},
+      {"ply_double_property_beyond_float", FileFormat::Ply,
+       ply_header("ascii", "element vertex 3\n" + ply_xyz + "property double q\n"
+                           "element face 1\nproperty list uchar int vertex_indices\n") +
+           "0 0 0 1e300\n1 0 0 inf\n0 1 0 -5e-324\n3 0 1 2\n",
+       Expect::Either},
+
       // --- OBJ ---------------------------------------------------------------------------------
       {"obj_face_without_vertices", FileFormat::Obj, "f 1 2 3\n", Expect::Reject},
       {"obj_index_zero", FileFormat::Obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", Expect::Reject},

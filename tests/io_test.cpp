@@ -12,6 +12,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <string>
@@ -517,6 +518,51 @@ TEST(IoWrite, AtomicSaveLeavesTargetUntouchedOnFailure) {
   qem::save_mesh(target, qem::test::cube());
   EXPECT_EQ(qem::load_mesh(target).face_count(), 12u);
   EXPECT_TRUE(temp_leftovers(dir).empty());
+}
+
+TEST(IoWrite, FloatWritersRefuseCoordinatesBeyondFloatAndDoublePlyKeepsThem) {
+  qem::Mesh m = qem::test::cube();
+  m.positions[3 * 5 + 1] = -4e38;  // just beyond FLT_MAX (3.4028e38)
+  for (bool binary : {false, true}) {
+    for (FileFormat f : {FileFormat::Ply, FileFormat::Stl}) {
+      try {
+        qem::serialize_mesh(m, f, binary);
+        ADD_FAILURE() << "no error for format " << int(f) << " binary=" << binary;
+      } catch (const qem::Error& e) {
+        EXPECT_NE(std::string(e.what()).find("vertex 5 has coordinate -4e+38"), std::string::npos) << e.what();
+      }
+    }
+    qem::SaveOptions o;
+    o.format = FileFormat::Ply;
+    o.binary = binary;
+    o.double_precision = true;
+    EXPECT_EQ(qem::parse_mesh(qem::serialize_mesh(m, o), FileFormat::Ply, "x").positions, m.positions);
+  }
+  // FLT_MAX itself is representable and written as is.
+  m.positions[3 * 5 + 1] = -double(std::numeric_limits<float>::max());
+  EXPECT_EQ(qem::parse_mesh(qem::serialize_mesh(m, FileFormat::Ply, true), FileFormat::Ply, "x").positions,
+            m.positions);
+  // A property value beyond float is refused by a float PLY too, an infinite one is kept.
+  m.positions[3 * 5 + 1] = 1;
+  m.vertex_properties.push_back({"q", std::vector<double>(m.vertex_count(), 0)});
+  m.vertex_properties[0].values[2] = std::numeric_limits<double>::infinity();
+  EXPECT_NO_THROW(qem::serialize_mesh(m, FileFormat::Ply, true));
+  m.vertex_properties[0].values[3] = 1e39;
+  EXPECT_THROW(qem::serialize_mesh(m, FileFormat::Ply, true), qem::Error);
+}
+
+TEST(IoWrite, NonFiniteCoordinatesAreRefusedByEveryWriter) {
+  qem::Mesh m = qem::test::cube();
+  m.positions[7] = std::numeric_limits<double>::quiet_NaN();
+  for (FileFormat f : {FileFormat::Obj, FileFormat::Ply, FileFormat::Stl, FileFormat::Off}) {
+    try {
+      qem::serialize_mesh(m, f, false);
+      ADD_FAILURE() << "no error for format " << int(f);
+    } catch (const qem::Error& e) {
+      EXPECT_NE(std::string(e.what()).find("vertex 2 has a coordinate that is not finite"), std::string::npos)
+          << e.what();
+    }
+  }
 }
 
 TEST(IoWrite, BinaryStlHeaderDoesNotStartWithSolid) {

@@ -338,6 +338,26 @@ TEST(Progressive, CliReplayIsByteIdenticalToSimplify) {
   EXPECT_NE(run("replay " + dir + "/broken.qrec " + dir + "/x.ply 2>/dev/null"), 0);
 }
 
+TEST(Progressive, CliDoublePlyStaysDoubleInSimplifyLodAndReplay) {
+  // A PLY storing doubles is written back with doubles by simplify and lod; replay needs --double
+  // (the record does not say how the input was stored) and then gives the same bytes.
+  const std::string dir = test::temp_dir() + "/prog_cli_double";
+  std::filesystem::create_directories(dir);
+  const std::string in = dir + "/in.ply";
+  SaveOptions o;
+  o.double_precision = true;
+  save_mesh(in, test::transformed(test::icosphere(3), 1, 4.5e6, -3.2e5, 1e3), o);
+  ASSERT_EQ(run("simplify " + in + " " + dir + "/s.ply --ratio 0.25 --record " + dir + "/run.qrec"), 0);
+  ASSERT_EQ(run("lod " + in + " " + dir + "/lod --ratios 0.25"), 0);
+  ASSERT_EQ(run("replay " + dir + "/run.qrec " + dir + "/r.ply --double"), 0);
+  ASSERT_EQ(run("replay " + dir + "/run.qrec " + dir + "/r_float.ply"), 0);
+  const std::string s = slurp(dir + "/s.ply");
+  EXPECT_NE(s.find("property double x"), std::string::npos);
+  EXPECT_TRUE(s == slurp(dir + "/lod/in_lod0.ply")) << "lod level differs from simplify";
+  EXPECT_TRUE(s == slurp(dir + "/r.ply")) << "replay --double differs from simplify";
+  EXPECT_NE(slurp(dir + "/r_float.ply").find("property float x"), std::string::npos);
+}
+
 TEST(Progressive, CliLodWritesLevelsAndManifest) {
   const std::string dir = test::temp_dir() + "/prog_cli_lod";
   std::filesystem::create_directories(dir);

@@ -9,7 +9,9 @@
 
 #include <cerrno>
 #include <charconv>
+#include <cmath>
 #include <cstring>
+#include <limits>
 
 namespace qem::io {
 
@@ -138,6 +140,29 @@ void check_mesh_for_writing(const Mesh& mesh) {
     if (p.values.size() != nv)
       throw Error("cannot write mesh: vertex property '" + p.name + "' has " +
                   std::to_string(p.values.size()) + " values for " + std::to_string(nv) + " vertices");
+  for (std::size_t i = 0; i < mesh.positions.size(); ++i)
+    if (!std::isfinite(mesh.positions[i]))
+      throw Error("cannot write mesh: vertex " + std::to_string(i / 3) + " has a coordinate that is not finite");
+}
+
+void check_fits_in_float(const Mesh& mesh, bool with_properties, const char* what) {
+  auto refuse = [&](std::size_t vertex, const std::string& value_name, double v) {
+    std::string value;
+    append_number(value, v);
+    throw Error(std::string("cannot write ") + what + ": vertex " + std::to_string(vertex) + " has " + value_name +
+                " " + value + ", beyond single precision (about 3.4e38); write a PLY with double values (qem --double), "
+                "an OBJ or an OFF");
+  };
+  // Compared before any conversion: a double beyond the float range converted to float is undefined
+  // behaviour in C++ (in practice infinity). An infinite or NaN property value stays what it is.
+  const double limit = std::numeric_limits<float>::max();
+  for (std::size_t i = 0; i < mesh.positions.size(); ++i)
+    if (std::fabs(mesh.positions[i]) > limit) refuse(i / 3, "coordinate", mesh.positions[i]);
+  if (with_properties)
+    for (const VertexProperty& p : mesh.vertex_properties)
+      for (std::size_t i = 0; i < p.values.size(); ++i)
+        if (std::isfinite(p.values[i]) && std::fabs(p.values[i]) > limit)
+          refuse(i, "property '" + p.name + "' =", p.values[i]);
 }
 
 }  // namespace qem::io

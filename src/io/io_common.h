@@ -219,7 +219,13 @@ void append_number(std::string& out, double v);
 void append_number(std::string& out, float v);
 void append_uint(std::string& out, std::uint64_t v);
 
-/// Throws unless the mesh is well formed for writing (index range, whole triangles).
+/// Throws unless the mesh is well formed for writing (index range, whole triangles, finite
+/// coordinates: every reader refuses a non-finite one, so a writer must not produce it).
 void check_mesh_for_writing(const Mesh& mesh);
+
+/// Throws unless every coordinate (and, with `with_properties`, every vertex property value) fits
+/// in single precision: a float writer would otherwise turn it into infinity, a file no reader
+/// takes back. `what` names the output ("STL", "PLY with float values") for the message.
+void check_fits_in_float(const Mesh& mesh, bool with_properties, const char* what);
 
 }  // namespace qem::io

@@ -688,6 +688,7 @@ std::string write_ply(const Mesh& mesh, bool binary, bool double_precision) {
   for (const VertexProperty& p : mesh.vertex_properties)
     if (!valid_property_name(p.name) || p.name == "x" || p.name == "y" || p.name == "z")
       throw Error("cannot write PLY: invalid vertex property name '" + p.name + "'");
+  if (!double_precision) check_fits_in_float(mesh, true, "PLY with float values");
   const char* type = double_precision ? "double" : "float";
   std::string out;
   out += "ply\nformat ";

@@ -184,6 +184,7 @@ Mesh parse_stl(std::string_view bytes, const std::string& name, const LoadOption
 std::string write_stl(const Mesh& mesh, bool binary) {
   const std::size_t nf = mesh.face_count();
   if (nf > 0xFFFFFFFFull) throw Error("cannot write binary STL: more than 2^32 triangles");
+  check_fits_in_float(mesh, false, "STL");
   auto normal = [&](std::size_t f, float n[3]) {
     const double* a = &mesh.positions[3 * std::size_t{mesh.indices[3 * f]}];
     const double* b = &mesh.positions[3 * std::size_t{mesh.indices[3 * f + 1]}];
