@@ -36,9 +36,12 @@ int run_cluster(const ClusterArgs& a) {
     throw Error("cluster: give --grid NX NY NZ or --cell SIZE");
   }
   o.placement = a.placement == "mean" ? ClusterPlacement::Mean : ClusterPlacement::Quadric;
-  const Mesh in = load_mesh(a.input);
+  LoadReport report;
+  const Mesh in = load_mesh(a.input, {}, &report);
   const Mesh out = cluster(in, o);
-  save_mesh(a.output, out);
+  SaveOptions save;
+  save.double_precision = report.double_precision;  // a double PLY stays double, as in `qem simplify`
+  save_mesh(a.output, out, save);
   std::printf("qem cluster: %s (%zu faces, %zu vertices) -> %s (%zu faces, %zu vertices) in %.3f s\n",
               a.input.c_str(), in.face_count(), in.vertex_count(), a.output.c_str(), out.face_count(),
               out.vertex_count(), clock.seconds());

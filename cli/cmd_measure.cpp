@@ -83,7 +83,8 @@ int run_measure(MeasureArgs& a) {
   if (!a.per_vertex.empty() && format_from_extension(a.per_vertex) != FileFormat::Ply)
     throw Error(a.per_vertex + ": --per-vertex writes a PLY file (the only format with vertex properties)");
   const Mesh original = load_mesh(a.original);
-  Mesh approx = load_mesh(a.approx);
+  LoadReport approx_report;
+  Mesh approx = load_mesh(a.approx, {}, &approx_report);
   a.options.per_vertex = !a.per_vertex.empty();
   MeasureResult r = measure(original, approx, a.options);
   const double seconds = clock.seconds();
@@ -94,7 +95,9 @@ int run_measure(MeasureArgs& a) {
   if (!a.per_vertex.empty()) {
     approx.vertex_properties.clear();
     approx.vertex_properties.push_back({"distance", std::move(r.vertex_distance)});
-    save_mesh(a.per_vertex, approx);
+    SaveOptions save;
+    save.double_precision = approx_report.double_precision;  // a double PLY stays double
+    save_mesh(a.per_vertex, approx, save);
     if (!a.json)
       std::printf("per-vertex     %s (property `distance`: approx vertex -> original)\n",
                   a.per_vertex.c_str());

@@ -37,7 +37,7 @@ int run_replay(const ReplayArgs& a) {
   const std::vector<ReplayLevel> level = replay_levels(record, targets);
   SaveOptions save;
   save.binary = !a.ascii;
-  save.double_precision = a.double_values;
+  save.double_precision = a.double_values || record.double_input;
   save_mesh(a.output, level[0].mesh, save);
   if (!a.quiet) {
     if (target < record.final_faces())
@@ -63,7 +63,9 @@ const bool registered = register_command(12, [](CLI::App& app) {
   sub->add_option("--ratio,-r", args->ratio,
                   "Stop at or below this fraction of the recorded run's input faces");
   sub->add_flag("--ascii", args->ascii, "Write PLY / STL as text instead of binary");
-  sub->add_flag("--double", args->double_values, "Write PLY values as double instead of float");
+  sub->add_flag("--double", args->double_values,
+                "Write PLY values as double (default: as `qem simplify` did, double when its input PLY "
+                "stored doubles)");
   sub->add_flag("--quiet,-q", args->quiet, "No summary on stderr");
   sub->add_flag("--force", args->force, "Allow the output to overwrite the record file");
   return [args] { return run_replay(*args); };

@@ -72,7 +72,11 @@ int run_simplify(const SimplifyArgs& a) {
   save.binary = !a.ascii;
   save.double_precision = a.double_values || report.double_precision;
   save_mesh(a.output, r.mesh, save);
-  if (!a.record.empty()) write_record(a.record, make_record(mesh, log));  // atomic, like save_mesh
+  if (!a.record.empty()) {
+    Record record = make_record(mesh, log);
+    record.double_input = report.double_precision;  // so that replay writes what simplify wrote
+    write_record(a.record, record);  // atomic, like save_mesh
+  }
   const double write_s = t_write.seconds();
 
   if (a.json) {

@@ -116,6 +116,14 @@ TEST(CliSimplify, DoublePlyInputGivesDoublePlyOutput) {
   bool sub_float_detail = false;  // some coordinate that float would have rounded
   for (double c : simplified.positions) sub_float_detail |= double(float(c)) != c;
   EXPECT_TRUE(sub_float_detail);
+  // `qem cluster` and `qem measure --per-vertex` keep a double PLY double too.
+  ASSERT_EQ(run("cluster " + in + " " + out + " --grid 8 8 8").exit_code, 0);
+  load_mesh(out, {}, &report);
+  EXPECT_TRUE(report.double_precision);
+  const std::string per_vertex = test::temp_dir() + "/cli_utm_distance.ply";
+  ASSERT_EQ(run("measure " + in + " " + out + " --samples 1000 --per-vertex " + per_vertex).exit_code, 0);
+  load_mesh(per_vertex, {}, &report);
+  EXPECT_TRUE(report.double_precision);
 
   ASSERT_EQ(run("simplify " + sphere_file() + " " + out + " --faces 200 --quiet").exit_code, 0);
   load_mesh(out, {}, &report);

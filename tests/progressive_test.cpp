@@ -182,6 +182,12 @@ TEST(Progressive, RecordIsLittleEndianWithMagicAndVersion) {
   const std::string bytes = serialize_record(sample_record());
   EXPECT_EQ(bytes.substr(0, 8), std::string("QEMREC\x1a\n", 8));
   EXPECT_EQ(bytes.substr(8, 8), std::string("\x01\0\0\0\0\0\0\0", 8));  // version 1, flags 0
+  Record r = sample_record();
+  r.double_input = true;
+  const std::string flagged = serialize_record(r);
+  EXPECT_EQ(flagged.substr(12, 4), std::string("\x01\0\0\0", 4));
+  EXPECT_TRUE(parse_record(flagged, "flagged").double_input);
+  EXPECT_FALSE(parse_record(bytes, "plain").double_input);
 }
 
 TEST(Progressive, MakeRecordRejectsAForeignLog) {
@@ -240,7 +246,8 @@ TEST(Progressive, ReaderRejectsCorruptFiles) {
       {"half header", [](std::string& s) { s.resize(20); }, "truncated header"},
       {"bad magic", [](std::string& s) { s[0] = 'X'; }, "bad magic"},
       {"future version", [](std::string& s) { put_u32(s, 8, 2); }, "unsupported record version 2"},
-      {"unknown flags", [](std::string& s) { put_u32(s, 12, 1); }, "unknown flags"},
+      {"unknown flags", [](std::string& s) { put_u32(s, 12, 2); }, "unknown flags 2"},
+      {"unknown flags beside a known one", [](std::string& s) { put_u32(s, 12, 0x80000001u); }, "unknown flags"},
       {"vertex count beyond 32 bits", [](std::string& s) { put_u64(s, 16, std::uint64_t(1) << 40); },
        "32-bit"},
       // Announces 4 billion vertices on a small file: rejected by size, before any allocation.
@@ -339,8 +346,8 @@ TEST(Progressive, CliReplayIsByteIdenticalToSimplify) {
 }
 
 TEST(Progressive, CliDoublePlyStaysDoubleInSimplifyLodAndReplay) {
-  // A PLY storing doubles is written back with doubles by simplify and lod; replay needs --double
-  // (the record does not say how the input was stored) and then gives the same bytes.
+  // A PLY storing doubles is written back with doubles by simplify and lod, and by replay (the
+  // record's header says the input stored doubles) without being asked.
   const std::string dir = test::temp_dir() + "/prog_cli_double";
   std::filesystem::create_directories(dir);
   const std::string in = dir + "/in.ply";
@@ -349,13 +356,12 @@ TEST(Progressive, CliDoublePlyStaysDoubleInSimplifyLodAndReplay) {
   save_mesh(in, test::transformed(test::icosphere(3), 1, 4.5e6, -3.2e5, 1e3), o);
   ASSERT_EQ(run("simplify " + in + " " + dir + "/s.ply --ratio 0.25 --record " + dir + "/run.qrec"), 0);
   ASSERT_EQ(run("lod " + in + " " + dir + "/lod --ratios 0.25"), 0);
-  ASSERT_EQ(run("replay " + dir + "/run.qrec " + dir + "/r.ply --double"), 0);
-  ASSERT_EQ(run("replay " + dir + "/run.qrec " + dir + "/r_float.ply"), 0);
+  ASSERT_EQ(run("replay " + dir + "/run.qrec " + dir + "/r.ply"), 0);
   const std::string s = slurp(dir + "/s.ply");
   EXPECT_NE(s.find("property double x"), std::string::npos);
   EXPECT_TRUE(s == slurp(dir + "/lod/in_lod0.ply")) << "lod level differs from simplify";
-  EXPECT_TRUE(s == slurp(dir + "/r.ply")) << "replay --double differs from simplify";
-  EXPECT_NE(slurp(dir + "/r_float.ply").find("property float x"), std::string::npos);
+  EXPECT_TRUE(s == slurp(dir + "/r.ply")) << "replay differs from simplify";
+  EXPECT_TRUE(read_record(dir + "/run.qrec").double_input);
 }
 
 TEST(Progressive, CliLodWritesLevelsAndManifest) {

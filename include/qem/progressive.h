@@ -38,6 +38,9 @@ struct Record {
   /// Base faces that died in contraction i: dead_faces[dead_begin[i] .. dead_begin[i+1]).
   std::vector<std::uint32_t> dead_begin{0};
   std::vector<std::uint32_t> dead_faces;
+  /// The input file stored double coordinates (a double PLY), so `qem replay` writes doubles too,
+  /// as `qem simplify` does for that input. Header flag kRecordFlagDoubleInput.
+  bool double_input = false;
 
   std::size_t size() const { return kept.size(); }
   /// Faces of the fully simplified mesh M_g (after every contraction).
@@ -54,6 +57,8 @@ void validate_record(const Record& record, const std::string& name = "record");
 
 /// The file format of docs/record-format.md, version kRecordVersion.
 inline constexpr std::uint32_t kRecordVersion = 1;
+/// Header flag bit 0: Record::double_input. Other bits are reserved; readers reject them.
+inline constexpr std::uint32_t kRecordFlagDoubleInput = 1;
 std::string serialize_record(const Record& record);
 /// Parses and validates a record held in memory; `name` is used in error messages. Checks the
 /// sizes the header announces against the bytes present before allocating anything.

@@ -79,7 +79,7 @@ std::string serialize_record(const Record& r) {
               kDeadBytes * r.dead_faces.size());
   out.append(kMagic, sizeof kMagic);
   put_u32(out, kRecordVersion);
-  put_u32(out, 0);  // flags: none defined in version 1
+  put_u32(out, r.double_input ? kRecordFlagDoubleInput : 0);
   put_u64(out, nv);
   put_u64(out, nf);
   put_u64(out, nc);
@@ -108,8 +108,9 @@ Record parse_record(std::string_view bytes, const std::string& name) {
   if (version != kRecordVersion)
     io::fail(name, "unsupported record version " + std::to_string(version) + " (this qem reads version " +
                        std::to_string(kRecordVersion) + ")");
-  if (const std::uint32_t flags = in.u32(); flags != 0)
-    io::fail(name, "unknown flags " + std::to_string(flags) + " in the header");
+  const std::uint32_t flags = in.u32();
+  if (flags & ~kRecordFlagDoubleInput)
+    io::fail(name, "unknown flags " + std::to_string(flags & ~kRecordFlagDoubleInput) + " in the header");
   const std::uint64_t nv = in.u64(), nf = in.u64(), nc = in.u64(), nd = in.u64();
   if (nv > 0xffffffffu) io::fail(name, "vertex count " + std::to_string(nv) + " exceeds 32-bit ids");
   if (nf > 0xffffffffu) io::fail(name, "face count " + std::to_string(nf) + " exceeds 32-bit ids");
@@ -126,6 +127,7 @@ Record parse_record(std::string_view bytes, const std::string& name) {
     io::fail(name, std::to_string(bytes.size() - expected) + " unexpected bytes after the last contraction");
 
   Record r;
+  r.double_input = flags & kRecordFlagDoubleInput;
   r.base.positions.resize(3 * nv);
   for (double& x : r.base.positions) x = in.f64();
   r.base.indices.resize(3 * nf);
