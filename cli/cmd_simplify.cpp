@@ -72,10 +72,10 @@ int run_simplify(const SimplifyArgs& a) {
   save.binary = !a.ascii;
   save.double_precision = a.double_values || report.double_precision;
   save_mesh(a.output, r.mesh, save);
-  if (!a.record.empty()) {
+  if (!a.record.empty()) {  // written atomically, like the mesh
     Record record = make_record(mesh, log);
     record.double_input = report.double_precision;  // so that replay writes what simplify wrote
-    write_record(a.record, record);  // atomic, like save_mesh
+    write_record(a.record, record);
   }
   const double write_s = t_write.seconds();
 
@@ -114,7 +114,8 @@ const bool registered = register_command(10, [](CLI::App& app) {
   add_algorithm_options(sub, args->algorithm);
   sub->add_flag("--ascii", args->ascii, "Write PLY / STL as text instead of binary");
   sub->add_flag("--double", args->double_values,
-                "Write PLY values as double (default: double when the input is a PLY that stores doubles, as georeferenced scans do; float otherwise)");
+                "Write PLY values as double (default: double when the input is a PLY that stores doubles, as "
+                "georeferenced scans do; float otherwise)");
   sub->add_flag("--json", args->json, "Print one JSON line with counts, timings, memory and error on stdout");
   sub->add_flag("--quiet,-q", args->quiet, "No progress and no summary on stderr");
   sub->add_flag("--force", args->force, "Allow the output to overwrite the input file");

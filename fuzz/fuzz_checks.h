@@ -46,7 +46,8 @@ inline std::string check_mesh(const Mesh& m) {
 
 /// Parses `bytes` as `format`. A qem::Error from the reader is the documented rejection and gives
 /// "". Otherwise the mesh must pass check_mesh, and what the writers write must read back with the
-/// same face count (and the same coordinates, where the variant is lossless). Returns "" or what is wrong; exceptions other than qem::Error propagate.
+/// same face count (and the same coordinates, where the variant is lossless). Returns "" or what
+/// is wrong; exceptions other than qem::Error propagate.
 inline std::string check_parse(std::string_view bytes, FileFormat format) {
   LoadOptions options;
   options.format = format;

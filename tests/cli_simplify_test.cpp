@@ -146,10 +146,10 @@ TEST(CliSimplify, BadOptionsAreRejected) {
 TEST(CliSimplify, HelpDocumentsEveryOption) {
   CliRun r = run("simplify --help");
   EXPECT_EQ(r.exit_code, 0);
-  for (const char* opt : {"--faces", "--ratio", "--vertices", "--max-error", "--max-error-rel", "--threshold",
-                          "--threshold-rel", "--weighting", "--placement", "--boundary-weight", "--lock-border",
-                          "--inversion", "--max-turn", "--allow-non-manifold", "--weld", "--json", "--quiet",
-                          "--force", "--double"})
+  for (const char* opt :
+       {"--faces", "--ratio", "--vertices", "--max-error", "--max-error-rel", "--threshold",
+        "--threshold-rel", "--weighting", "--placement", "--boundary-weight", "--lock-border", "--inversion",
+        "--max-turn", "--allow-non-manifold", "--weld", "--json", "--quiet", "--force", "--double"})
     EXPECT_NE(r.out.find(opt), std::string::npos) << opt;
 }
 

@@ -100,11 +100,13 @@ std::vector<ParserCase> parser_cases() {
       // huge real (8.5e32) was converted to long long before any range check, which is undefined
       // behaviour. It must be rejected as "expected a number".
       {"ply_ascii_index_as_huge_real", FileFormat::Ply,
-       ply_header("ascii", "element vertex 3\n" + ply_xyz + "element face 1\nproperty list uchar int vertex_indices\n") +
+       ply_header("ascii", "element vertex 3\n" + ply_xyz +
+                               "element face 1\nproperty list uchar int vertex_indices\n") +
            kTriangleVerts + "3 0 1 8.55556e+32\n",
        Expect::Reject},
       {"ply_ascii_index_as_integral_real", FileFormat::Ply,
-       ply_header("ascii", "element vertex 3\n" + ply_xyz + "element face 1\nproperty list uchar int vertex_indices\n") +
+       ply_header("ascii", "element vertex 3\n" + ply_xyz +
+                               "element face 1\nproperty list uchar int vertex_indices\n") +
            kTriangleVerts + "3 0 1 2.0\n",
        Expect::Either},
 
@@ -112,13 +114,15 @@ std::vector<ParserCase> parser_cases() {
       // float range, and the default float writer wrote "inf", which the reader then refused. The
       // float writer must refuse it (qem::Error); the double writer must keep it exactly.
       {"ply_double_coordinate_beyond_float", FileFormat::Ply,
-       ply_header("ascii", "element vertex 3\nproperty double x\nproperty double y\nproperty double z\n"
-                           "element face 1\nproperty list uchar int vertex_indices\n") +
+       ply_header("ascii",
+                  "element vertex 3\nproperty double x\nproperty double y\nproperty double z\n"
+                  "element face 1\nproperty list uchar int vertex_indices\n") +
            "1e300 0 0\n1 0 0\n0 1 -1.7976931348623157e308\n3 0 1 2\n",
        Expect::Either},
       {"ply_double_property_beyond_float", FileFormat::Ply,
-       ply_header("ascii", "element vertex 3\n" + ply_xyz + "property double q\n"
-                           "element face 1\nproperty list uchar int vertex_indices\n") +
+       ply_header("ascii", "element vertex 3\n" + ply_xyz +
+                               "property double q\n"
+                               "element face 1\nproperty list uchar int vertex_indices\n") +
            "0 0 0 1e300\n1 0 0 inf\n0 1 0 -5e-324\n3 0 1 2\n",
        Expect::Either},
 

@@ -529,7 +529,8 @@ TEST(IoWrite, FloatWritersRefuseCoordinatesBeyondFloatAndDoublePlyKeepsThem) {
         qem::serialize_mesh(m, f, binary);
         ADD_FAILURE() << "no error for format " << int(f) << " binary=" << binary;
       } catch (const qem::Error& e) {
-        EXPECT_NE(std::string(e.what()).find("vertex 5 has coordinate -4e+38"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("vertex 5 has coordinate -4e+38"), std::string::npos)
+            << e.what();
       }
     }
     qem::SaveOptions o;

@@ -247,7 +247,8 @@ TEST(Progressive, ReaderRejectsCorruptFiles) {
       {"bad magic", [](std::string& s) { s[0] = 'X'; }, "bad magic"},
       {"future version", [](std::string& s) { put_u32(s, 8, 2); }, "unsupported record version 2"},
       {"unknown flags", [](std::string& s) { put_u32(s, 12, 2); }, "unknown flags 2"},
-      {"unknown flags beside a known one", [](std::string& s) { put_u32(s, 12, 0x80000001u); }, "unknown flags"},
+      {"unknown flags beside a known one", [](std::string& s) { put_u32(s, 12, 0x80000001u); },
+       "unknown flags"},
       {"vertex count beyond 32 bits", [](std::string& s) { put_u64(s, 16, std::uint64_t(1) << 40); },
        "32-bit"},
       // Announces 4 billion vertices on a small file: rejected by size, before any allocation.

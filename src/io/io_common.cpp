@@ -142,15 +142,17 @@ void check_mesh_for_writing(const Mesh& mesh) {
                   std::to_string(p.values.size()) + " values for " + std::to_string(nv) + " vertices");
   for (std::size_t i = 0; i < mesh.positions.size(); ++i)
     if (!std::isfinite(mesh.positions[i]))
-      throw Error("cannot write mesh: vertex " + std::to_string(i / 3) + " has a coordinate that is not finite");
+      throw Error("cannot write mesh: vertex " + std::to_string(i / 3) +
+                  " has a coordinate that is not finite");
 }
 
 void check_fits_in_float(const Mesh& mesh, bool with_properties, const char* what) {
   auto refuse = [&](std::size_t vertex, const std::string& value_name, double v) {
     std::string value;
     append_number(value, v);
-    throw Error(std::string("cannot write ") + what + ": vertex " + std::to_string(vertex) + " has " + value_name +
-                " " + value + ", beyond single precision (about 3.4e38); write a PLY with double values (qem --double), "
+    throw Error(std::string("cannot write ") + what + ": vertex " + std::to_string(vertex) + " has " +
+                value_name + " " + value +
+                ", beyond single precision (about 3.4e38); write a PLY with double values (qem --double), "
                 "an OBJ or an OFF");
   };
   // Compared before any conversion: a double beyond the float range converted to float is undefined
