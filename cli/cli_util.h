@@ -31,6 +31,11 @@ bool same_file(const std::string& a, const std::string& b);
 /// must never destroy its own input by accident.
 void refuse_to_overwrite(const std::string& input, const std::string& output, bool force);
 
+/// Help of `--double` for the commands that write a mesh made from an input mesh.
+inline constexpr const char* kDoubleOutputHelp =
+    "Write PLY values as double (default: double when the input is a PLY that stores doubles, as "
+    "georeferenced scans do; float otherwise)";
+
 /// A JSON string literal: quotes, backslashes and control characters escaped (paths may hold them).
 std::string json_string(const std::string& s);
 

@@ -135,9 +135,7 @@ const bool registered = register_command(13, [](CLI::App& app) {
                   "File name stem of the levels: <name>_lod<i>.<ext> (default: input's stem)");
   add_algorithm_options(sub, args->algorithm);
   sub->add_flag("--ascii", args->ascii, "Write PLY / STL as text instead of binary");
-  sub->add_flag("--double", args->double_values,
-                "Write PLY values as double (default: double when the input is a PLY that stores doubles, as "
-                "georeferenced scans do; float otherwise)");
+  sub->add_flag("--double", args->double_values, kDoubleOutputHelp);
   sub->add_flag("--json", args->json, "Print one JSON line with CPU timings and memory on stdout");
   sub->add_flag("--quiet,-q", args->quiet, "No summary on stderr");
   return [args] { return run_lod(*args); };

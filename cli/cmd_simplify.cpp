@@ -113,9 +113,7 @@ const bool registered = register_command(10, [](CLI::App& app) {
   g->add_option("--max-error-rel", args->max_error_rel, "As --max-error, relative to the bounding-box diagonal");
   add_algorithm_options(sub, args->algorithm);
   sub->add_flag("--ascii", args->ascii, "Write PLY / STL as text instead of binary");
-  sub->add_flag("--double", args->double_values,
-                "Write PLY values as double (default: double when the input is a PLY that stores doubles, as "
-                "georeferenced scans do; float otherwise)");
+  sub->add_flag("--double", args->double_values, kDoubleOutputHelp);
   sub->add_flag("--json", args->json, "Print one JSON line with counts, timings, memory and error on stdout");
   sub->add_flag("--quiet,-q", args->quiet, "No progress and no summary on stderr");
   sub->add_flag("--force", args->force, "Allow the output to overwrite the input file");
