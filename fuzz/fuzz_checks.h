@@ -44,6 +44,23 @@ inline std::string check_mesh(const Mesh& m) {
   return "";
 }
 
+/// Every way a mesh can be written in `format`: text and binary (PLY, STL), and for PLY float and
+/// double values. The fuzzers' round trips and seeds go through all of them.
+inline std::vector<SaveOptions> save_variants(FileFormat format) {
+  std::vector<SaveOptions> variants;
+  for (bool binary : {false, true})
+    for (bool double_precision : {false, true}) {
+      if (binary && format != FileFormat::Ply && format != FileFormat::Stl) continue;
+      if (double_precision && format != FileFormat::Ply) continue;
+      SaveOptions o;
+      o.format = format;
+      o.binary = binary;
+      o.double_precision = double_precision;
+      variants.push_back(o);
+    }
+  return variants;
+}
+
 /// Parses `bytes` as `format`. A qem::Error from the reader is the documented rejection and gives
 /// "". Otherwise the mesh must pass check_mesh, and what the writers write must read back with the
 /// same face count (and the same coordinates, where the variant is lossless). Returns "" or what
@@ -60,21 +77,9 @@ inline std::string check_parse(std::string_view bytes, FileFormat format) {
   }
   std::string problem = check_mesh(mesh);
   if (!problem.empty()) return problem;
-  // Every variant the format has: text and binary, and for PLY float and double values. A writer
-  // may refuse with qem::Error (a PLY property name it cannot write, a coordinate beyond float
-  // range).
-  std::vector<SaveOptions> variants;
-  for (bool binary : {false, true})
-    for (bool double_precision : {false, true}) {
-      if (binary && format != FileFormat::Ply && format != FileFormat::Stl) continue;
-      if (double_precision && format != FileFormat::Ply) continue;
-      SaveOptions o;
-      o.format = format;
-      o.binary = binary;
-      o.double_precision = double_precision;
-      variants.push_back(o);
-    }
-  for (const SaveOptions& o : variants) {
+  // A writer may refuse with qem::Error (a PLY property name it cannot write, a coordinate beyond
+  // float range).
+  for (const SaveOptions& o : save_variants(format)) {
     std::string out;
     try {
       out = serialize_mesh(mesh, o);

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "fuzz_checks.h"
 #include "qem/error.h"
 #include "qem/io.h"
 #include "qem/mesh.h"
@@ -88,32 +89,24 @@ void serialised_seeds(const fs::path& out) {
   struct Format {
     qem::FileFormat format;
     const char* dir;
-    bool has_binary;
   };
-  const Format formats[] = {{qem::FileFormat::Obj, "obj", false},
-                            {qem::FileFormat::Ply, "ply", true},
-                            {qem::FileFormat::Stl, "stl", true},
-                            {qem::FileFormat::Off, "off", false}};
+  const Format formats[] = {{qem::FileFormat::Obj, "obj"},
+                            {qem::FileFormat::Ply, "ply"},
+                            {qem::FileFormat::Stl, "stl"},
+                            {qem::FileFormat::Off, "off"}};
   for (const Format& f : formats)
     for (const Named& m : meshes)
-      for (bool binary : {false, true})
-        for (bool double_precision : {false, true}) {
-          if (binary && !f.has_binary) continue;
-          if (double_precision && f.format != qem::FileFormat::Ply) continue;
-          qem::SaveOptions o;
-          o.format = f.format;
-          o.binary = binary;
-          o.double_precision = double_precision;
-          std::string bytes;
-          try {
-            bytes = qem::serialize_mesh(m.mesh, o);
-          } catch (const qem::Error&) {
-            continue;  // the float writers refuse odd()'s 1e300: no such file can exist
-          }
-          std::string file = std::string("seed_") + m.name + (binary ? "_binary" : "_ascii") +
-                             (double_precision ? "_double" : "");
-          write_file(out / f.dir / file, bytes);
+      for (const qem::SaveOptions& o : qem::fuzz::save_variants(f.format)) {
+        std::string bytes;
+        try {
+          bytes = qem::serialize_mesh(m.mesh, o);
+        } catch (const qem::Error&) {
+          continue;  // the float writers refuse odd()'s 1e300: no such file can exist
         }
+        std::string file = std::string("seed_") + m.name + (o.binary ? "_binary" : "_ascii") +
+                           (o.double_precision ? "_double" : "");
+        write_file(out / f.dir / file, bytes);
+      }
 }
 
 /// Big-endian binary PLY with an extra property, uchar counts and a quad, built byte by byte.
