@@ -40,6 +40,13 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
                 "Do not check the link condition: edge collapses may create non-manifold edges");
   sub->add_flag("--weld", a.weld, "Merge exactly coincident vertices on load (default for STL)");
   sub->add_flag("--no-weld", a.no_weld, "Never weld on load, not even STL");
+  sub->add_flag("--refit", a.refit,
+                "After the last contraction, move the vertices to fit the input surface, faces fixed "
+                "(Hoppe et al. 1993; lowers the error at the same face count, see `qem refit --help`)");
+  sub->add_option("--refit-rounds", a.refit_rounds,
+                  "Project-and-solve rounds of --refit (implies it; default " +
+                      std::to_string(RefitOptions{}.rounds) + ")")
+      ->check(CLI::Range(1u, 100u));
 }
 
 SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
@@ -68,6 +75,8 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
   opt.max_normal_turn_degrees = a.max_turn;
   opt.lock_border = a.lock_border;
   opt.preserve_topology = !a.allow_non_manifold;
+  if (a.refit || a.refit_rounds > 0)
+    opt.refit_rounds = a.refit_rounds > 0 ? a.refit_rounds : RefitOptions{}.rounds;
   return opt;
 }
 

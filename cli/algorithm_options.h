@@ -21,10 +21,13 @@ struct AlgorithmArgs {
   double max_turn = SimplifyOptions{}.max_normal_turn_degrees;
   bool lock_border = false, allow_non_manifold = false;
   bool weld = false, no_weld = false;
+  bool refit = false;         // --refit
+  unsigned refit_rounds = 0;  // --refit-rounds (implies --refit); 0 = RefitOptions' default
 };
 
-/// Adds --threshold(-rel), --weighting, --placement, --scheme, --greedy-below, --threads, --boundary-weight, --lock-border, --inversion,
-/// --max-turn, --allow-non-manifold, --weld, --no-weld to `sub`.
+/// Adds --threshold(-rel), --weighting, --placement, --scheme, --greedy-below, --threads,
+/// --boundary-weight, --lock-border, --inversion, --max-turn, --allow-non-manifold, --weld,
+/// --no-weld, --refit, --refit-rounds to `sub`.
 void add_algorithm_options(CLI::App* sub, AlgorithmArgs& args);
 
 /// The algorithm part of SimplifyOptions (stop criteria are left to the caller).

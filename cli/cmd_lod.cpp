@@ -1,7 +1,8 @@
 // `qem lod INPUT OUTDIR --ratios 0.5,0.25,0.1`: an LOD chain from ONE simplification (GH97 §3:
 // a single run yields M_n ... M_g). The run goes to the coarsest level with a contraction record;
 // every level is then a prefix of that record, rebuilt in one pass, and each file is
-// byte-identical to `qem simplify INPUT FILE --faces <level target>` with the same options.
+// byte-identical to `qem simplify INPUT FILE --faces <level target>` with the same options
+// (with --refit, each level is refitted to the input after it is rebuilt, as simplify does).
 // Writes the levels and a manifest.json that `qem view` shows as a chain with a slider.
 #include <algorithm>
 #include <cmath>
@@ -18,6 +19,7 @@
 #include "qem/error.h"
 #include "qem/io.h"
 #include "qem/progressive.h"
+#include "qem/refit.h"
 #include "qem/simplify.h"
 
 namespace qem::cli {
@@ -47,6 +49,10 @@ int run_lod(const LodArgs& a) {
   // One run to the coarsest level, recorded. Ratios are taken of the faces the run starts from
   // (degenerate and duplicate input faces dropped), exactly as `qem simplify --ratio` does.
   SimplifyOptions opt = to_simplify_options(a.algorithm);
+  // --refit: each level is refitted below, as `simplify --refit` refits its output; the run itself
+  // only records the contractions.
+  const RefitOptions refit = refit_options(opt);
+  opt.refit_rounds = 0;
   ContractionLog log;
   opt.record = &log;
   if (!a.faces.empty())
@@ -63,6 +69,8 @@ int run_lod(const LodArgs& a) {
   std::sort(targets.begin(), targets.end(), std::greater<>());  // finest first, as the manifest lists them
   targets.erase(std::unique(targets.begin(), targets.end()), targets.end());
   std::vector<ReplayLevel> levels = replay_levels(record, targets);
+  if (refit.rounds > 0)
+    for (ReplayLevel& l : levels) qem::refit(mesh, l.mesh, refit);
   const double replay_cpu = process_cpu_seconds() - cpu_replay0;
 
   namespace fs = std::filesystem;

@@ -176,6 +176,7 @@ inline SimplifyCase decode_simplify_case(const std::uint8_t* data, std::size_t s
   o.boundary_weight = kBoundaryWeights[(misc >> 2) & 3];
   o.lock_border = misc & 16;
   o.preserve_topology = misc & 32;
+  if (misc & 64) o.refit_rounds = misc & 128 ? 3 : 1;  // the refit after the contractions (qem/refit.h)
   o.inversion = static_cast<InversionPolicy>(in.byte() % 3);
   o.max_normal_turn_degrees = in.in_range(1, 89.9);
   // Now and then an invalid option: simplify must throw qem::Error, not misbehave.
@@ -228,6 +229,8 @@ inline std::string check_simplify_result(const SimplifyCase& c, const SimplifyRe
   for (std::size_t v = 0; v < used.size(); ++v)
     if (!used[v]) return "output vertex " + std::to_string(v) + " is unreferenced";
   if (!(r.max_error >= 0)) return "max_error is negative or NaN";
+  if (r.refit_rounds > 0 && !(r.refit_rms_after <= r.refit_rms_before))
+    return "the refit raised its own error";
   return "";
 }
 

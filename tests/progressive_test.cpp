@@ -307,17 +307,8 @@ TEST(Progressive, Deterministic) {
 
 // --- the CLI ---------------------------------------------------------------------------------
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-int run(const std::string& args) {
-  const std::string cmd = std::string(QEM_CLI_PATH) + " " + args + " -q";
-  return std::system(cmd.c_str());
-}
+using test::slurp;
+int run(const std::string& args) { return test::run_qem_quietly(args); }
 
 TEST(Progressive, CliReplayIsByteIdenticalToSimplify) {
   const std::string dir = test::temp_dir() + "/prog_cli_replay";

@@ -1,12 +1,15 @@
 #include "test_meshes.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <map>
-#include <unistd.h>
+#include <sstream>
 
 namespace qem::test {
 
@@ -111,6 +114,18 @@ std::string temp_dir() {
     return p.string();
   }();
   return dir;
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+int run_qem_quietly(const std::string& args) {
+  const std::string cmd = std::string(QEM_CLI_PATH) + " " + args + " -q";
+  return std::system(cmd.c_str());
 }
 
 }  // namespace qem::test

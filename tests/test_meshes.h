@@ -25,5 +25,9 @@ Mesh concatenated(const Mesh& a, const Mesh& b);
 std::string shared_data(const std::string& name);
 /// A fresh empty temporary directory for this test process.
 std::string temp_dir();
+/// The whole content of a file ("" if it cannot be read).
+std::string slurp(const std::string& path);
+/// Runs `qem ARGS -q` (the CLI under test) through the shell and gives its exit status.
+int run_qem_quietly(const std::string& args);
 
 }  // namespace qem::test

@@ -9,4 +9,5 @@
 #include "qem/mesh.h"
 #include "qem/mesh_info.h"
 #include "qem/progressive.h"
+#include "qem/refit.h"
 #include "qem/simplify.h"

@@ -9,10 +9,14 @@
 //                        (topology, inversion, error limit), contract it, re-cost the new vertex's pairs
 //   run_passes           the default: rank all pairs, make the cheapest independent ones, repeat;
 //                        each band of a pass is made region by region (make_band), on all threads
+//   simplify_and_refit   with refit_rounds > 0, the output's vertices are then refitted to the
+//                        input surface (src/refit, Hoppe et al. 1993) once the arrays above are freed
 //
 // Everything runs in a normalised frame (centred, bounding-box diagonal 1), so every tolerance is
 // relative and the result does not depend on the model's position or scale; vertices that never
 // move are written back with their exact input coordinates.
+#include "qem/simplify.h"
+
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -32,7 +36,7 @@
 #include "core/valid_pairs.h"
 #include "core/vertex_lists.h"
 #include "qem/error.h"
-#include "qem/simplify.h"
+#include "refit/refit_points.h"
 
 namespace qem {
 
@@ -95,6 +99,8 @@ class Simplifier {
   Simplifier(MeshView input, const SimplifyOptions& options) : in_(input), opt_(options) {}
   /// The input's index array, released once prepare_input has copied the faces (simplify(Mesh&&)).
   std::vector<std::uint32_t>* consumed_indices = nullptr;
+  /// Filled with the input's vertex areas when a refit follows (see simplify_and_refit).
+  std::vector<double>* refit_weights = nullptr;
 
   SimplifyResult run();
 
@@ -1197,6 +1203,8 @@ bool Simplifier::make_band(const std::uint32_t* band, std::size_t count) {
 
 SimplifyResult Simplifier::run() {
   prepare_input();
+  // The refit measures against the input's vertices weighted by area: taken before the faces go.
+  if (opt_.refit_rounds > 0 && refit_weights) *refit_weights = refit_detail::vertex_areas(in_);
   if (consumed_indices) {
     in_.indices = {};
     std::vector<std::uint32_t>().swap(*consumed_indices);
@@ -1277,15 +1285,46 @@ SimplifyResult Simplifier::build_output() {
 
 }  // namespace
 
+RefitOptions refit_options(const SimplifyOptions& options) {
+  RefitOptions r;
+  r.rounds = options.refit_rounds;
+  r.lock_border = options.lock_border;
+  r.max_normal_turn_degrees = options.max_normal_turn_degrees;
+  r.threads = options.threads;
+  return r;
+}
+
+namespace {
+
+// Runs the simplifier, then the refit once the simplifier's arrays are freed.
+SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options,
+                                  std::vector<std::uint32_t>* consumed_indices) {
+  std::vector<double> weights;
+  SimplifyResult out;
+  {
+    Simplifier s(input, options);
+    s.consumed_indices = consumed_indices;
+    s.refit_weights = &weights;
+    out = s.run();
+  }
+  if (options.refit_rounds > 0 && out.contractions > 0 && out.stop_reason != StopReason::Cancelled) {
+    const RefitResult fit =
+        refit_detail::refit_to_points(input.positions, weights, out.mesh, refit_options(options));
+    out.refit_rms_before = fit.rms_before;
+    out.refit_rms_after = fit.rms_after;
+    out.refit_rounds = fit.rounds;
+  }
+  return out;
+}
+
+}  // namespace
+
 SimplifyResult simplify(MeshView input, const SimplifyOptions& options) {
-  Simplifier s(input, options);
-  return s.run();
+  return simplify_and_refit(input, options, nullptr);
 }
 
 SimplifyResult simplify(Mesh&& input, const SimplifyOptions& options) {
-  Simplifier s(input, options);
-  s.consumed_indices = &input.indices;
-  return s.run();
+  return simplify_and_refit(input, options, &input.indices);
 }
 
 }  // namespace qem

@@ -4,14 +4,14 @@
 #include "qem/measure.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <string>
 #include <thread>
 
-#include "measure/bvh.h"
+#include "core/parallel_chunks.h"
 #include "core/spatial_order.h"
+#include "measure/bvh.h"
 #include "measure/surface_sampling.h"
 #include "qem/error.h"
 
@@ -23,26 +23,6 @@ using measure_detail::Surface;
 using measure_detail::TriangleBvh;
 
 constexpr std::size_t kChunk = 4096;  // queries per work item (and per warm-start run)
-
-unsigned resolve_threads(unsigned requested) {
-  if (requested > 0) return requested;
-  return std::max(1u, std::thread::hardware_concurrency());
-}
-
-/// Calls fn(chunk, begin, end) for the fixed chunks of [0, n) on `threads` threads.
-template <class Fn>
-void for_chunks(std::size_t n, unsigned threads, Fn&& fn) {
-  const std::size_t chunks = (n + kChunk - 1) / kChunk;
-  std::atomic<std::size_t> next{0};
-  auto work = [&] {
-    for (std::size_t c; (c = next.fetch_add(1)) < chunks;) fn(c, c * kChunk, std::min(n, (c + 1) * kChunk));
-  };
-  const unsigned extra = unsigned(std::min<std::size_t>(threads, chunks)) - (chunks > 0 ? 1 : 0);
-  std::vector<std::thread> pool;
-  for (unsigned t = 0; t < extra; ++t) pool.emplace_back(work);
-  work();
-  for (std::thread& t : pool) t.join();
-}
 
 struct Distances {
   double sum_d2 = 0, sum_d = 0, max_d = 0;
@@ -60,7 +40,7 @@ Distances distances(const TriangleBvh& tree, const std::vector<double>& samples,
   const std::vector<std::uint32_t> order = core::morton_order(
       points.size() / 3, [&](std::size_t i) { return core::Vec3(points[3 * i], points[3 * i + 1], points[3 * i + 2]); });
   std::vector<double> d2(order.size());
-  for_chunks(order.size(), threads, [&](std::size_t, std::size_t begin, std::size_t end) {
+  core::for_chunks(order.size(), kChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
     std::uint32_t hint = UINT32_MAX;  // reset per chunk: the warm start never crosses chunks
     for (std::size_t j = begin; j < end; ++j) d2[order[j]] = tree.closest(&points[3 * order[j]], &hint).d2;
   });
@@ -89,7 +69,7 @@ MeasureResult measure(MeshView original, MeshView approx, const MeasureOptions& 
   const Surface si = measure_detail::make_surface(approx, "approximation");
   if (sn.triangle_count() == 0) throw Error("original: no face with non-zero area, nothing to measure");
   if (si.triangle_count() == 0) throw Error("approximation: no face with non-zero area, nothing to measure");
-  const unsigned threads = resolve_threads(options.threads);
+  const unsigned threads = core::resolve_threads(options.threads);
   if (options.samples + (sn.vertices.size() + si.vertices.size()) / 3 >= UINT32_MAX)
     throw Error("measure: " + std::to_string(options.samples) + " samples is too many (at most about 4e9)");
 
@@ -146,7 +126,7 @@ MeasureResult measure(MeshView original, MeshView approx, const MeasureOptions& 
   if (options.per_vertex) {
     const std::size_t nv = approx.vertex_count();
     r.vertex_distance.assign(nv, 0.0);
-    for_chunks(nv, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
+    core::for_chunks(nv, kChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
       std::uint32_t hint = UINT32_MAX;  // mesh vertex order is usually coherent enough
       for (std::size_t v = begin; v < end; ++v)
         r.vertex_distance[v] = std::sqrt(tree_n.closest(&approx.positions[3 * v], &hint).d2);

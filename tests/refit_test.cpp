@@ -1,0 +1,255 @@
+// Tests of the refit (qem/refit.h, Hoppe et al. 1993 §4.2): it recovers a surface it can represent
+// exactly, lowers the GH97 §6.1 error of a real simplification, never folds a face over, honours
+// a locked border, and is deterministic and independent of scale, position and thread count.
+#include "qem/refit.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <numbers>
+#include <string>
+
+#include "qem/error.h"
+#include "qem/io.h"
+#include "qem/measure.h"
+#include "qem/simplify.h"
+#include "test_meshes.h"
+
+namespace qem {
+namespace {
+
+double waves(double x, double y) { return 0.1 * std::sin(6 * x) * std::cos(5 * y); }
+
+/// A coarse grid over the unit square with its interior lifted off the plane z = 0.
+Mesh lifted_coarse_grid() {
+  Mesh m = test::grid(4);
+  for (std::size_t v = 0; v < m.vertex_count(); ++v) {
+    const double x = m.positions[3 * v], y = m.positions[3 * v + 1];
+    if (x > 0 && x < 1 && y > 0 && y < 1) m.positions[3 * v + 2] = 0.05 * (1 + x * y);
+  }
+  return m;
+}
+
+SimplifyResult coarse_sphere(int faces) {
+  SimplifyOptions o;
+  o.target_faces = std::size_t(faces);
+  return simplify(test::icosphere(4), o);
+}
+
+double face_turn_degrees(const Mesh& a, const Mesh& b, std::size_t f) {
+  auto normal = [f](const Mesh& m, double n[3]) {
+    const std::uint32_t* t = &m.indices[3 * f];
+    const double* p0 = &m.positions[3 * t[0]];
+    const double* p1 = &m.positions[3 * t[1]];
+    const double* p2 = &m.positions[3 * t[2]];
+    const double u[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+    const double v[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+    n[0] = u[1] * v[2] - u[2] * v[1], n[1] = u[2] * v[0] - u[0] * v[2], n[2] = u[0] * v[1] - u[1] * v[0];
+  };
+  double na[3], nb[3];
+  normal(a, na), normal(b, nb);
+  const double dot = na[0] * nb[0] + na[1] * nb[1] + na[2] * nb[2];
+  const double len = std::sqrt((na[0] * na[0] + na[1] * na[1] + na[2] * na[2]) *
+                               (nb[0] * nb[0] + nb[1] * nb[1] + nb[2] * nb[2]));
+  return std::acos(std::clamp(dot / len, -1.0, 1.0)) * 180 / std::numbers::pi;
+}
+
+TEST(Refit, RecoversASurfaceTheFacesCanRepresent) {
+  // The original is the plane z = 0 (a fine grid); the approximation's faces can lie in it exactly,
+  // so the fit must bring every lifted vertex back down. The membrane on the displacement lets each
+  // round take only part of the way here (the lift jumps at the border), so convergence is linear:
+  // most of the way in the default 3 rounds, all of it in 40.
+  const Mesh original = test::grid(40);
+  Mesh approx = lifted_coarse_grid();
+  const RefitResult r3 = refit(original, approx);
+  EXPECT_GT(r3.rms_before, 0.01);
+  EXPECT_EQ(r3.rounds, 3u);
+  EXPECT_LT(r3.rms_after, 0.25 * r3.rms_before);
+  approx = lifted_coarse_grid();
+  RefitOptions many;
+  many.rounds = 40;
+  const RefitResult r = refit(original, approx, many);
+  EXPECT_EQ(r.rounds, 40u);
+  EXPECT_LT(r.rms_after, 1e-3 * r.rms_before);
+  for (std::size_t v = 0; v < approx.vertex_count(); ++v)
+    EXPECT_NEAR(approx.positions[3 * v + 2], 0, 1e-4) << v;
+}
+
+TEST(Refit, LowersTheErrorOfASimplification) {
+  const Mesh original = test::icosphere(4);
+  for (int faces : {60, 300}) {
+    SCOPED_TRACE(faces);
+    const Mesh before = coarse_sphere(faces).mesh;
+    Mesh after = before;
+    const RefitResult r = refit(original, after);
+    EXPECT_LT(r.rms_after, 0.9 * r.rms_before);
+    MeasureOptions m;
+    m.samples = 200000;
+    const double e_before = measure(original, before, m).E, e_after = measure(original, after, m).E;
+    EXPECT_LT(e_after, 0.9 * e_before) << e_before << " -> " << e_after;
+    ASSERT_EQ(after.indices, before.indices);  // connectivity untouched
+  }
+}
+
+TEST(Refit, AMeshThatFitsExactlyDoesNotMove) {
+  const Mesh original = test::icosphere(2);
+  Mesh approx = original;
+  const RefitResult r = refit(original, approx);
+  EXPECT_EQ(r.rms_before, 0);
+  EXPECT_EQ(r.rounds, 0u);
+  EXPECT_EQ(approx.positions, original.positions);  // bit for bit
+}
+
+TEST(Refit, NoFaceTurnsBeyondTheLimitInARound) {
+  // A crude approximation of a wavy surface: the fit moves vertices a lot, and the limit holds
+  // some of the moves back.
+  const Mesh original = test::height_field(60, waves);
+  Mesh before = test::grid(6);
+  for (std::size_t v = 0; v < before.vertex_count(); ++v)
+    before.positions[3 * v + 2] = 0.2 * ((v * 7) % 5) / 5.0;
+  for (double limit : {10.0, 15.0}) {
+    SCOPED_TRACE(limit);
+    Mesh after = before;
+    RefitOptions o;
+    o.rounds = 1;
+    o.max_normal_turn_degrees = limit;
+    const RefitResult r = refit(original, after, o);
+    ASSERT_EQ(r.rounds, 1u);
+    EXPECT_GT(r.vertices_held, 0u);
+    EXPECT_LT(r.rms_after, r.rms_before);
+    for (std::size_t f = 0; f < after.face_count(); ++f)
+      EXPECT_LE(face_turn_degrees(before, after, f), limit + 1e-9) << f;
+  }
+}
+
+TEST(Refit, LockedBorderStaysPut) {
+  const Mesh original = test::height_field(40, waves);
+  Mesh approx = lifted_coarse_grid();
+  for (std::size_t v = 0; v < approx.vertex_count(); ++v) approx.positions[3 * v + 2] += 0.03;  // border too
+  const Mesh before = approx;
+  RefitOptions o;
+  o.lock_border = true;
+  const RefitResult r = refit(original, approx, o);
+  EXPECT_LT(r.rms_after, r.rms_before);
+  std::size_t moved = 0;
+  for (std::size_t v = 0; v < approx.vertex_count(); ++v) {
+    const double x = before.positions[3 * v], y = before.positions[3 * v + 1];
+    const bool border = x == 0 || x == 1 || y == 0 || y == 1;
+    const bool same = approx.positions[3 * v] == before.positions[3 * v] &&
+                      approx.positions[3 * v + 1] == before.positions[3 * v + 1] &&
+                      approx.positions[3 * v + 2] == before.positions[3 * v + 2];
+    if (border) {
+      EXPECT_TRUE(same) << "border vertex " << v << " moved";
+    }
+    moved += !same;
+  }
+  EXPECT_EQ(moved, 9u);  // the 3 x 3 interior vertices
+}
+
+TEST(Refit, SameResultAtAnyScalePositionAndThreadCount) {
+  const Mesh original = test::icosphere(4);
+  const Mesh approx = coarse_sphere(200).mesh;
+  RefitOptions one;
+  one.threads = 1;
+  Mesh a = approx;
+  refit(original, a, one);
+  RefitOptions three = one;
+  three.threads = 3;
+  Mesh b = approx;
+  refit(original, b, three);
+  EXPECT_EQ(a.positions, b.positions);  // bit for bit
+  Mesh c = approx;
+  refit(original, c, one);
+  EXPECT_EQ(a.positions, c.positions);
+
+  const double s = 1e3, o[3] = {2e4, -7e3, 5e2};
+  Mesh moved = test::transformed(approx, s, o[0], o[1], o[2]);
+  const RefitResult r = refit(test::transformed(original, s, o[0], o[1], o[2]), moved, one);
+  EXPECT_GT(r.rounds, 0u);
+  for (std::size_t i = 0; i < a.positions.size(); ++i)
+    EXPECT_NEAR((moved.positions[i] - o[i % 3]) / s, a.positions[i], 1e-9) << i;
+}
+
+TEST(Refit, BadInputIsAnError) {
+  const Mesh original = test::icosphere(2);
+  Mesh approx = test::icosphere(1);
+  Mesh bad = original;
+  bad.indices[5] = 9999;
+  EXPECT_THROW(refit(bad, approx), Error);
+  Mesh nan = approx;
+  nan.positions[4] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(refit(original, nan), Error);
+  RefitOptions o;
+  o.max_normal_turn_degrees = 0;
+  EXPECT_THROW(refit(original, approx, o), Error);
+  Mesh empty;
+  EXPECT_NO_THROW(refit(original, empty));  // nothing to fit: nothing happens
+}
+
+TEST(Refit, SimplifyRefitsItsOutputWhenAsked) {
+  // simplify(refit_rounds) is simplify, then refit against the input, in either overload.
+  const Mesh input =
+      test::concatenated(test::icosphere(4), test::transformed(test::height_field(20, waves), 1, 3, 0, 0));
+  SimplifyOptions o;
+  o.target_faces = 400;
+  const SimplifyResult plain = simplify(input, o);
+  o.refit_rounds = 2;
+  const SimplifyResult fitted = simplify(input, o);
+  Mesh expected = plain.mesh;
+  const RefitResult r = refit(input, expected, refit_options(o));
+  EXPECT_EQ(fitted.mesh.positions, expected.positions);
+  EXPECT_EQ(fitted.mesh.indices, plain.mesh.indices);
+  EXPECT_EQ(fitted.refit_rms_before, r.rms_before);
+  EXPECT_EQ(fitted.refit_rms_after, r.rms_after);
+  EXPECT_LT(fitted.refit_rms_after, fitted.refit_rms_before);
+  EXPECT_EQ(fitted.refit_rounds, r.rounds);
+  Mesh copy = input;
+  const SimplifyResult consumed = simplify(std::move(copy), o);
+  EXPECT_EQ(consumed.mesh.positions, fitted.mesh.positions);
+}
+
+// --- the CLI ---------------------------------------------------------------------------------
+
+using test::slurp;
+int run(const std::string& args) { return test::run_qem_quietly(args); }
+
+TEST(Refit, CliSimplifyRefitEqualsRefitCommandAndLodLevel) {
+  const std::string dir = test::temp_dir() + "/refit_cli";
+  std::filesystem::create_directories(dir);
+  const std::string in = dir + "/in.obj";  // OBJ keeps doubles exactly, so files chain losslessly
+  save_mesh(in, test::concatenated(test::icosphere(4),
+                                   test::transformed(test::height_field(20, waves), 1, 3, 0, 0)));
+  ASSERT_EQ(run("simplify " + in + " " + dir + "/fitted.obj --faces 500 --refit"), 0);
+  ASSERT_EQ(run("simplify " + in + " " + dir + "/plain.obj --faces 500"), 0);
+  ASSERT_EQ(
+      run("simplify " + in + " " + dir + "/json.obj --faces 500 --refit --json > " + dir + "/line.json"), 0);
+  const std::string line = slurp(dir + "/line.json");
+  EXPECT_NE(line.find("\"refit_rounds\":3,"), std::string::npos) << line;
+  EXPECT_NE(line.find("\"refit_rms_after\":"), std::string::npos) << line;
+  ASSERT_EQ(run("refit " + in + " " + dir + "/plain.obj " + dir + "/refitted.obj"), 0);
+  const std::string fitted = slurp(dir + "/fitted.obj");
+  EXPECT_FALSE(fitted.empty());
+  EXPECT_NE(fitted, slurp(dir + "/plain.obj"));
+  EXPECT_TRUE(fitted == slurp(dir + "/refitted.obj")) << "qem refit differs from simplify --refit";
+  ASSERT_EQ(run("lod " + in + " " + dir + "/lod --faces 2000,500 --format obj --refit"), 0);
+  EXPECT_TRUE(fitted == slurp(dir + "/lod/in_lod1.obj")) << "lod --refit level differs from simplify --refit";
+  ASSERT_EQ(run("simplify " + in + " " + dir + "/f2000.obj --faces 2000 --refit-rounds 3"), 0);
+  EXPECT_TRUE(slurp(dir + "/f2000.obj") == slurp(dir + "/lod/in_lod0.obj"));
+  // A record would replay the unrefitted contractions: the combination is refused, nothing written.
+  EXPECT_NE(run("simplify " + in + " " + dir + "/rec.obj --faces 500 --refit --record " + dir +
+                "/r.qrec 2>/dev/null"),
+            0);
+  EXPECT_FALSE(std::filesystem::exists(dir + "/rec.obj"));
+  EXPECT_FALSE(std::filesystem::exists(dir + "/r.qrec"));
+  // Bad input: a clear error and no output.
+  { std::ofstream(dir + "/bad.obj") << "v 0 0 0\nv 1 0 0\nf 1 2 7\n"; }
+  EXPECT_NE(run("refit " + dir + "/bad.obj " + dir + "/plain.obj " + dir + "/x.obj 2>/dev/null"), 0);
+  EXPECT_FALSE(std::filesystem::exists(dir + "/x.obj"));
+}
+
+}  // namespace
+}  // namespace qem
