@@ -87,11 +87,10 @@ int run_simplify(const SimplifyArgs& a) {
   if (a.json) {
     std::printf(
         "{\"tool\":\"qem\",\"in_faces\":%zu,\"target_faces\":%zu,\"out_faces\":%zu,\"out_vertices\":%zu,"
-        "\"load_s\":%s,\"simplify_s\":%s,\"simplify_cpu_s\":%s,\"write_s\":%s,\"total_s\":%s,\"peak_rss_mb\":"
-        "%s,\"max_error\":%s,"
-        "\"max_error_rel\":%s,\"contractions\":%zu,\"virtual_pairs\":%zu,\"rejected_topology\":%zu,"
-        "\"rejected_inversion\":%zu,\"rejected_error\":%zu,\"refit_rounds\":%zu,\"refit_rms_before\":%s,"
-        "\"refit_rms_after\":%s,\"stop\":\"%s\"}\n",
+        "\"load_s\":%s,\"simplify_s\":%s,\"simplify_cpu_s\":%s,\"write_s\":%s,\"total_s\":%s,"
+        "\"peak_rss_mb\":%s,\"max_error\":%s,\"max_error_rel\":%s,\"contractions\":%zu,\"virtual_pairs\":%zu,"
+        "\"rejected_topology\":%zu,\"rejected_inversion\":%zu,\"rejected_error\":%zu,\"refit_rounds\":%zu,"
+        "\"refit_rms_before\":%s,\"refit_rms_after\":%s,\"stop\":\"%s\"}\n",
         in_faces, a.faces, r.mesh.face_count(), r.mesh.vertex_count(), json_number(load_s).c_str(),
         json_number(simplify_s).c_str(), json_number(simplify_cpu_s).c_str(), json_number(write_s).c_str(),
         json_number(total.seconds()).c_str(), json_number(peak_rss_mb()).c_str(),

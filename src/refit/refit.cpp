@@ -171,12 +171,12 @@ class Refitter {
                          const std::uint32_t j = order_[k];
                          const auto hit = tree.closest(&points_[3 * j], &hint);
                          if (hit.triangle == UINT32_MAX) continue;
+                         d2[j] = hit.d2;  // counted in the error even when the face cannot pull
                          const std::uint32_t* t = &tri_[3 * std::size_t(hit.triangle)];
                          if (!barycentric({hit.point[0], hit.point[1], hit.point[2]}, at(x, t[0]),
                                           at(x, t[1]), at(x, t[2]), &p.bary[3 * j]))
                            continue;  // a face without area pulls nothing (it cannot be solved for)
                          p.face[j] = hit.triangle;
-                         d2[j] = hit.d2;
                        }
                      });
     for (std::size_t j = 0; j < used_.size(); ++j) p.energy += weights_[j] * d2[j];  // in point order
