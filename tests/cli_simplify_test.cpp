@@ -149,8 +149,14 @@ TEST(CliSimplify, HelpDocumentsEveryOption) {
   for (const char* opt :
        {"--faces", "--ratio", "--vertices", "--max-error", "--max-error-rel", "--threshold",
         "--threshold-rel", "--weighting", "--placement", "--boundary-weight", "--lock-border", "--inversion",
-        "--max-turn", "--allow-non-manifold", "--weld", "--json", "--quiet", "--force", "--double"})
+        "--max-turn", "--allow-non-manifold", "--weld", "--json", "--quiet", "--force", "--double",
+        "--refit", "--refit-rounds", "--record"})
     EXPECT_NE(r.out.find(opt), std::string::npos) << opt;
+  r = run("refit --help");
+  EXPECT_EQ(r.exit_code, 0);
+  for (const char* opt : {"--rounds", "--lock-border", "--max-turn", "--threads", "--ascii", "--double", "--json",
+                          "--quiet", "--force"})
+    EXPECT_NE(r.out.find(opt), std::string::npos) << "refit " << opt;
 }
 
 }  // namespace

@@ -207,7 +207,8 @@ class Refitter {
     if (with_data == 0) return false;
     mean /= double(with_data);
 
-    // The membrane on the displacement: per face edge (r, c), kappa |(X_r - X_c) - (old_r - old_c)|^2.
+    // The membrane on the displacement: per face edge (r, c), kappa |(X_r - X_c) - (old_r - old_c)|^2
+    // (an interior edge has two faces, so it counts twice and a border edge once).
     const double kappa = kMembrane * mean;
     for (std::size_t f = 0; f < nf; ++f)
       for (int r = 0; r < 3; ++r) {
