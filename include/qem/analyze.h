@@ -60,7 +60,7 @@ struct Analysis {
   std::size_t face_count() const { return aspect.size(); }
 };
 
-/// Analyses a mesh. Throws qem::Error when an index is out of range.
+/// Analyses a mesh. Throws qem::Error when an index is out of range or a coordinate is not finite.
 Analysis analyze(const Mesh& mesh, const AnalyzeOptions& options = {});
 
 /// GH97 Fig. 11 / HG99 Fig. 3: one small ellipsoid per referenced vertex, centred at the vertex,

@@ -26,7 +26,8 @@ struct ClusterOptions {
 /// Clusters `mesh`. Only vertices referenced by a face take part; the output holds one vertex per
 /// cluster that is still used by a face, faces in input order, and no two faces on the same three
 /// vertices (either orientation: the first one is kept). Deterministic. Throws qem::Error on bad
-/// options (no grid and no positive cell, too many cells) or out-of-range indices.
+/// options (no grid and no positive cell, too many cells), an out-of-range index or a non-finite
+/// coordinate.
 Mesh cluster(MeshView mesh, const ClusterOptions& options);
 
 }  // namespace qem

@@ -38,7 +38,8 @@ struct MeasureResult {
   std::vector<double> vertex_distance;                         ///< per approx vertex (all of them), if asked
 };
 
-/// Throws qem::Error when a mesh has an out-of-range index or no face of non-zero area.
+/// Throws qem::Error when a mesh has an out-of-range index, a non-finite coordinate or no face
+/// of non-zero area.
 MeasureResult measure(MeshView original, MeshView approx, const MeasureOptions& options = {});
 
 }  // namespace qem

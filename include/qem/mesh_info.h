@@ -42,7 +42,8 @@ struct MeshInfo {
 };
 
 /// Computes the facts in O(V + F) time and memory (a bucket sort of the half-edges by their
-/// smaller vertex, no hashing). Throws qem::Error when an index is out of range.
+/// smaller vertex, no hashing). Throws qem::Error when an index is out of range or a coordinate is
+/// not finite.
 MeshInfo mesh_info(MeshView mesh);
 
 }  // namespace qem

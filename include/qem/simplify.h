@@ -140,7 +140,8 @@ RefitOptions refit_options(const SimplifyOptions& options);
 
 /// Simplifies a mesh. Input positions are never normalised in the output: vertices that did not
 /// move keep their exact input coordinates. Deterministic: the same input and options give the
-/// same output. Throws qem::Error on invalid options or indices.
+/// same output. Throws qem::Error on invalid options, an out-of-range index or a
+/// non-finite coordinate.
 SimplifyResult simplify(MeshView input, const SimplifyOptions& options);
 
 /// The same, consuming the input: its index array is released (left empty) as soon as the

@@ -7,6 +7,7 @@
 #include <limits>
 #include <string>
 
+#include "check_mesh.h"
 #include "qem/error.h"
 
 namespace qem {
@@ -14,14 +15,6 @@ namespace qem {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-void check_indices(const Mesh& mesh) {
-  std::size_t n = mesh.vertex_count();
-  for (std::size_t i = 0; i < mesh.indices.size(); ++i)
-    if (mesh.indices[i] >= n)
-      throw Error("analyze: face " + std::to_string(i / 3) + " uses vertex " +
-                  std::to_string(mesh.indices[i]) + " but the mesh has " + std::to_string(n) + " vertices");
-}
 
 }  // namespace
 
@@ -59,7 +52,7 @@ double optimal_aspect_ratio(double k1, double k2) {
 }
 
 Analysis analyze(const Mesh& mesh, const AnalyzeOptions& options) {
-  check_indices(mesh);
+  check_mesh(mesh, "analyze");
   const std::size_t nv = mesh.vertex_count(), nf = mesh.face_count();
   const double* p = mesh.positions.data();
   Analysis r;

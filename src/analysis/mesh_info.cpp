@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "analysis/disjoint_sets.h"
+#include "check_mesh.h"
 #include "qem/error.h"
 
 namespace qem {
@@ -37,15 +38,10 @@ bool zero_area(std::span<const double> p, const std::uint32_t* t) {
 }
 
 void check_indices(MeshView mesh) {
-  if (mesh.indices.size() % 3 != 0)
-    throw Error("mesh_info: index count " + std::to_string(mesh.indices.size()) + " is not a multiple of 3");
+  check_mesh(mesh, "mesh_info");
+  // Corners are numbered 3f + k in 32 bits, kNone reserved.
   if (mesh.indices.size() >= std::size_t(kNone))
     throw Error("mesh_info: too many faces (" + std::to_string(mesh.face_count()) + ")");
-  const std::size_t nv = mesh.vertex_count();
-  for (std::size_t i = 0; i < mesh.indices.size(); ++i)
-    if (mesh.indices[i] >= nv)
-      throw Error("mesh_info: face " + std::to_string(i / 3) + " has vertex index " +
-                  std::to_string(mesh.indices[i]) + " but the mesh has " + std::to_string(nv) + " vertices");
 }
 
 /// Faces with the same vertex set as an earlier face, over faces without repeated indices.

@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "check_mesh.h"
 #include "cluster/cluster_quadric.h"
 #include "qem/error.h"
 
@@ -201,20 +202,9 @@ std::vector<std::uint32_t> collapse_faces(MeshView mesh, const std::vector<std::
 }  // namespace
 
 Mesh cluster(MeshView mesh, const ClusterOptions& options) {
-  const std::size_t nv = mesh.vertex_count();
-  std::vector<char> used(nv, 0);
-  for (std::size_t i = 0; i < mesh.indices.size(); ++i) {
-    if (mesh.indices[i] >= nv)
-      throw Error("cluster: face " + std::to_string(i / 3) + " references vertex " +
-                  std::to_string(mesh.indices[i]) + " but there are only " + std::to_string(nv) +
-                  " vertices");
-    used[mesh.indices[i]] = 1;
-  }
-  for (std::size_t v = 0; v < nv; ++v)
-    if (used[v])
-      for (int k = 0; k < 3; ++k)
-        if (!std::isfinite(mesh.positions[3 * v + k]))
-          throw Error("cluster: vertex " + std::to_string(v) + " has a non-finite coordinate");
+  check_mesh(mesh, "cluster");
+  std::vector<char> used(mesh.vertex_count(), 0);
+  for (std::uint32_t v : mesh.indices) used[v] = 1;
   const Grid grid = grid_of(mesh, used, options);
   std::uint32_t count = 0;
   const std::vector<std::uint32_t> cluster = assign_clusters(mesh, used, grid, count);

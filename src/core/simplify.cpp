@@ -28,6 +28,7 @@
 #include <system_error>
 #include <thread>
 
+#include "check_mesh.h"
 #include "core/indexed_heap.h"
 #include "core/placement.h"
 #include "core/quadric.h"
@@ -274,15 +275,7 @@ class Simplifier {
 
 void Simplifier::prepare_input() {
   const std::size_t nv = in_.vertex_count(), nf = in_.face_count();
-  if (in_.positions.size() % 3 != 0) throw Error("positions must hold 3 numbers per vertex");
-  if (in_.indices.size() % 3 != 0) throw Error("indices must hold 3 numbers per triangle");
-  for (std::size_t i = 0; i < in_.positions.size(); ++i)
-    if (!std::isfinite(in_.positions[i]))
-      throw Error("vertex " + std::to_string(i / 3) + " has a non-finite coordinate");
-  for (std::size_t i = 0; i < in_.indices.size(); ++i)
-    if (in_.indices[i] >= nv)
-      throw Error("face " + std::to_string(i / 3) + " refers to vertex " + std::to_string(in_.indices[i]) +
-                  ", but there are only " + std::to_string(nv) + " vertices");
+  check_mesh(in_, "input");
 
   // Referenced vertices only: unreferenced ones take no part and are dropped from the output.
   // Degenerate faces (a repeated corner) carry no plane and no area: dropped too.

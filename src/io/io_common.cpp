@@ -13,6 +13,8 @@
 #include <cstring>
 #include <limits>
 
+#include "check_mesh.h"
+
 namespace qem::io {
 
 void fail(const std::string& name, const std::string& what) { throw Error(name + ": " + what); }
@@ -129,21 +131,12 @@ void append_uint(std::string& out, std::uint64_t v) {
 }
 
 void check_mesh_for_writing(const Mesh& mesh) {
-  if (mesh.positions.size() % 3 != 0) throw Error("cannot write mesh: positions are not a multiple of 3");
-  if (mesh.indices.size() % 3 != 0) throw Error("cannot write mesh: indices are not a multiple of 3");
-  std::size_t nv = mesh.vertex_count();
-  for (std::size_t i = 0; i < mesh.indices.size(); ++i)
-    if (mesh.indices[i] >= nv)
-      throw Error("cannot write mesh: face " + std::to_string(i / 3) + " uses vertex " +
-                  std::to_string(mesh.indices[i]) + " of " + std::to_string(nv));
+  check_mesh(mesh, "cannot write mesh");
+  const std::size_t nv = mesh.vertex_count();
   for (const VertexProperty& p : mesh.vertex_properties)
     if (p.values.size() != nv)
       throw Error("cannot write mesh: vertex property '" + p.name + "' has " +
                   std::to_string(p.values.size()) + " values for " + std::to_string(nv) + " vertices");
-  for (std::size_t i = 0; i < mesh.positions.size(); ++i)
-    if (!std::isfinite(mesh.positions[i]))
-      throw Error("cannot write mesh: vertex " + std::to_string(i / 3) +
-                  " has a coordinate that is not finite");
 }
 
 void check_fits_in_float(const Mesh& mesh, bool with_properties, const char* what) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "check_mesh.h"
 #include "measure/point_triangle.h"
 #include "measure/rng.h"
 #include "qem/error.h"
@@ -11,6 +12,7 @@
 namespace qem::measure_detail {
 
 Surface make_surface(MeshView mesh, const char* what) {
+  check_mesh(mesh, what);
   Surface s;
   const std::size_t nv = mesh.vertex_count();
   s.faces = mesh.face_count();
@@ -20,10 +22,6 @@ Surface make_surface(MeshView mesh, const char* what) {
   const double* P = mesh.positions.data();
   for (std::size_t f = 0; f < s.faces; ++f) {
     const std::uint32_t* t = &mesh.indices[3 * f];
-    for (int k = 0; k < 3; ++k)
-      if (t[k] >= nv)
-        throw Error(std::string(what) + ": face " + std::to_string(f) + " references vertex " +
-                    std::to_string(t[k]) + " but there are only " + std::to_string(nv) + " vertices");
     used[t[0]] = used[t[1]] = used[t[2]] = 1;
     const Vec3 a{P[3 * t[0]], P[3 * t[0] + 1], P[3 * t[0] + 2]};
     const Vec3 b{P[3 * t[1]], P[3 * t[1] + 1], P[3 * t[1] + 2]};
@@ -31,7 +29,7 @@ Surface make_surface(MeshView mesh, const char* what) {
     const Vec3 n = cross(b - a, c - a);
     const double area = 0.5 * std::sqrt(dot(n, n));
     // Zero-area faces carry no surface: they can be neither sampled nor be the closest surface point.
-    // NaN areas (non-finite input) are rejected the same way.
+    // An area that overflows to infinity is dropped the same way.
     if (!(area > 0) || !std::isfinite(area)) {
       ++s.degenerate;
       continue;

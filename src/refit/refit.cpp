@@ -25,6 +25,7 @@
 #include <numbers>
 #include <string>
 
+#include "check_mesh.h"
 #include "core/parallel_chunks.h"
 #include "core/spatial_order.h"
 #include "measure/bvh.h"
@@ -302,21 +303,6 @@ class Refitter {
   double centre_[3] = {0, 0, 0}, diag_ = 0, total_weight_ = 0;
   bool ready_ = false;
 };
-
-void check_mesh(MeshView mesh, const char* what) {
-  if (mesh.positions.size() % 3 != 0)
-    throw Error(std::string(what) + ": positions must hold 3 numbers per vertex");
-  if (mesh.indices.size() % 3 != 0)
-    throw Error(std::string(what) + ": indices must hold 3 numbers per triangle");
-  for (std::size_t i = 0; i < mesh.positions.size(); ++i)
-    if (!std::isfinite(mesh.positions[i]))
-      throw Error(std::string(what) + ": vertex " + std::to_string(i / 3) + " has a non-finite coordinate");
-  const std::size_t nv = mesh.vertex_count();
-  for (std::size_t i = 0; i < mesh.indices.size(); ++i)
-    if (mesh.indices[i] >= nv)
-      throw Error(std::string(what) + ": face " + std::to_string(i / 3) + " refers to vertex " +
-                  std::to_string(mesh.indices[i]) + ", but there are " + std::to_string(nv) + " vertices");
-}
 
 }  // namespace
 
