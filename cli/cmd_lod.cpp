@@ -69,8 +69,11 @@ int run_lod(const LodArgs& a) {
   std::sort(targets.begin(), targets.end(), std::greater<>());  // finest first, as the manifest lists them
   targets.erase(std::unique(targets.begin(), targets.end()), targets.end());
   std::vector<ReplayLevel> levels = replay_levels(record, targets);
-  if (refit.rounds > 0)
-    for (ReplayLevel& l : levels) qem::refit(mesh, l.mesh, refit);
+  if (refit.rounds > 0) {
+    std::vector<Mesh*> meshes;
+    for (ReplayLevel& l : levels) meshes.push_back(&l.mesh);
+    qem::refit(mesh, meshes, refit);
+  }
   const double replay_cpu = process_cpu_seconds() - cpu_replay0;
 
   namespace fs = std::filesystem;

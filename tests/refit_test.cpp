@@ -12,6 +12,7 @@
 #include <limits>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "qem/error.h"
 #include "qem/io.h"
@@ -172,6 +173,26 @@ TEST(Refit, SameResultAtAnyScalePositionAndThreadCount) {
   EXPECT_GT(r.rounds, 0u);
   for (std::size_t i = 0; i < a.positions.size(); ++i)
     EXPECT_NEAR((moved.positions[i] - o[i % 3]) / s, a.positions[i], 1e-9) << i;
+}
+
+TEST(Refit, SeveralApproximationsAtOnceEqualOneByOne) {
+  const Mesh original = test::icosphere(4);
+  std::vector<Mesh> levels = {coarse_sphere(800).mesh, coarse_sphere(200).mesh, coarse_sphere(60).mesh};
+  std::vector<Mesh> alone = levels;
+  std::vector<RefitResult> expected;
+  for (Mesh& m : alone) expected.push_back(refit(original, m));
+  std::vector<Mesh*> pointers;
+  for (Mesh& m : levels) pointers.push_back(&m);
+  const std::vector<RefitResult> got = refit(original, pointers);
+  ASSERT_EQ(got.size(), levels.size());
+  for (std::size_t i = 0; i < levels.size(); ++i) {
+    EXPECT_EQ(levels[i].positions, alone[i].positions) << i;  // bit for bit
+    EXPECT_EQ(got[i].rms_before, expected[i].rms_before) << i;
+    EXPECT_EQ(got[i].rms_after, expected[i].rms_after) << i;
+    EXPECT_EQ(got[i].rounds, expected[i].rounds) << i;
+    EXPECT_GT(got[i].rounds, 0u) << i;
+  }
+  EXPECT_TRUE(refit(original, std::span<Mesh* const>{}).empty());
 }
 
 TEST(Refit, BadInputIsAnError) {

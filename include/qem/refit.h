@@ -12,6 +12,8 @@
 #pragma once
 
 #include <cstddef>
+#include <span>
+#include <vector>
 
 #include "qem/mesh.h"
 
@@ -42,5 +44,11 @@ struct RefitResult {
 /// count; invariant to the model's scale and position (up to rounding). Throws qem::Error on an
 /// out-of-range index or a non-finite coordinate.
 RefitResult refit(MeshView original, Mesh& approx, const RefitOptions& options = {});
+
+/// Refits several approximations of one original (the levels of a chain), each exactly as the
+/// single refit above would, with the work on the original (its validation, area weights and
+/// spatial order) done once. Results in the order of `approximations`.
+std::vector<RefitResult> refit(MeshView original, std::span<Mesh* const> approximations,
+                               const RefitOptions& options = {});
 
 }  // namespace qem

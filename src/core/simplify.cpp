@@ -1301,8 +1301,8 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
     out = s.run();
   }
   if (options.refit_rounds > 0 && out.contractions > 0 && out.stop_reason != StopReason::Cancelled) {
-    const RefitResult fit =
-        refit_detail::refit_to_points(input.positions, weights, out.mesh, refit_options(options));
+    const RefitResult fit = refit_detail::refit_to_points(refit_detail::FitPoints(input.positions, weights),
+                                                          out.mesh, refit_options(options));
     out.refit_rms_before = fit.rms_before;
     out.refit_rms_after = fit.rms_after;
     out.refit_rounds = fit.rounds;

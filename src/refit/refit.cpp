@@ -80,34 +80,49 @@ struct Projection {
   double energy = 0;                ///< sum of w_i * squared distance
 };
 
+}  // namespace
+
+// Everything about the points that does not depend on the approximation: made once for all the
+// approximations of one original (`qem lod --refit`).
+FitPoints::FitPoints(std::span<const double> points, std::span<const double> weights) {
+  std::vector<std::uint32_t> used;  // the points with a weight
+  for (std::size_t i = 0; i < weights.size(); ++i)
+    if (weights[i] > 0) used.push_back(std::uint32_t(i));
+  // The frame: centre and diagonal of the points' box (the approximation's vertices lie near them).
+  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  for (std::uint32_t i : used)
+    for (int k = 0; k < 3; ++k)
+      lo[k] = std::min(lo[k], points[3 * i + k]), hi[k] = std::max(hi[k], points[3 * i + k]);
+  double d2 = 0;
+  for (int k = 0; k < 3; ++k) centre[k] = 0.5 * (lo[k] + hi[k]), d2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+  diag = std::sqrt(d2);
+  if (used.empty() || !(diag > 0)) return;
+  position.resize(3 * used.size());
+  weight.resize(used.size());
+  for (std::size_t j = 0; j < used.size(); ++j) {
+    for (int k = 0; k < 3; ++k) position[3 * j + k] = (points[3 * used[j] + k] - centre[k]) / diag;
+    weight[j] = weights[used[j]];
+    total_weight += weight[j];
+  }
+  order = core::morton_order(used.size(), [&](std::size_t j) {
+    return core::Vec3(position[3 * j], position[3 * j + 1], position[3 * j + 2]);
+  });
+}
+
+namespace {
+
 class Refitter {
  public:
-  Refitter(std::span<const double> points, std::span<const double> weights, Mesh& approx,
-           const RefitOptions& o)
-      : approx_(approx), opt_(o), tri_(approx.indices) {
-    for (std::size_t i = 0; i < weights.size(); ++i)
-      if (weights[i] > 0) used_.push_back(std::uint32_t(i));
-    // The frame: centre and diagonal of the points' box (the approximation's vertices lie near them).
-    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
-    for (std::uint32_t i : used_)
-      for (int k = 0; k < 3; ++k)
-        lo[k] = std::min(lo[k], points[3 * i + k]), hi[k] = std::max(hi[k], points[3 * i + k]);
-    double d2 = 0;
-    for (int k = 0; k < 3; ++k) centre_[k] = 0.5 * (lo[k] + hi[k]), d2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
-    diag_ = std::sqrt(d2);
-    if (used_.empty() || !(diag_ > 0) || approx.indices.empty()) return;
-    points_.resize(3 * used_.size());
-    weights_.resize(used_.size());
-    for (std::size_t j = 0; j < used_.size(); ++j) {
-      for (int k = 0; k < 3; ++k) points_[3 * j + k] = (points[3 * used_[j] + k] - centre_[k]) / diag_;
-      weights_[j] = weights[used_[j]];
-      total_weight_ += weights_[j];
-    }
+  Refitter(const FitPoints& points, Mesh& approx, const RefitOptions& o)
+      : approx_(approx),
+        opt_(o),
+        tri_(approx.indices),
+        pts_(points),
+        centre_(points.centre),
+        diag_(points.diag) {
+    if (pts_.weight.empty() || approx.indices.empty()) return;
     x_.resize(approx.positions.size());
     for (std::size_t i = 0; i < x_.size(); ++i) x_[i] = (approx.positions[i] - centre_[i % 3]) / diag_;
-    order_ = core::morton_order(used_.size(), [&](std::size_t j) {
-      return core::Vec3(points_[3 * j], points_[3 * j + 1], points_[3 * j + 2]);
-    });
     fixed_.assign(approx.vertex_count(), 0);
     if (o.lock_border) mark_border();
     ready_ = true;
@@ -118,7 +133,7 @@ class Refitter {
     if (!ready_) return r;
     const std::vector<double> start = x_;
     Projection proj = project(x_);
-    r.rms_before = r.rms_after = std::sqrt(proj.energy / total_weight_) * diag_;
+    r.rms_before = r.rms_after = std::sqrt(proj.energy / pts_.total_weight) * diag_;
     for (unsigned round = 0; round < opt_.rounds; ++round) {
       std::vector<double> next;
       if (!solve(proj, next)) break;
@@ -129,7 +144,7 @@ class Refitter {
       proj = std::move(next_proj);
       ++r.rounds;
       r.vertices_held += held;
-      r.rms_after = std::sqrt(proj.energy / total_weight_) * diag_;
+      r.rms_after = std::sqrt(proj.energy / pts_.total_weight) * diag_;
     }
     // Back to model coordinates; a vertex that did not move keeps its exact input coordinates.
     for (std::size_t v = 0; v < approx_.vertex_count(); ++v)
@@ -162,15 +177,16 @@ class Refitter {
       for (int k = 0; k < 3; ++k) corners[3 * c + k] = x[3 * tri_[c] + k];
     const measure_detail::TriangleBvh tree(corners);
     Projection p;
-    p.face.assign(used_.size(), UINT32_MAX);
-    p.bary.assign(3 * used_.size(), 0.0);
-    std::vector<double> d2(used_.size(), 0.0);
-    core::for_chunks(order_.size(), kChunk, core::resolve_threads(opt_.threads),
+    const std::size_t count = pts_.weight.size();
+    p.face.assign(count, UINT32_MAX);
+    p.bary.assign(3 * count, 0.0);
+    std::vector<double> d2(count, 0.0);
+    core::for_chunks(count, kChunk, core::resolve_threads(opt_.threads),
                      [&](std::size_t, std::size_t begin, std::size_t end) {
                        std::uint32_t hint = UINT32_MAX;  // reset per chunk: never crosses chunks
                        for (std::size_t k = begin; k < end; ++k) {
-                         const std::uint32_t j = order_[k];
-                         const auto hit = tree.closest(&points_[3 * j], &hint);
+                         const std::uint32_t j = pts_.order[k];
+                         const auto hit = tree.closest(&pts_.position[3 * j], &hint);
                          if (hit.triangle == UINT32_MAX) continue;
                          d2[j] = hit.d2;  // counted in the error even when the face cannot pull
                          const std::uint32_t* t = &tri_[3 * std::size_t(hit.triangle)];
@@ -180,7 +196,7 @@ class Refitter {
                          p.face[j] = hit.triangle;
                        }
                      });
-    for (std::size_t j = 0; j < used_.size(); ++j) p.energy += weights_[j] * d2[j];  // in point order
+    for (std::size_t j = 0; j < count; ++j) p.energy += pts_.weight[j] * d2[j];  // in point order
     return p;
   }
 
@@ -189,15 +205,15 @@ class Refitter {
     const std::size_t n = approx_.vertex_count(), nf = tri_.size() / 3;
     // Per face, the 3x3 block sum_i w_i b_i b_i^T; per vertex, sum_i w_i b_i p_i.
     std::vector<double> block(9 * nf, 0.0), rhs(3 * n, 0.0), data(n, 0.0);
-    for (std::size_t j = 0; j < used_.size(); ++j) {
+    for (std::size_t j = 0; j < pts_.weight.size(); ++j) {
       const std::uint32_t f = proj.face[j];
       if (f == UINT32_MAX) continue;
       const double* b = &proj.bary[3 * j];
-      const double w = weights_[j];
+      const double w = pts_.weight[j];
       for (int r = 0; r < 3; ++r) {
         const std::uint32_t v = tri_[3 * std::size_t(f) + r];
         for (int c = 0; c < 3; ++c) block[9 * f + 3 * r + c] += w * b[r] * b[c];
-        for (int k = 0; k < 3; ++k) rhs[3 * v + k] += w * b[r] * points_[3 * j + k];
+        for (int k = 0; k < 3; ++k) rhs[3 * v + k] += w * b[r] * pts_.position[3 * j + k];
         data[v] += w * b[r] * b[r];
       }
     }
@@ -294,13 +310,11 @@ class Refitter {
   Mesh& approx_;
   const RefitOptions& opt_;
   const std::vector<std::uint32_t>& tri_;
-  std::vector<std::uint32_t> used_;  // input points with a weight
-  std::vector<double> points_;       // those points, normalised
-  std::vector<double> weights_;
-  std::vector<std::uint32_t> order_;  // Morton order of the points, for warm-started queries
+  const FitPoints& pts_;
+  const double* centre_;
+  double diag_;
   std::vector<double> x_;             // approximation vertices, normalised
   std::vector<std::uint8_t> fixed_;
-  double centre_[3] = {0, 0, 0}, diag_ = 0, total_weight_ = 0;
   bool ready_ = false;
 };
 
@@ -323,20 +337,29 @@ std::vector<double> vertex_areas(MeshView mesh) {
   return area;
 }
 
-RefitResult refit_to_points(std::span<const double> points, std::span<const double> weights, Mesh& approx,
-                            const RefitOptions& options) {
+RefitResult refit_to_points(const FitPoints& points, Mesh& approx, const RefitOptions& options) {
   if (!(options.max_normal_turn_degrees > 0 && options.max_normal_turn_degrees < 180))
     throw Error("refit: the face turn limit must be between 0 and 180 degrees");
   check_mesh(approx, "approximation");
-  Refitter refitter(points, weights, approx, options);
+  Refitter refitter(points, approx, options);
   return refitter.run();
 }
 
 }  // namespace refit_detail
 
-RefitResult refit(MeshView original, Mesh& approx, const RefitOptions& options) {
+std::vector<RefitResult> refit(MeshView original, std::span<Mesh* const> approximations,
+                               const RefitOptions& options) {
   const std::vector<double> weights = refit_detail::vertex_areas(original);
-  return refit_detail::refit_to_points(original.positions, weights, approx, options);
+  const refit_detail::FitPoints points(original.positions, weights);
+  std::vector<RefitResult> results;
+  for (Mesh* approx : approximations)
+    results.push_back(refit_detail::refit_to_points(points, *approx, options));
+  return results;
+}
+
+RefitResult refit(MeshView original, Mesh& approx, const RefitOptions& options) {
+  Mesh* one[] = {&approx};
+  return refit(original, one, options).front();
 }
 
 }  // namespace qem

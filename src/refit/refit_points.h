@@ -2,6 +2,7 @@
 // refit its output after it has released the input's faces (it keeps the per-vertex weights).
 #pragma once
 
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -15,8 +16,20 @@ namespace qem::refit_detail {
 /// Throws qem::Error on an out-of-range index or a non-finite coordinate.
 std::vector<double> vertex_areas(MeshView mesh);
 
-/// Refits `approx` to the points (3 doubles each) with the given weights; weight 0 = ignored.
-RefitResult refit_to_points(std::span<const double> points, std::span<const double> weights, Mesh& approx,
-                            const RefitOptions& options);
+/// The points an approximation is fitted to, in the refit's normalised frame: made once for any
+/// number of approximations of the same original.
+struct FitPoints {
+  /// Points of 3 doubles each, with the given weights; the points of weight 0 are left out.
+  FitPoints(std::span<const double> points, std::span<const double> weights);
+  std::vector<double> position;      ///< 3 per kept point, normalised
+  std::vector<double> weight;        ///< one per kept point
+  std::vector<std::uint32_t> order;  ///< Morton order of the kept points (warm-started queries)
+  double centre[3] = {0, 0, 0};      ///< the frame: centre and diagonal of the kept points' box
+  double diag = 0;
+  double total_weight = 0;
+};
+
+/// Refits `approx` to the points.
+RefitResult refit_to_points(const FitPoints& points, Mesh& approx, const RefitOptions& options);
 
 }  // namespace qem::refit_detail
