@@ -14,10 +14,12 @@
 #include <string>
 #include <vector>
 
+#include "measure/bvh.h"
 #include "qem/error.h"
 #include "qem/io.h"
 #include "qem/measure.h"
 #include "qem/simplify.h"
+#include "refit/refit_points.h"
 #include "test_meshes.h"
 
 namespace qem {
@@ -94,6 +96,28 @@ TEST(Refit, LowersTheErrorOfASimplification) {
     EXPECT_LT(e_after, 0.9 * e_before) << e_before << " -> " << e_after;
     ASSERT_EQ(after.indices, before.indices);  // connectivity untouched
   }
+}
+
+// The rounds after the first project each point only onto the faces around its face of the round
+// before; the RMS they report must still be the true one, to the closest of all faces.
+TEST(Refit, ReportedErrorIsTheDistanceToTheClosestOfAllFaces) {
+  const Mesh original = test::height_field(40, waves);
+  SimplifyOptions o;
+  o.target_faces = 150;
+  Mesh approx = simplify(original, o).mesh;
+  const RefitResult r = refit(original, approx);
+  ASSERT_GT(r.rounds, 1u);
+  std::vector<double> corners;
+  for (std::uint32_t v : approx.indices)
+    corners.insert(corners.end(), &approx.positions[3 * v], &approx.positions[3 * v] + 3);
+  const measure_detail::TriangleBvh tree(corners);
+  const std::vector<double> area = refit_detail::vertex_areas(original);
+  double sum = 0, total = 0;
+  for (std::size_t v = 0; v < original.vertex_count(); ++v) {
+    sum += area[v] * tree.closest(&original.positions[3 * v]).d2;
+    total += area[v];
+  }
+  EXPECT_NEAR(r.rms_after, std::sqrt(sum / total), 1e-12 * r.rms_after);
 }
 
 TEST(Refit, AMeshThatFitsExactlyDoesNotMove) {

@@ -3,8 +3,10 @@
 // One round, in a frame normalised to the bounding-box diagonal (so nothing depends on scale or
 // position):
 //   project   each original vertex p_i (weight w_i, its area share) onto its closest approximation
-//             face t_i, at barycentric coordinates b_i: a bounding volume hierarchy query, on all
-//             threads over fixed chunks in Morton order (the answer does not depend on the threads);
+//             face t_i, at barycentric coordinates b_i: first a bounding volume hierarchy query,
+//             then (the moves of a round being small) the closest of the faces around the corners
+//             of the point's face of the round before; on all threads over fixed chunks in Morton
+//             order (the answer does not depend on the threads);
 //   solve     min over X of  sum_i w_i |b_i . X(t_i) - p_i|^2            (the fit)
 //                            + kappa sum_edges |D_r - D_c|^2, D = X - X_old  (a membrane)
 //                            + lambda sum_v |D_v|^2                          (a small anchor),
@@ -75,7 +77,8 @@ bool barycentric(Vec3 q, Vec3 a, Vec3 b, Vec3 c, double out[3]) {
 
 /// Where each point lands on the approximation.
 struct Projection {
-  std::vector<std::uint32_t> face;  ///< closest face, UINT32_MAX = not used this round
+  std::vector<std::uint32_t> nearest;  ///< closest face, UINT32_MAX = none
+  std::vector<std::uint32_t> face;     ///< closest face, UINT32_MAX = not used this round
   std::vector<double> bary;         ///< 3 per point
   double energy = 0;                ///< sum of w_i * squared distance
 };
@@ -125,6 +128,13 @@ class Refitter {
     for (std::size_t i = 0; i < x_.size(); ++i) x_[i] = (approx.positions[i] - centre_[i % 3]) / diag_;
     fixed_.assign(approx.vertex_count(), 0);
     if (o.lock_border) mark_border();
+    // Faces around each vertex (CSR), for the projections after the first.
+    ring_start_.assign(approx.vertex_count() + 1, 0);
+    for (std::uint32_t v : tri_) ++ring_start_[v + 1];
+    for (std::size_t v = 0; v < approx.vertex_count(); ++v) ring_start_[v + 1] += ring_start_[v];
+    ring_faces_.resize(tri_.size());
+    std::vector<std::uint32_t> fill(ring_start_.begin(), ring_start_.end() - 1);
+    for (std::size_t c = 0; c < tri_.size(); ++c) ring_faces_[fill[tri_[c]]++] = std::uint32_t(c / 3);
     ready_ = true;
   }
 
@@ -138,7 +148,7 @@ class Refitter {
       std::vector<double> next;
       if (!solve(proj, next)) break;
       const std::size_t held = hold_turned_faces(next);
-      Projection next_proj = project(next);
+      Projection next_proj = project(next, &proj);
       if (!(next_proj.energy < proj.energy)) break;
       x_ = std::move(next);
       proj = std::move(next_proj);
@@ -170,14 +180,24 @@ class Refitter {
     }
   }
 
-  Projection project(const std::vector<double>& x) const {
-    const std::size_t nf = tri_.size() / 3;
-    std::vector<double> corners(9 * nf);
-    for (std::size_t c = 0; c < tri_.size(); ++c)
-      for (int k = 0; k < 3; ++k) corners[3 * c + k] = x[3 * tri_[c] + k];
-    const measure_detail::TriangleBvh tree(corners);
-    Projection p;
+  // Where each point lands on the approximation with vertices x. The first projection asks a tree
+  // of all faces. Later ones (`before`: the round before, whose moves are small) look only at the
+  // faces around the corners of the point's closest face of then: a fixed set, searched whole, so
+  // the answer is the closest of them (a walk from face to face would stop at a local minimum that
+  // rounding chooses between). A point that had no closest face asks the tree.
+  Projection project(const std::vector<double>& x, const Projection* before = nullptr) const {
     const std::size_t count = pts_.weight.size();
+    bool need_tree = before == nullptr;
+    for (std::size_t j = 0; j < count && !need_tree; ++j) need_tree = before->nearest[j] == UINT32_MAX;
+    measure_detail::TriangleBvh tree;
+    if (need_tree) {
+      std::vector<double> corners(3 * tri_.size());
+      for (std::size_t c = 0; c < tri_.size(); ++c)
+        for (int k = 0; k < 3; ++k) corners[3 * c + k] = x[3 * tri_[c] + k];
+      tree = measure_detail::TriangleBvh(corners);
+    }
+    Projection p;
+    p.nearest.assign(count, UINT32_MAX);
     p.face.assign(count, UINT32_MAX);
     p.bary.assign(3 * count, 0.0);
     std::vector<double> d2(count, 0.0);
@@ -186,8 +206,12 @@ class Refitter {
                        std::uint32_t hint = UINT32_MAX;  // reset per chunk: never crosses chunks
                        for (std::size_t k = begin; k < end; ++k) {
                          const std::uint32_t j = pts_.order[k];
-                         const auto hit = tree.closest(&pts_.position[3 * j], &hint);
+                         const double* q = &pts_.position[3 * j];
+                         const std::uint32_t was = before ? before->nearest[j] : UINT32_MAX;
+                         const auto hit =
+                             was != UINT32_MAX ? closest_around(x, q, was) : tree.closest(q, &hint);
                          if (hit.triangle == UINT32_MAX) continue;
+                         p.nearest[j] = hit.triangle;
                          d2[j] = hit.d2;  // counted in the error even when the face cannot pull
                          const std::uint32_t* t = &tri_[3 * std::size_t(hit.triangle)];
                          if (!barycentric({hit.point[0], hit.point[1], hit.point[2]}, at(x, t[0]),
@@ -198,6 +222,31 @@ class Refitter {
                      });
     for (std::size_t j = 0; j < count; ++j) p.energy += pts_.weight[j] * d2[j];  // in point order
     return p;
+  }
+
+  // The closest point to q of the faces around the corners of face f (f among them).
+  measure_detail::TriangleBvh::Hit closest_around(const std::vector<double>& x, const double* q,
+                                                  std::uint32_t f) const {
+    measure_detail::TriangleBvh::Hit hit;
+    const Vec3 point{q[0], q[1], q[2]};
+    const std::uint32_t* corners = &tri_[3 * std::size_t(f)];
+    for (int corner = 0; corner < 3; ++corner) {
+      const std::uint32_t v = corners[corner];
+      for (std::uint32_t i = ring_start_[v]; i < ring_start_[v + 1]; ++i) {
+        const std::uint32_t g = ring_faces_[i];
+        const std::uint32_t* t = &tri_[3 * std::size_t(g)];
+        // A face around an earlier corner too was tested there.
+        const auto has = [t](std::uint32_t u) { return t[0] == u || t[1] == u || t[2] == u; };
+        if ((corner > 0 && has(corners[0])) || (corner > 1 && has(corners[1]))) continue;
+        const Vec3 c =
+            measure_detail::closest_point_on_triangle(point, at(x, t[0]), at(x, t[1]), at(x, t[2]));
+        const Vec3 d = point - c;
+        const double d2 = measure_detail::dot(d, d);
+        if (d2 < hit.d2)
+          hit.d2 = d2, hit.triangle = g, hit.point[0] = c.x, hit.point[1] = c.y, hit.point[2] = c.z;
+      }
+    }
+    return hit;
   }
 
   // The least squares problem of one round, for all three coordinates at once (same matrix).
@@ -315,6 +364,7 @@ class Refitter {
   double diag_;
   std::vector<double> x_;             // approximation vertices, normalised
   std::vector<std::uint8_t> fixed_;
+  std::vector<std::uint32_t> ring_start_, ring_faces_;  // faces around each vertex
   bool ready_ = false;
 };
 
