@@ -77,10 +77,10 @@ bool barycentric(Vec3 q, Vec3 a, Vec3 b, Vec3 c, double out[3]) {
 
 /// Where each point lands on the approximation.
 struct Projection {
-  std::vector<std::uint32_t> nearest;  ///< closest face, UINT32_MAX = none
-  std::vector<std::uint32_t> face;     ///< closest face, UINT32_MAX = not used this round
-  std::vector<double> bary;         ///< 3 per point
-  double energy = 0;                ///< sum of w_i * squared distance
+  std::vector<std::uint32_t> nearest;  ///< closest face, UINT32_MAX = none (where the next round looks)
+  std::vector<std::uint32_t> face;     ///< the same face if it pulls the point (has area), else UINT32_MAX
+  std::vector<double> bary;            ///< 3 per point
+  double energy = 0;                   ///< sum of w_i * squared distance
 };
 
 }  // namespace
