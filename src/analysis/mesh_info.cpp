@@ -37,7 +37,7 @@ bool zero_area(std::span<const double> p, const std::uint32_t* t) {
   return cx == 0.0 && cy == 0.0 && cz == 0.0;
 }
 
-void check_indices(MeshView mesh) {
+void check_input(MeshView mesh) {
   check_mesh(mesh, "mesh_info");
   // Corners are numbered 3f + k in 32 bits, kNone reserved.
   if (mesh.indices.size() >= std::size_t(kNone))
@@ -101,7 +101,7 @@ std::uint32_t corner_of(std::span<const std::uint32_t> idx, std::uint32_t f, std
 }  // namespace
 
 MeshInfo mesh_info(MeshView mesh) {
-  check_indices(mesh);
+  check_input(mesh);
   const std::span<const std::uint32_t> idx = mesh.indices;
   const std::size_t nv = mesh.vertex_count(), nf = mesh.face_count();
 
