@@ -371,7 +371,6 @@ class Refitter {
 }  // namespace
 
 std::vector<double> vertex_areas(MeshView mesh) {
-  check_mesh(mesh, "original");
   std::vector<double> area(mesh.vertex_count(), 0.0);
   for (std::size_t f = 0; f < mesh.indices.size(); f += 3) {
     const std::uint32_t* t = &mesh.indices[f];
@@ -388,9 +387,6 @@ std::vector<double> vertex_areas(MeshView mesh) {
 }
 
 RefitResult refit_to_points(const FitPoints& points, Mesh& approx, const RefitOptions& options) {
-  if (!(options.max_normal_turn_degrees > 0 && options.max_normal_turn_degrees < 180))
-    throw Error("refit: the face turn limit must be between 0 and 180 degrees");
-  check_mesh(approx, "approximation");
   Refitter refitter(points, approx, options);
   return refitter.run();
 }
@@ -399,6 +395,11 @@ RefitResult refit_to_points(const FitPoints& points, Mesh& approx, const RefitOp
 
 std::vector<RefitResult> refit(MeshView original, std::span<Mesh* const> approximations,
                                const RefitOptions& options) {
+  // Everything is checked before anything moves.
+  if (!(options.max_normal_turn_degrees > 0 && options.max_normal_turn_degrees < 180))
+    throw Error("refit: the face turn limit must be between 0 and 180 degrees");
+  check_mesh(original, "original");
+  for (const Mesh* approx : approximations) check_mesh(*approx, "approximation");
   const std::vector<double> weights = refit_detail::vertex_areas(original);
   const refit_detail::FitPoints points(original.positions, weights);
   std::vector<RefitResult> results;

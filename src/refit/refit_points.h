@@ -13,7 +13,7 @@ namespace qem::refit_detail {
 
 /// A third of the area of each face around each vertex: the vertex's share of the surface, so
 /// that sums over vertices approximate integrals over the surface (HG99 §2's area weighting).
-/// Throws qem::Error on an out-of-range index or a non-finite coordinate.
+/// The mesh must have passed check_mesh (simplify and qem::refit check it first).
 std::vector<double> vertex_areas(MeshView mesh);
 
 /// The points an approximation is fitted to, in the refit's normalised frame: made once for any
@@ -29,7 +29,8 @@ struct FitPoints {
   double total_weight = 0;
 };
 
-/// Refits `approx` to the points.
+/// Refits `approx` (a mesh that has passed check_mesh; the options checked by the caller) to the
+/// points.
 RefitResult refit_to_points(const FitPoints& points, Mesh& approx, const RefitOptions& options);
 
 }  // namespace qem::refit_detail
