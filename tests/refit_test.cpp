@@ -233,6 +233,12 @@ TEST(Refit, BadInputIsAnError) {
   EXPECT_THROW(refit(original, approx, o), Error);
   Mesh empty;
   EXPECT_NO_THROW(refit(original, empty));  // nothing to fit: nothing happens
+  // Several at once: a bad one is found before any other moves.
+  Mesh first = coarse_sphere(60).mesh;
+  const Mesh untouched = first;
+  Mesh* both[] = {&first, &nan};
+  EXPECT_THROW(refit(test::icosphere(4), both), Error);
+  EXPECT_EQ(first.positions, untouched.positions);
 }
 
 TEST(Refit, SimplifyRefitsItsOutputWhenAsked) {
