@@ -196,6 +196,8 @@ class Refitter {
         for (int k = 0; k < 3; ++k) corners[3 * c + k] = x[3 * tri_[c] + k];
       tree = measure_detail::TriangleBvh(corners);
     }
+    std::vector<double> spheres;  // per face: centre and radius, to skip far faces in closest_around
+    if (!need_tree) spheres = bounding_spheres(x);
     Projection p;
     p.nearest.assign(count, UINT32_MAX);
     p.face.assign(count, UINT32_MAX);
@@ -209,7 +211,7 @@ class Refitter {
                          const double* q = &pts_.position[3 * j];
                          const std::uint32_t was = before ? before->nearest[j] : UINT32_MAX;
                          const auto hit =
-                             was != UINT32_MAX ? closest_around(x, q, was) : tree.closest(q, &hint);
+                             was != UINT32_MAX ? closest_around(x, spheres, q, was) : tree.closest(q, &hint);
                          if (hit.triangle == UINT32_MAX) continue;
                          p.nearest[j] = hit.triangle;
                          d2[j] = hit.d2;  // counted in the error even when the face cannot pull
@@ -224,11 +226,45 @@ class Refitter {
     return p;
   }
 
-  // The closest point to q of the faces around the corners of face f (f among them).
-  measure_detail::TriangleBvh::Hit closest_around(const std::vector<double>& x, const double* q,
-                                                  std::uint32_t f) const {
+  // Per face of the approximation with vertices x, a sphere that holds it: centre = the corners'
+  // mean, radius = the farthest corner's distance plus 1e-12 (of the diagonal: the frame is
+  // normalised), far above the rounding of the distances (~1e-16), so a face the bound skips could
+  // never have been the closest.
+  std::vector<double> bounding_spheres(const std::vector<double>& x) const {
+    std::vector<double> out(tri_.size() / 3 * 4);
+    for (std::size_t f = 0; f < tri_.size() / 3; ++f) {
+      const std::uint32_t* t = &tri_[3 * f];
+      const Vec3 a = at(x, t[0]), b = at(x, t[1]), c = at(x, t[2]);
+      const Vec3 m = (1.0 / 3) * (a + b + c);
+      using measure_detail::squared_distance;
+      const double r2 = std::max({squared_distance(a, m), squared_distance(b, m), squared_distance(c, m)});
+      out[4 * f] = m.x, out[4 * f + 1] = m.y, out[4 * f + 2] = m.z;
+      out[4 * f + 3] = std::sqrt(r2) + 1e-12;
+    }
+    return out;
+  }
+
+  // The closest point to q of the faces around the corners of face f (f among them). f goes first
+  // (the moves of a round are small, so it is usually still the closest); after it, a face whose
+  // bounding sphere lies farther away than the closest point so far cannot be closer and is
+  // skipped: the answer of testing every face, for a fraction of the point-triangle tests.
+  measure_detail::TriangleBvh::Hit closest_around(const std::vector<double>& x, const std::vector<double>& spheres,
+                                                  const double* q, std::uint32_t f) const {
     measure_detail::TriangleBvh::Hit hit;
+    double reach = HUGE_VAL;  // sqrt(hit.d2)
     const Vec3 point{q[0], q[1], q[2]};
+    const auto test = [&](std::uint32_t g) {
+      const double* s = &spheres[4 * std::size_t(g)];
+      const double gap = reach + s[3];
+      if (measure_detail::squared_distance(point, {s[0], s[1], s[2]}) > gap * gap) return;
+      const std::uint32_t* t = &tri_[3 * std::size_t(g)];
+      const Vec3 c = measure_detail::closest_point_on_triangle(point, at(x, t[0]), at(x, t[1]), at(x, t[2]));
+      const double d2 = measure_detail::squared_distance(point, c);
+      if (!(d2 < hit.d2)) return;
+      hit.d2 = d2, hit.triangle = g, hit.point[0] = c.x, hit.point[1] = c.y, hit.point[2] = c.z;
+      reach = std::sqrt(d2);
+    };
+    test(f);
     const std::uint32_t* corners = &tri_[3 * std::size_t(f)];
     for (int corner = 0; corner < 3; ++corner) {
       const std::uint32_t v = corners[corner];
@@ -237,13 +273,8 @@ class Refitter {
         const std::uint32_t* t = &tri_[3 * std::size_t(g)];
         // A face around an earlier corner too was tested there.
         const auto has = [t](std::uint32_t u) { return t[0] == u || t[1] == u || t[2] == u; };
-        if ((corner > 0 && has(corners[0])) || (corner > 1 && has(corners[1]))) continue;
-        const Vec3 c =
-            measure_detail::closest_point_on_triangle(point, at(x, t[0]), at(x, t[1]), at(x, t[2]));
-        const Vec3 d = point - c;
-        const double d2 = measure_detail::dot(d, d);
-        if (d2 < hit.d2)
-          hit.d2 = d2, hit.triangle = g, hit.point[0] = c.x, hit.point[1] = c.y, hit.point[2] = c.z;
+        if (g == f || (corner > 0 && has(corners[0])) || (corner > 1 && has(corners[1]))) continue;
+        test(g);
       }
     }
     return hit;
