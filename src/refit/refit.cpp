@@ -248,8 +248,9 @@ class Refitter {
   // (the moves of a round are small, so it is usually still the closest); after it, a face whose
   // bounding sphere lies farther away than the closest point so far cannot be closer and is
   // skipped: the answer of testing every face, for a fraction of the point-triangle tests.
-  measure_detail::TriangleBvh::Hit closest_around(const std::vector<double>& x, const std::vector<double>& spheres,
-                                                  const double* q, std::uint32_t f) const {
+  measure_detail::TriangleBvh::Hit closest_around(const std::vector<double>& x,
+                                                  const std::vector<double>& spheres, const double* q,
+                                                  std::uint32_t f) const {
     measure_detail::TriangleBvh::Hit hit;
     double reach = HUGE_VAL;  // sqrt(hit.d2)
     const Vec3 point{q[0], q[1], q[2]};
