@@ -197,7 +197,7 @@ class Refitter {
       tree = measure_detail::TriangleBvh(corners);
     }
     std::vector<double> spheres;  // per face: centre and radius, to skip far faces in closest_around
-    if (!need_tree) spheres = bounding_spheres(x);
+    if (before) spheres = bounding_spheres(x);
     Projection p;
     p.nearest.assign(count, UINT32_MAX);
     p.face.assign(count, UINT32_MAX);
