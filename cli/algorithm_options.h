@@ -23,6 +23,7 @@ struct AlgorithmArgs {
   bool weld = false, no_weld = false;
   bool refit = false;         // --refit
   unsigned refit_rounds = 0;  // --refit-rounds (implies --refit); 0 = RefitOptions' default
+  double refit_sample = 0;    // --refit-sample (implies --refit); 0 = every input vertex
 };
 
 /// Adds --threshold(-rel), --weighting, --placement, --scheme, --greedy-below, --threads,

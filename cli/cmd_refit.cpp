@@ -70,6 +70,12 @@ const bool registered = register_command(14, [](CLI::App& app) {
       ->check(CLI::Range(1.0, 179.0));
   sub->add_option("--threads", o.threads, "Threads for the closest-point queries (0 = all; same result)")
       ->capture_default_str();
+  sub->add_option(
+         "--sample", o.points_per_vertex,
+         "Fit to about this many of the original's vertices per approximation vertex, every k-th "
+         "along a space-filling curve (0 = all). 2-4 keep most of the gain at a fraction of the time")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e6));
   sub->add_flag("--ascii", args->ascii, "Write PLY / STL as text instead of binary");
   sub->add_flag("--double", args->double_values, kDoubleOutputHelp);
   sub->add_flag("--json", args->json, "Print one JSON line with the fit's RMS before and after");

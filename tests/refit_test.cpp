@@ -263,6 +263,89 @@ TEST(Refit, SimplifyRefitsItsOutputWhenAsked) {
   EXPECT_EQ(consumed.mesh.positions, fitted.mesh.positions);
 }
 
+TEST(Refit, ThinnedPointsKeepTheFrameAndTheTotalWeight) {
+  const Mesh original = test::icosphere(3);
+  const std::vector<double> weights = refit_detail::vertex_areas(original);
+  const refit_detail::FitPoints all(original.positions, weights);
+  for (std::size_t group : {2, 3, 7}) {
+    SCOPED_TRACE(group);
+    const refit_detail::FitPoints few = all.thinned(group);
+    ASSERT_EQ(few.weight.size(), (all.weight.size() + group - 1) / group);
+    ASSERT_EQ(few.order.size(), few.weight.size());
+    EXPECT_NEAR(few.total_weight, all.total_weight, 1e-12 * all.total_weight);
+    EXPECT_EQ(few.diag, all.diag);
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(few.centre[k], all.centre[k]);
+    // Each kept point is one of the originals, and together they carry every run's weight.
+    double sum = 0;
+    for (std::size_t j = 0; j < few.weight.size(); ++j) {
+      bool found = false;
+      for (std::size_t i = 0; i < all.weight.size() && !found; ++i)
+        found = all.position[3 * i] == few.position[3 * j] &&
+                all.position[3 * i + 1] == few.position[3 * j + 1] &&
+                all.position[3 * i + 2] == few.position[3 * j + 2];
+      EXPECT_TRUE(found) << j;
+      EXPECT_GT(few.weight[j], 0);
+      sum += few.weight[j];
+    }
+    EXPECT_NEAR(sum, all.total_weight, 1e-12 * all.total_weight);
+  }
+}
+
+TEST(Refit, AFitToSampledPointsKeepsMostOfTheGain) {
+  const Mesh original = test::icosphere(5);  // 10242 vertices
+  const Mesh before = coarse_sphere(300).mesh;
+  RefitOptions sampled;
+  sampled.points_per_vertex = 4;  // about 600 of the 10242 points
+  sampled.threads = 1;
+  Mesh a = before;
+  const RefitResult r = refit(original, a, sampled);
+  EXPECT_GT(r.rounds, 0u);
+  EXPECT_LT(r.rms_after, 0.9 * r.rms_before);
+  Mesh full = before;
+  refit(original, full);
+  EXPECT_NE(a.positions, full.positions);  // the sample is in use
+  MeasureOptions m;
+  m.samples = 200000;
+  const double e_before = measure(original, before, m).E, e_sampled = measure(original, a, m).E;
+  const double e_full = measure(original, full, m).E;
+  EXPECT_LT(e_sampled, 0.9 * e_before) << e_before << " -> " << e_sampled;
+  // Most of the full fit's gain (here 97 %: E 5.1e-5 -> 2.04e-5 sampled, 1.96e-5 full).
+  EXPECT_GT(e_before - e_sampled, 0.8 * (e_before - e_full)) << e_sampled << " full " << e_full;
+  ASSERT_EQ(a.indices, before.indices);
+
+  // Deterministic, for any thread count, scale and position.
+  RefitOptions three = sampled;
+  three.threads = 3;
+  Mesh b = before;
+  refit(original, b, three);
+  EXPECT_EQ(a.positions, b.positions);
+  const double s = 1e-3, o[3] = {-40, 7, 1e3};
+  Mesh moved = test::transformed(before, s, o[0], o[1], o[2]);
+  refit(test::transformed(original, s, o[0], o[1], o[2]), moved, sampled);
+  for (std::size_t i = 0; i < a.positions.size(); ++i)
+    EXPECT_NEAR((moved.positions[i] - o[i % 3]) / s, a.positions[i], 1e-9) << i;
+
+  // A sample no smaller than half the original is the original itself.
+  RefitOptions plenty;
+  plenty.points_per_vertex = 1e6;
+  Mesh c = before;
+  refit(original, c, plenty);
+  EXPECT_EQ(c.positions, full.positions);
+
+  for (double bad :
+       {-1.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+    RefitOptions o2;
+    o2.points_per_vertex = bad;
+    Mesh d = before;
+    EXPECT_THROW(refit(original, d, o2), Error) << bad;
+    SimplifyOptions so;
+    so.target_faces = 300;
+    so.refit_rounds = 1;
+    so.refit_points_per_vertex = bad;
+    EXPECT_THROW(simplify(original, so), Error) << bad;
+  }
+}
+
 // --- the CLI ---------------------------------------------------------------------------------
 
 using test::slurp;
@@ -300,6 +383,28 @@ TEST(Refit, CliSimplifyRefitEqualsRefitCommandAndLodLevel) {
   { std::ofstream(dir + "/bad.obj") << "v 0 0 0\nv 1 0 0\nf 1 2 7\n"; }
   EXPECT_NE(run("refit " + dir + "/bad.obj " + dir + "/plain.obj " + dir + "/x.obj 2>/dev/null"), 0);
   EXPECT_FALSE(std::filesystem::exists(dir + "/x.obj"));
+}
+
+TEST(Refit, CliSampledRefitIsTheSameInSimplifyRefitAndLod) {
+  const std::string dir = test::temp_dir() + "/refit_sample_cli";
+  std::filesystem::create_directories(dir);
+  const std::string in = dir + "/in.obj";
+  save_mesh(in, test::icosphere(5));
+  ASSERT_EQ(run("simplify " + in + " " + dir + "/sampled.obj --faces 400 --refit-sample 3"), 0);
+  ASSERT_EQ(run("simplify " + in + " " + dir + "/full.obj --faces 400 --refit"), 0);
+  ASSERT_EQ(run("simplify " + in + " " + dir + "/plain.obj --faces 400"), 0);
+  ASSERT_EQ(run("refit " + in + " " + dir + "/plain.obj " + dir + "/refitted.obj --sample 3"), 0);
+  ASSERT_EQ(run("lod " + in + " " + dir + "/lod --faces 400 --format obj --refit-sample 3"), 0);
+  const std::string sampled = slurp(dir + "/sampled.obj");
+  EXPECT_FALSE(sampled.empty());
+  EXPECT_NE(sampled, slurp(dir + "/full.obj"));
+  EXPECT_NE(sampled, slurp(dir + "/plain.obj"));
+  EXPECT_TRUE(sampled == slurp(dir + "/refitted.obj")) << "qem refit --sample differs from simplify";
+  EXPECT_TRUE(sampled == slurp(dir + "/lod/in_lod0.obj")) << "lod --refit-sample differs from simplify";
+  EXPECT_NE(run("simplify " + in + " " + dir + "/neg.obj --faces 400 --refit-sample -1 2>/dev/null"), 0);
+  EXPECT_FALSE(std::filesystem::exists(dir + "/neg.obj"));
+  EXPECT_NE(run("refit " + in + " " + dir + "/plain.obj " + dir + "/neg.obj --sample nan 2>/dev/null"), 0);
+  EXPECT_FALSE(std::filesystem::exists(dir + "/neg.obj"));
 }
 
 }  // namespace

@@ -29,6 +29,11 @@ struct RefitOptions {
   /// Threads for the closest-point queries (0 = all hardware threads); the result does not
   /// depend on it.
   unsigned threads = 0;
+  /// Fit to about this many of the original's vertices per approximation vertex; 0 = all of them.
+  /// Every k-th vertex along a Morton curve stands for its k neighbours (their summed area), so
+  /// the cost follows the approximation's size, not the original's. 2 is about the fewest that
+  /// fit a noisy surface rather than its noise; with fewer points the reported RMS is over them.
+  double points_per_vertex = 0;
 };
 
 struct RefitResult {
@@ -42,7 +47,7 @@ struct RefitResult {
 /// Moves the vertices of `approx` to fit `original` better; faces and vertex order are unchanged,
 /// and a vertex that does not move keeps its exact coordinates. Deterministic for any thread
 /// count; invariant to the model's scale and position (up to rounding). Throws qem::Error on an
-/// out-of-range index or a non-finite coordinate.
+/// out-of-range index, a non-finite coordinate or an option out of range.
 RefitResult refit(MeshView original, Mesh& approx, const RefitOptions& options = {});
 
 /// Refits several approximations of one original (the levels of a chain), each exactly as the

@@ -108,6 +108,9 @@ struct SimplifyOptions {
   /// `max_normal_turn_degrees` apply to it too. The record (if any) holds the contractions only:
   /// a replayed level is the unrefitted mesh (refit it with qem::refit to match).
   unsigned refit_rounds = 0;
+  /// The refit's input points per output vertex, 0 = every input vertex (RefitOptions::
+  /// points_per_vertex): 2-4 keep most of the refit's gain for much less time on a large input.
+  double refit_points_per_vertex = 0;
 
   /// If set, every contraction is appended to this log (cleared first).
   ContractionLog* record = nullptr;
@@ -128,14 +131,15 @@ struct SimplifyResult {
   double max_error_relative = 0;    ///< the same over the bounding-box diagonal
   StopReason stop_reason = StopReason::TargetReached;
   std::string stop_detail;          ///< human-readable explanation of the stop
-  /// With refit_rounds > 0: the refit's area-weighted RMS distance from the input's vertices to
-  /// the output, before and after it (model units), and the rounds it kept.
+  /// With refit_rounds > 0: the refit's area-weighted RMS distance from the input's vertices (or
+  /// those it sampled) to the output, before and after it (model units), and the rounds it kept.
   double refit_rms_before = 0, refit_rms_after = 0;
   std::size_t refit_rounds = 0;
 };
 
-/// The refit options `simplify` uses for `options` (qem/refit.h): the same rounds, border lock,
-/// face turn limit and threads. `qem lod` refits each level with them, as `simplify` would.
+/// The refit options `simplify` uses for `options` (qem/refit.h): the same rounds, points per
+/// vertex, border lock, face turn limit and threads. `qem lod` refits each level with them, as
+/// `simplify` would.
 RefitOptions refit_options(const SimplifyOptions& options);
 
 /// Simplifies a mesh. Input positions are never normalised in the output: vertices that did not

@@ -2,11 +2,12 @@
 //
 // One round, in a frame normalised to the bounding-box diagonal (so nothing depends on scale or
 // position):
-//   project   each original vertex p_i (weight w_i, its area share) onto its closest approximation
-//             face t_i, at barycentric coordinates b_i: first a bounding volume hierarchy query,
-//             then (the moves of a round being small) the closest of the faces around the corners
-//             of the point's face of the round before; on all threads over fixed chunks in Morton
-//             order (the answer does not depend on the threads);
+//   project   each original vertex p_i (weight w_i, its area share; with points_per_vertex, every
+//             k-th along the Morton order, carrying the area of its run of k) onto its closest
+//             approximation face t_i, at barycentric coordinates b_i: first a bounding volume
+//             hierarchy query, then (the moves of a round being small) the closest of the faces
+//             around the corners of the point's face of the round before; on all threads over
+//             fixed chunks in Morton order (the answer does not depend on the threads);
 //   solve     min over X of  sum_i w_i |b_i . X(t_i) - p_i|^2            (the fit)
 //                            + kappa sum_edges |D_r - D_c|^2, D = X - X_old  (a membrane)
 //                            + lambda sum_v |D_v|^2                          (a small anchor),
@@ -110,6 +111,24 @@ FitPoints::FitPoints(std::span<const double> points, std::span<const double> wei
   order = core::morton_order(used.size(), [&](std::size_t j) {
     return core::Vec3(position[3 * j], position[3 * j + 1], position[3 * j + 2]);
   });
+}
+
+FitPoints FitPoints::thinned(std::size_t group) const {
+  FitPoints out;
+  std::copy(centre, centre + 3, out.centre);
+  out.diag = diag;
+  const std::size_t n = order.size();
+  for (std::size_t begin = 0; begin < n; begin += group) {
+    const std::size_t end = std::min(n, begin + group);
+    double w = 0;
+    for (std::size_t k = begin; k < end; ++k) w += weight[order[k]];
+    const std::uint32_t middle = order[begin + (end - begin) / 2];
+    out.position.insert(out.position.end(), &position[3 * middle], &position[3 * middle] + 3);
+    out.weight.push_back(w);
+    out.order.push_back(std::uint32_t(out.order.size()));  // runs follow the Morton order
+    out.total_weight += w;
+  }
+  return out;
 }
 
 namespace {
@@ -419,7 +438,12 @@ std::vector<double> vertex_areas(MeshView mesh) {
 }
 
 RefitResult refit_to_points(const FitPoints& points, Mesh& approx, const RefitOptions& options) {
-  Refitter refitter(points, approx, options);
+  // points_per_vertex: one point for each run of `group` (fewer than one point wanted: one run).
+  const double wanted = options.points_per_vertex * double(approx.vertex_count());
+  const std::size_t n = points.weight.size();
+  const std::size_t group = !(wanted > 0) ? 0 : wanted <= 1 ? n : std::size_t(double(n) / wanted);
+  const FitPoints sample = group >= 2 ? points.thinned(group) : FitPoints{};
+  Refitter refitter(group >= 2 ? sample : points, approx, options);
   return refitter.run();
 }
 
@@ -430,6 +454,8 @@ std::vector<RefitResult> refit(MeshView original, std::span<Mesh* const> approxi
   // Everything is checked before anything moves.
   if (!(options.max_normal_turn_degrees > 0 && options.max_normal_turn_degrees < 180))
     throw Error("refit: the face turn limit must be between 0 and 180 degrees");
+  if (!(options.points_per_vertex >= 0 && std::isfinite(options.points_per_vertex)))
+    throw Error("refit: the points per vertex must be 0 (all) or a positive number");
   check_mesh(original, "original");
   for (const Mesh* approx : approximations) check_mesh(*approx, "approximation");
   const std::vector<double> weights = refit_detail::vertex_areas(original);

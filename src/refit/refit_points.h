@@ -19,8 +19,12 @@ std::vector<double> vertex_areas(MeshView mesh);
 /// The points an approximation is fitted to, in the refit's normalised frame: made once for any
 /// number of approximations of the same original.
 struct FitPoints {
+  FitPoints() = default;
   /// Points of 3 doubles each, with the given weights; the points of weight 0 are left out.
   FitPoints(std::span<const double> points, std::span<const double> weights);
+  /// One point for each run of `group` consecutive points in Morton order: the run's middle
+  /// point, carrying the run's summed weight (RefitOptions::points_per_vertex). Same frame.
+  FitPoints thinned(std::size_t group) const;
   std::vector<double> position;      ///< 3 per kept point, normalised
   std::vector<double> weight;        ///< one per kept point
   std::vector<std::uint32_t> order;  ///< Morton order of the kept points (warm-started queries)
