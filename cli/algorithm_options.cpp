@@ -49,8 +49,8 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
       ->check(CLI::Range(1u, 100u));
   sub->add_option("--refit-sample", a.refit_sample,
                   "Fit --refit to about this many input vertices per output vertex, every k-th along a "
-                  "space-filling curve (implies --refit; 0 = all). 2-4 keep most of its gain at a "
-                  "fraction of its time on a large input")
+                  "space-filling curve (implies --refit; 0 = all). 4-8 keep most of its gain; the time "
+                  "saved grows with the input vertices per output vertex")
       ->check(CLI::Range(0.0, 1e6));
 }
 

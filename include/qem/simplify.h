@@ -109,7 +109,8 @@ struct SimplifyOptions {
   /// a replayed level is the unrefitted mesh (refit it with qem::refit to match).
   unsigned refit_rounds = 0;
   /// The refit's input points per output vertex, 0 = every input vertex (RefitOptions::
-  /// points_per_vertex): 2-4 keep most of the refit's gain for much less time on a large input.
+  /// points_per_vertex). 4-8 keep most of the refit's gain; the time saved grows with the input's
+  /// vertices per output vertex (docs/benchmarks.md).
   double refit_points_per_vertex = 0;
 
   /// If set, every contraction is appended to this log (cleared first).
