@@ -493,8 +493,7 @@ void Simplifier::resolve_targets() {
     throw Error("the inversion angle limit must be in (0, 90) degrees");
   if (opt_.threshold < 0) throw Error("threshold must not be negative");
   if (opt_.boundary_weight < 0) throw Error("boundary weight must not be negative");
-  if (!(opt_.refit_points_per_vertex >= 0 && std::isfinite(opt_.refit_points_per_vertex)))
-    throw Error("the refit's points per vertex must be 0 (all) or a positive number");
+  refit_detail::check_options(refit_options(opt_));
   cos_max_turn_ = std::cos(opt_.max_normal_turn_degrees * 3.14159265358979323846 / 180.0);
 }
 

@@ -437,11 +437,19 @@ std::vector<double> vertex_areas(MeshView mesh) {
   return area;
 }
 
+void check_options(const RefitOptions& options) {
+  if (!(options.max_normal_turn_degrees > 0 && options.max_normal_turn_degrees < 180))
+    throw Error("refit: the face turn limit must be between 0 and 180 degrees");
+  if (!(options.points_per_vertex >= 0 && std::isfinite(options.points_per_vertex)))
+    throw Error("refit: the points per vertex must be 0 (all) or a positive number");
+}
+
 RefitResult refit_to_points(const FitPoints& points, Mesh& approx, const RefitOptions& options) {
   // points_per_vertex: one point for each run of `group` (fewer than one point wanted: one run).
   const double wanted = options.points_per_vertex * double(approx.vertex_count());
   const std::size_t n = points.weight.size();
-  const std::size_t group = !(wanted > 0) ? 0 : wanted <= 1 ? n : std::size_t(double(n) / wanted);
+  std::size_t group = 0;  // 0 or 1: every point
+  if (wanted > 0) group = wanted <= 1 ? n : std::size_t(double(n) / wanted);
   const FitPoints sample = group >= 2 ? points.thinned(group) : FitPoints{};
   Refitter refitter(group >= 2 ? sample : points, approx, options);
   return refitter.run();
@@ -452,10 +460,7 @@ RefitResult refit_to_points(const FitPoints& points, Mesh& approx, const RefitOp
 std::vector<RefitResult> refit(MeshView original, std::span<Mesh* const> approximations,
                                const RefitOptions& options) {
   // Everything is checked before anything moves.
-  if (!(options.max_normal_turn_degrees > 0 && options.max_normal_turn_degrees < 180))
-    throw Error("refit: the face turn limit must be between 0 and 180 degrees");
-  if (!(options.points_per_vertex >= 0 && std::isfinite(options.points_per_vertex)))
-    throw Error("refit: the points per vertex must be 0 (all) or a positive number");
+  refit_detail::check_options(options);
   check_mesh(original, "original");
   for (const Mesh* approx : approximations) check_mesh(*approx, "approximation");
   const std::vector<double> weights = refit_detail::vertex_areas(original);

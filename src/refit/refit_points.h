@@ -33,6 +33,9 @@ struct FitPoints {
   double total_weight = 0;
 };
 
+/// Throws qem::Error if an option is out of range (qem::refit, and simplify for its refit).
+void check_options(const RefitOptions& options);
+
 /// Refits `approx` (a mesh that has passed check_mesh; the options checked by the caller) to the
 /// points.
 RefitResult refit_to_points(const FitPoints& points, Mesh& approx, const RefitOptions& options);
