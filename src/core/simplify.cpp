@@ -2,7 +2,7 @@
 //
 // Pipeline (each step one function below):
 //   prepare_input        validate, drop degenerate and duplicate faces, normalise the frame
-//   build_adjacency      per-vertex face lists
+//   rebuild_face_lists   per-vertex face lists (again at the start of each pass)
 //   compute_quadrics     GH97 §5 fundamental quadrics, weighted (HG99 §2), + boundary planes (GH97 §6)
 //   select_pairs         GH97 §3.2: edges + pairs closer than t
 //   run_greedy           cost every pair, heap them, then repeatedly: pop the cheapest, check it
@@ -24,12 +24,14 @@
 #include <exception>
 #include <future>
 #include <limits>
+#include <stdexcept>
 #include <string>
 #include <system_error>
 #include <thread>
 
 #include "check_mesh.h"
 #include "core/indexed_heap.h"
+#include "core/invariant_checks.h"
 #include "core/placement.h"
 #include "core/quadric.h"
 #include "core/radix_sort.h"
@@ -108,15 +110,15 @@ class Simplifier {
  private:
   // --- setup --------------------------------------------------------------------------------
   void prepare_input();
-  void build_adjacency();
+  void rebuild_face_lists();
+  void rebuild_pair_lists();
   void compute_quadrics();
   void select_pairs(std::vector<Edge> edges);
   void resolve_targets();
 
   // What one thread needs to make contractions: its own scratch space, stamps and counters (the
-  // shared counters absorb them), and, in a band made on several threads, the stretches of the
-  // vertex-list arenas its moved lists go to. Threads work on disjoint parts of the mesh (see
-  // make_band), so nothing else they write is shared.
+  // shared counters absorb them). Threads work on disjoint parts of the mesh (see make_band), so
+  // nothing else they write is shared.
   struct Worker {
     std::uint32_t stamp = 0;  // last stamp used in mark_; every stamp is used once in a run
     std::vector<std::uint32_t> scratch, scratch2;
@@ -124,8 +126,6 @@ class Simplifier {
     std::size_t blocked_topology = 0, blocked_inversion = 0, blocked_error = 0;
     double max_error = 0;
     std::uint32_t last_kept = 0, last_removed = 0;  // of the last contraction made
-    VertexLists::Tail* face_tail = nullptr;  // null: moved lists go to the arena's end
-    VertexLists::Tail* pair_tail = nullptr;
   };
   void absorb(Worker& w);
 
@@ -140,6 +140,7 @@ class Simplifier {
   void prefetch_for_contraction(const std::uint32_t* pairs, std::size_t count, std::size_t i) const;
   void recost_dirty_pairs();
   void renumber_densely();
+  void check_lists() const;
   unsigned thread_count() const {
     return opt_.threads > 0 ? opt_.threads : std::max(1u, std::thread::hardware_concurrency());
   }
@@ -168,6 +169,15 @@ class Simplifier {
   void record_contraction(double error, const Worker& w);
   bool kill_if_coincident(std::uint32_t f, std::size_t own, Worker& w);
   void unblock_around(std::uint32_t v);
+  // Calls f(r) for every pair r in the list of v as it is now: in a pass, a vertex's stored list
+  // is the one of the pass's start, and a survivor's pairs now are its own and those of the
+  // vertex it absorbed (merged_from_). Dead pairs are included: callers skip them.
+  template <class F>
+  void for_each_pair_of(std::uint32_t v, F f) const {
+    for (std::uint32_t r : vertex_pairs_[v]) f(r);
+    if (passes_ && merged_from_[v] != kNoVertex)
+      for (std::uint32_t r : vertex_pairs_[merged_from_[v]]) f(r);
+  }
   void forget(std::uint32_t p) {
     if (!passes_) heap_.remove(p);
   }
@@ -240,6 +250,12 @@ class Simplifier {
   // every other cost ranked in the pass stays exact).
   std::vector<std::uint8_t> dirty_;
   std::vector<std::uint32_t> touched_in_pass_;
+  // Passes: the vertex lists are rebuilt at the start of each pass and not written during it. A
+  // contraction renames its removed end in the faces and pairs themselves, so every list but the
+  // survivor's stays right; the survivor's is its own plus that of the vertex it absorbed, which
+  // is recorded here (kNoVertex: none), and it is never contracted again in the pass.
+  static constexpr std::uint32_t kNoVertex = 0xffffffffu;
+  std::vector<std::uint32_t> merged_from_;
 
   // Stamps for set membership without clearing (one array, fresh stamp per query).
   std::vector<std::uint32_t> mark_;
@@ -379,12 +395,21 @@ void Simplifier::prepare_input() {
   result_.input_vertices = vertices_alive_;
 }
 
-void Simplifier::build_adjacency() {
-  std::vector<std::uint32_t> count(pos_.size(), 0);
-  for (std::uint32_t v : tri_) ++count[v];
-  vertex_faces_.layout(count);
-  for (std::uint32_t f = 0; f < face_source_.size(); ++f)
-    for (int k = 0; k < 3; ++k) vertex_faces_.push_initial(tri_[3 * f + k], f);
+// Each vertex's live faces, in face order.
+void Simplifier::rebuild_face_lists() {
+  vertex_faces_.rebuild(pos_.size(), [&](auto emit) {
+    for (std::uint32_t f = 0; f < face_alive_.size(); ++f)
+      if (face_alive_[f])
+        for (int k = 0; k < 3; ++k) emit(tri_[3 * std::size_t(f) + k], f);
+  });
+}
+
+// Each vertex's pairs that are not dead, in pair order.
+void Simplifier::rebuild_pair_lists() {
+  vertex_pairs_.rebuild(pos_.size(), [&](auto emit) {
+    for (std::uint32_t p = 0; p < pairs_.size(); ++p)
+      if (pairs_[p].state != kDead) emit(pairs_[p].v[0], p), emit(pairs_[p].v[1], p);
+  });
 }
 
 void Simplifier::compute_quadrics() {
@@ -461,13 +486,7 @@ void Simplifier::select_pairs(std::vector<Edge> edges) {
   for (std::size_t i = 0; i < virtual_pairs.size(); ++i)
     pairs_[edges.size() + i] = {{virtual_pairs[i].first, virtual_pairs[i].second}, kInHeap, 1};
   std::vector<Edge>().swap(edges);
-  std::vector<std::uint32_t> count(pos_.size(), 0);
-  for (const PairRecord& r : pairs_) ++count[r.v[0]], ++count[r.v[1]];
-  vertex_pairs_.layout(count);
-  for (std::uint32_t p = 0; p < np; ++p) {
-    vertex_pairs_.push_initial(pairs_[p].v[0], p);
-    vertex_pairs_.push_initial(pairs_[p].v[1], p);
-  }
+  rebuild_pair_lists();
 }
 
 void Simplifier::resolve_targets() {
@@ -648,14 +667,15 @@ void Simplifier::block(std::uint32_t p) {
 
 // The neighbourhood of v changed: pairs of v's neighbours that were rejected get another chance.
 void Simplifier::unblock_around(std::uint32_t v) {
-  for (std::uint32_t p : vertex_pairs_[v]) {
-    if (pairs_[p].state == kDead) continue;
+  for_each_pair_of(v, [&](std::uint32_t p) {
+    if (pairs_[p].state == kDead) return;
     std::uint32_t o = other_end(p, v);
-    if (!has_blocked_[o]) continue;
+    if (!has_blocked_[o]) return;
     has_blocked_[o] = 0;
-    for (std::uint32_t q : vertex_pairs_[o])
+    for_each_pair_of(o, [&](std::uint32_t q) {
       if (pairs_[q].state == kBlocked) cost_pair(q);
-  }
+    });
+  });
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -705,8 +725,10 @@ void Simplifier::contract(std::uint32_t p, const Quadric& q, const Vec3& target,
       if (face_alive_[f]) faces[kept++] = f;
     faces.resize(kept);
   }
-  vertex_faces_.assign(a, faces.data(), faces.size(), b, w.face_tail);
-  vertex_faces_.clear(b);
+  if (!passes_) {  // in a pass, the lists wait for the next pass's rebuild (merged_from_)
+    vertex_faces_.assign(a, faces.data(), faces.size(), b);
+    vertex_faces_.clear(b);
+  }
 
   // Pairs: GH97 §4 "pair sets merge": b's pairs now start at a; the contracted pair and any pair
   // that now duplicates another (same two vertices) are removed.
@@ -733,11 +755,15 @@ void Simplifier::contract(std::uint32_t p, const Quadric& q, const Vec3& target,
       pairs.push_back(r);
     }
   }
-  vertex_pairs_.assign(a, pairs.data(), pairs.size(), b, w.pair_tail);
-  vertex_pairs_.clear(b);
+  if (passes_) {
+    merged_from_[a] = b;
+  } else {
+    vertex_pairs_.assign(a, pairs.data(), pairs.size(), b);
+    vertex_pairs_.clear(b);
+  }
 
   // GH97 §4 step 5: update the costs of all valid pairs involving the new vertex.
-  for (std::uint32_t r : vertex_pairs_[a])
+  for (std::uint32_t r : pairs)
     if (pairs_[r].state != kLocked) cost_pair(r);
   unblock_around(a);
 }
@@ -765,9 +791,9 @@ void Simplifier::recost_dirty_pairs() {
 
 // Passes: once half the vertices are gone, the survivors, live faces and live pairs are numbered
 // densely again, each in its old order, so later passes sweep small dense arrays instead of
-// sparse ones (fewer cache misses per contraction). Every relative order is kept (list contents,
-// tie-breaks on ids, output order), so the result is exactly the same. Expects the vertex lists
-// to hold live items only.
+// sparse ones (fewer cache misses per contraction). Every relative order is kept (tie-breaks on
+// ids, the order of the rebuilt lists, output order), so the result is exactly the same. The
+// vertex lists are rebuilt after it.
 void Simplifier::renumber_densely() {
   static constexpr std::uint32_t kGone = 0xffffffffu;
   // Named members, not structured bindings: clang 14 (Debian 12, the fuzz
@@ -788,29 +814,24 @@ void Simplifier::renumber_densely() {
       if (to[i] != kGone) array[to[i]] = array[i];
     array.resize(count);
   };
-  const Numbering vertices = numbering(
-      pos_.size(), [&](std::size_t v) { return !vertex_faces_[std::uint32_t(v)].empty() || !vertex_pairs_[std::uint32_t(v)].empty(); });
+  // A vertex lives on while a live face or a pair that is not dead has it.
+  std::vector<std::uint8_t> used(pos_.size(), 0);
+  for (std::uint32_t f = 0; f < face_alive_.size(); ++f)
+    if (face_alive_[f])
+      used[tri_[3 * std::size_t(f)]] = used[tri_[3 * std::size_t(f) + 1]] =
+          used[tri_[3 * std::size_t(f) + 2]] = 1;
+  for (const PairRecord& r : pairs_)
+    if (r.state != kDead) used[r.v[0]] = used[r.v[1]] = 1;
+  const Numbering vertices = numbering(pos_.size(), [&](std::size_t v) { return used[v] != 0; });
+  std::vector<std::uint8_t>().swap(used);
 
-  auto renumber_lists = [&](VertexLists& lists, const std::vector<std::uint32_t>& item_to) {
-    std::vector<std::uint32_t> sizes(vertices.count);
-    for (std::uint32_t v = 0; v < vertices.to.size(); ++v)
-      if (vertices.to[v] != kGone) sizes[vertices.to[v]] = std::uint32_t(lists[v].size());
-    VertexLists dense;
-    dense.layout(sizes);
-    for (std::uint32_t v = 0; v < vertices.to.size(); ++v)
-      if (vertices.to[v] != kGone)
-        for (std::uint32_t item : lists[v]) dense.push_initial(vertices.to[v], item_to[item]);
-    lists = std::move(dense);
-  };
-  // One arena at a time (each is rebuilt beside the old one), each numbering freed once used:
-  // on large meshes this is the peak of the run's memory.
+  // Each numbering is freed once used: on large meshes this is the peak of the run's memory.
   Numbering pairs = numbering(pairs_.size(), [&](std::size_t p) { return pairs_[p].state != kDead; });
   for (PairRecord& r : pairs_)
     if (r.state != kDead) r.v[0] = vertices.to[r.v[0]], r.v[1] = vertices.to[r.v[1]];
   squeeze(pairs_, pairs.to, pairs.count);
   squeeze(cost_, pairs.to, pairs.count);
   squeeze(dirty_, pairs.to, pairs.count);
-  renumber_lists(vertex_pairs_, pairs.to);
   std::vector<std::uint32_t>().swap(pairs.to);
 
   Numbering faces = numbering(face_alive_.size(), [&](std::size_t f) { return face_alive_[f] != 0; });
@@ -822,7 +843,6 @@ void Simplifier::renumber_densely() {
   tri_.resize(3 * std::size_t(faces.count));
   face_source_.resize(faces.count);
   face_alive_.assign(faces.count, 1);
-  renumber_lists(vertex_faces_, faces.to);
 
   squeeze(pos_, vertices.to, vertices.count);
   squeeze(quadric_, vertices.to, vertices.count);
@@ -975,16 +995,18 @@ void Simplifier::run_passes() {
   touched_in_pass_.assign(pos_.size(), 0);
   std::vector<std::uint32_t> order, scratch, selected;
   for (std::uint32_t pass = 1; !done(); ++pass) {
+    if (pass > 1) {
+      // The lists as the last pass left them (see merged_from_), rebuilt with live items only,
+      // which also keeps each contraction's loops (and cache misses) to the live neighbourhood.
+      if (2 * vertices_alive_ < pos_.size()) renumber_densely();
+      side_by_side([&] { rebuild_pair_lists(); }, [&] { rebuild_face_lists(); });
+    }
+    merged_from_.assign(pos_.size(), kNoVertex);
     if (faces_alive_ <= opt_.greedy_below_faces) {
       passes_ = false;
       run_greedy();
       return;
     }
-    // Dead faces and pairs linger in the lists of vertices that were not contracted; dropping
-    // them keeps each contraction's loops (and cache misses) to the live neighbourhood.
-    side_by_side([&] { vertex_pairs_.filter([&](std::uint32_t p) { return pairs_[p].state != kDead; }); },
-                 [&] { vertex_faces_.filter([&](std::uint32_t f) { return face_alive_[f] != 0; }); });
-    if (2 * vertices_alive_ < pos_.size()) renumber_densely();
     recost_dirty_pairs();
     order.clear();
     order.reserve(pairs_.size());
@@ -1028,7 +1050,44 @@ void Simplifier::run_passes() {
     for (std::size_t band = 0; band < kBands && !done(); ++band) {
       const std::size_t begin = n * band / kBands, end = n * (band + 1) / kBands;
       if (!make_band(selected.data() + begin, end - begin)) return;
+      if (check_invariants) check_lists();
     }
+  }
+}
+
+// For the tests (core::check_invariants): every vertex's lists, as a pass reads them, hold exactly
+// its live faces and its pairs that are not dead. In a pass, a survivor's face list is never read
+// again (it is not contracted twice), and a removed vertex's lists are not read at all.
+void Simplifier::check_lists() const {
+  const std::size_t n = pos_.size();
+  std::vector<std::vector<std::uint32_t>> faces(n), pairs(n);
+  for (std::uint32_t f = 0; f < face_alive_.size(); ++f)
+    if (face_alive_[f])
+      for (int k = 0; k < 3; ++k) faces[tri_[3 * std::size_t(f) + k]].push_back(f);
+  for (std::uint32_t p = 0; p < pairs_.size(); ++p)
+    if (pairs_[p].state != kDead) pairs[pairs_[p].v[0]].push_back(p), pairs[pairs_[p].v[1]].push_back(p);
+  std::vector<std::uint8_t> removed(n, 0), survivor(n, 0);
+  if (passes_)
+    for (std::uint32_t v = 0; v < n; ++v)
+      if (merged_from_[v] != kNoVertex) survivor[v] = 1, removed[merged_from_[v]] = 1;
+  auto sorted = [](std::vector<std::uint32_t> items) {
+    std::sort(items.begin(), items.end());
+    return items;
+  };
+  for (std::uint32_t v = 0; v < n; ++v) {
+    if (removed[v]) continue;
+    std::vector<std::uint32_t> read;
+    for_each_pair_of(v, [&](std::uint32_t p) {
+      if (pairs_[p].state != kDead) read.push_back(p);
+    });
+    if (sorted(read) != pairs[v])
+      throw std::logic_error("pair list out of step at vertex " + std::to_string(v));
+    if (survivor[v]) continue;
+    read.clear();
+    for (std::uint32_t f : vertex_faces_[v])
+      if (face_alive_[f]) read.push_back(f);
+    if (sorted(read) != faces[v])
+      throw std::logic_error("face list out of step at vertex " + std::to_string(v));
   }
 }
 
@@ -1064,8 +1123,9 @@ void Simplifier::mark_cut(std::uint32_t v) {
 }
 
 void Simplifier::mark_neighbours_near(std::uint32_t v) {
-  for (std::uint32_t r : vertex_pairs_[v])
+  for_each_pair_of(v, [&](std::uint32_t r) {
     if (pairs_[r].state != kDead) near_cut_[other_end(r, v)] = 1;
+  });
 }
 
 // After a contraction in the border group, whose survivor took over the other end's pairs: a pair
@@ -1073,12 +1133,12 @@ void Simplifier::mark_neighbours_near(std::uint32_t v) {
 // next to the cut (or on it) are marked near it. (Contractions inside a region change neither.)
 void Simplifier::update_cut_after(std::uint32_t a) {
   const std::uint32_t region = region_of(a);
-  for (std::uint32_t r : vertex_pairs_[a]) {
-    if (pairs_[r].state == kDead) continue;
+  for_each_pair_of(a, [&](std::uint32_t r) {
+    if (pairs_[r].state == kDead) return;
     const std::uint32_t o = other_end(r, a);
     if (region_of(o) != region) mark_cut(a), mark_cut(o);
     if (cut_[o]) near_cut_[a] = 1;
-  }
+  });
   if (cut_[a]) mark_neighbours_near(a);
 }
 
@@ -1087,19 +1147,16 @@ void Simplifier::update_cut_after(std::uint32_t a) {
 // or across region borders, each group in the band's order. A pair is inside its region when
 // neither end is on the cut or next to it. Everything its contraction reads or writes (the faces
 // and pairs of its ends, their neighbours' flags and pairs) is then within two steps of its ends,
-// so inside its region; and contractions inside a region never create a pair to another one, so
-// this stays true through the band. So the regions can be made at the same time on several
-// threads, with exactly the result of making them one after another. That is done unless the
-// band could reach the target (the run must stop at exactly the same contraction) or the
+// so inside its region (the vertex lists are only read during a pass); and contractions inside a
+// region never create a pair to another one, so this stays true through the band. So the regions can be made
+// at the same time on several threads, with exactly the result of making them one after another. That is done
+// unless the band could reach the target (the run must stop at exactly the same contraction) or the
 // contractions are recorded; then they are made one after another, in the same schedule.
 // Returns false if the caller cancelled.
 bool Simplifier::make_band(const std::uint32_t* band, std::size_t count) {
-  // Each pair to its region or to the border group. The arena stretches of a region get the
-  // most room its contractions' moved lists can take.
+  // Each pair to its region or to the border group.
   std::array<std::vector<std::uint32_t>, kRegions> inside;
   std::vector<std::uint32_t> border;
-  std::vector<std::size_t> face_room(kRegions, 0), pair_room(kRegions, 0);
-  std::vector<std::size_t> face_room_compacted(kRegions, 0), pair_room_compacted(kRegions, 0);
   std::size_t faces_at_stake = 0;
   for (std::size_t i = 0; i < count; ++i) {
     const std::uint32_t p = band[i], a = pairs_[p].v[0], b = pairs_[p].v[1];
@@ -1109,17 +1166,8 @@ bool Simplifier::make_band(const std::uint32_t* band, std::size_t count) {
       continue;
     }
     inside[region].push_back(p);
-    face_room[region] += vertex_faces_.growth_bound(a, b, true);
-    pair_room[region] += vertex_pairs_.growth_bound(a, b, true);
-    face_room_compacted[region] += vertex_faces_.growth_bound(a, b, false);
-    pair_room_compacted[region] += vertex_pairs_.growth_bound(a, b, false);
     faces_at_stake += vertex_faces_[a].size() + vertex_faces_[b].size();  // it removes only faces of its ends
   }
-  // The two arenas are independent: when they must be slid together, that is done side by side.
-  std::vector<VertexLists::Tail> face_tails, pair_tails;
-  side_by_side([&] { vertex_pairs_.carve(pair_room, pair_room_compacted, pair_tails); },
-               [&] { vertex_faces_.carve(face_room, face_room_compacted, face_tails); });
-
   // Disjoint stamp ranges (each contraction takes 3 stamps), so every stamp stays unique.
   std::array<std::uint32_t, kRegions> first_stamp;
   for (std::uint32_t r = 0; r < kRegions; ++r) {
@@ -1133,8 +1181,6 @@ bool Simplifier::make_band(const std::uint32_t* band, std::size_t count) {
   // Returns false if the caller cancelled.
   auto make_region = [&](std::uint32_t r, Worker& w, bool one_by_one) {
     w.stamp = first_stamp[r];
-    w.face_tail = &face_tails[r];
-    w.pair_tail = &pair_tails[r];
     const std::vector<std::uint32_t>& pairs = inside[r];
     for (std::size_t i = 0; i < pairs.size(); ++i) {
       if (one_by_one && done()) break;
@@ -1178,7 +1224,6 @@ bool Simplifier::make_band(const std::uint32_t* band, std::size_t count) {
     for (std::uint32_t r = 0; r < kRegions && go_on; ++r) go_on = make_region(r, main_, true);
     main_.stamp = stamp;
   }
-  main_.face_tail = main_.pair_tail = nullptr;
 
   // The border group, one by one.
   for (std::size_t i = 0; i < border.size() && go_on; ++i) {
@@ -1215,7 +1260,7 @@ SimplifyResult Simplifier::run() {
     result_.stop_detail = "the input already meets the target";
     return build_output();
   }
-  build_adjacency();
+  rebuild_face_lists();
   // The quadrics and the edges are independent: found side by side.
   std::vector<Edge> edges;
   side_by_side([this] { compute_quadrics(); }, [&] { edges = unique_edges(tri_, vertex_faces_, pos_.size()); });

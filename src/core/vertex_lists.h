@@ -1,7 +1,7 @@
 // Per-vertex lists (incident faces, valid pairs) in one flat arena, so the contraction loop never
-// allocates per element. A list that outgrows its slot moves to the end of the arena (or to a
-// stretch of it set aside for one thread, see carve) with room to grow; the old slot is abandoned,
-// and when the arena is full the lists are slid together again.
+// allocates per element. The lists are built in one go (rebuild: a counting sort); a list that
+// later outgrows its slot moves to the end of the arena with room to grow, the old slot is
+// abandoned, and when the arena is full the lists are slid together again.
 #pragma once
 
 #include <cstdint>
@@ -40,29 +40,29 @@ struct DefaultInitAllocator : std::allocator<T> {
 
 class VertexLists {
  public:
-  /// A stretch of the arena set aside for one thread's moved lists, so that threads working on
-  /// disjoint vertices can grow lists without touching shared state (see carve).
-  struct Tail {
-    std::uint32_t next = 0, end = 0;
-  };
-
-  /// Lays out one list per vertex with the given sizes (CSR); fill with push_initial.
-  void layout(const std::vector<std::uint32_t>& sizes) {
-    std::size_t n = sizes.size();
-    begin_.resize(n);
-    size_.assign(n, 0);
-    capacity_.resize(n);
+  /// Builds every list anew, in place: for_each_item(emit) must call emit(v, item) for every item
+  /// of every list, the same way both times it is called (once to count, once to fill). Each
+  /// list gets the items in the order emitted. The arena's memory is reused, so a rebuild of
+  /// fewer items touches no fresh page; the first build reserves a quarter more for lists that
+  /// grow later (assign).
+  template <class ForEachItem>
+  void rebuild(std::size_t vertex_count, ForEachItem for_each_item) {
+    size_.assign(vertex_count, 0);
+    for_each_item([&](std::uint32_t v, std::uint32_t) { ++size_[v]; });
+    begin_.resize(vertex_count);
+    capacity_.resize(vertex_count);
     std::size_t total = 0;
-    for (std::size_t v = 0; v < n; ++v) {
+    for (std::size_t v = 0; v < vertex_count; ++v) {
       begin_[v] = std::uint32_t(total);
-      capacity_[v] = sizes[v];
-      total += sizes[v];
+      capacity_[v] = size_[v];
+      total += size_[v];
+      size_[v] = 0;
     }
     if (total + total / 4 + 64 >= 0xffffffffu) throw std::length_error("vertex lists beyond 32-bit offsets");
-    data_.reserve(total + total / 4 + 64);
-    data_.assign(total, 0);
+    if (data_.capacity() < total) data_.reserve(total + total / 4 + 64);
+    data_.resize(total);
+    for_each_item([&](std::uint32_t v, std::uint32_t item) { data_[begin_[v] + size_[v]++] = item; });
   }
-  void push_initial(std::uint32_t v, std::uint32_t item) { data_[begin_[v] + size_[v]++] = item; }
 
   std::span<const std::uint32_t> operator[](std::uint32_t v) const { return {data_.data() + begin_[v], size_[v]}; }
   /// Hints the cache that the list of v is about to be read: its slot, or (once the slot is
@@ -75,63 +75,31 @@ class VertexLists {
 
   /// Replaces the list of v by items[0..n), which must not point into this arena. If it does not
   /// fit, it takes the slot of `donor` (a list being emptied, e.g. the contracted vertex) if that
-  /// is large enough, and only otherwise moves: to `tail` if given, else to the end of the arena.
-  void assign(std::uint32_t v, const std::uint32_t* items, std::size_t n, std::uint32_t donor,
-              Tail* tail = nullptr) {
+  /// is large enough, and only otherwise moves to the end of the arena.
+  void assign(std::uint32_t v, const std::uint32_t* items, std::size_t n, std::uint32_t donor) {
     if (n > capacity_[v] && n <= capacity_[donor]) {
       std::swap(begin_[v], begin_[donor]);
       std::swap(capacity_[v], capacity_[donor]);
       size_[donor] = 0;
     }
-    write(v, items, n, tail);
+    assign(v, items, n);
   }
-  void assign(std::uint32_t v, const std::uint32_t* items, std::size_t n) { write(v, items, n, nullptr); }
+  /// The same without a donor. A list that moves gets half as much room again to grow; when the
+  /// arena is full the lists are slid together first, so its memory stays at its first size.
+  void assign(std::uint32_t v, const std::uint32_t* items, std::size_t n) {
+    if (n > capacity_[v]) {
+      const std::size_t room = n + n / 2 + 2;
+      if (data_.size() + room > data_.capacity()) compact();
+      if (data_.size() + room >= 0xffffffffu) throw std::length_error("vertex lists beyond 32-bit offsets");
+      begin_[v] = std::uint32_t(data_.size());
+      data_.resize(data_.size() + room);
+      capacity_[v] = std::uint32_t(room);
+    }
+    std::uint32_t* dst = data_.data() + begin_[v];
+    for (std::size_t i = 0; i < n; ++i) dst[i] = items[i];
+    size_[v] = std::uint32_t(n);
+  }
   void clear(std::uint32_t v) { size_[v] = 0; }
-
-  /// The room a list of n items takes when it moves (assign), so callers can size a Tail.
-  static std::size_t room_for(std::size_t n) { return n + n / 2 + 2; }
-  /// The most room assign(v, ..., donor, tail) can take from a tail for a list built from the
-  /// items of v and donor (at most their two sizes together): with the capacities as they are
-  /// (`as_now`), or as they will be after compact() (which shrinks every capacity to its size).
-  std::size_t growth_bound(std::uint32_t v, std::uint32_t donor, bool as_now) const {
-    const std::size_t n = std::size_t(size_[v]) + size_[donor];
-    if (!as_now) return n > size_[v] && n > size_[donor] ? room_for(n) : 0;
-    return n > capacity_[v] && n > capacity_[donor] ? room_for(n) : 0;
-  }
-  /// Appends one stretch per entry of `now` to the arena and returns them in `tails`. The sizes
-  /// are growth bounds with the capacities as they are (`now`) and as they will be after
-  /// compact() (`compacted`): if the first do not fit, the lists are slid together and the
-  /// second are used.
-  void carve(const std::vector<std::size_t>& now, const std::vector<std::size_t>& compacted,
-             std::vector<Tail>& tails) {
-    std::size_t total = 0;
-    for (std::size_t s : now) total += s;
-    const std::vector<std::size_t>* sizes = &now;
-    if (data_.size() + total > data_.capacity()) {
-      compact();
-      sizes = &compacted;
-    }
-    total = 0;
-    for (std::size_t s : *sizes) total += s;
-    if (data_.size() + total >= 0xffffffffu) throw std::length_error("vertex lists beyond 32-bit offsets");
-    tails.resize(sizes->size());
-    for (std::size_t i = 0; i < sizes->size(); ++i) {
-      tails[i].next = std::uint32_t(data_.size());
-      data_.resize(data_.size() + (*sizes)[i]);
-      tails[i].end = std::uint32_t(data_.size());
-    }
-  }
-  /// Drops, from every list, the items for which keep(item) is false (order kept).
-  template <class Keep>
-  void filter(Keep keep) {
-    for (std::size_t v = 0; v < begin_.size(); ++v) {
-      std::uint32_t* items = data_.data() + begin_[v];
-      std::uint32_t kept = 0;
-      for (std::uint32_t i = 0; i < size_[v]; ++i)
-        if (keep(items[i])) items[kept++] = items[i];
-      size_[v] = kept;
-    }
-  }
 
   /// Moves every list down to close the gaps left by abandoned slots, in place, in arena order;
   /// each keeps exactly its size as capacity.
@@ -151,30 +119,6 @@ class VertexLists {
   }
 
  private:
-  // The list of v becomes items[0..n); if it does not fit its slot, it moves to new room with
-  // space to grow, taken from `tail` (sized by growth_bound: an overrun is a logic error) or from
-  // the end of the arena (sliding the lists together first if the arena is full, so its memory
-  // stays at its first size for the whole run).
-  void write(std::uint32_t v, const std::uint32_t* items, std::size_t n, Tail* tail) {
-    if (n > capacity_[v]) {
-      const std::uint32_t room = std::uint32_t(room_for(n));
-      if (tail) {
-        if (tail->end - tail->next < room) throw std::logic_error("vertex list tail too small");
-        begin_[v] = tail->next;
-        tail->next += room;
-      } else {
-        if (data_.size() + room > data_.capacity()) compact();
-        if (data_.size() + room >= 0xffffffffu) throw std::length_error("vertex lists beyond 32-bit offsets");
-        begin_[v] = std::uint32_t(data_.size());
-        data_.resize(data_.size() + room);
-      }
-      capacity_[v] = room;
-    }
-    std::uint32_t* dst = data_.data() + begin_[v];
-    for (std::size_t i = 0; i < n; ++i) dst[i] = items[i];
-    size_[v] = std::uint32_t(n);
-  }
-
   std::vector<std::uint32_t, DefaultInitAllocator<std::uint32_t>> data_;
   std::vector<std::uint32_t> begin_;
   std::vector<std::uint32_t> size_;
