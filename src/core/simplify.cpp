@@ -825,24 +825,30 @@ void Simplifier::renumber_densely() {
   const Numbering vertices = numbering(pos_.size(), [&](std::size_t v) { return used[v] != 0; });
   std::vector<std::uint8_t>().swap(used);
 
-  // Each numbering is freed once used: on large meshes this is the peak of the run's memory.
-  Numbering pairs = numbering(pairs_.size(), [&](std::size_t p) { return pairs_[p].state != kDead; });
-  for (PairRecord& r : pairs_)
-    if (r.state != kDead) r.v[0] = vertices.to[r.v[0]], r.v[1] = vertices.to[r.v[1]];
-  squeeze(pairs_, pairs.to, pairs.count);
-  squeeze(cost_, pairs.to, pairs.count);
-  squeeze(dirty_, pairs.to, pairs.count);
-  std::vector<std::uint32_t>().swap(pairs.to);
-
-  Numbering faces = numbering(face_alive_.size(), [&](std::size_t f) { return face_alive_[f] != 0; });
-  for (std::uint32_t f = 0; f < faces.to.size(); ++f) {
-    if (faces.to[f] == kGone) continue;
-    for (int k = 0; k < 3; ++k) tri_[3 * std::size_t(faces.to[f]) + k] = vertices.to[tri_[3 * std::size_t(f) + k]];
-    face_source_[faces.to[f]] = face_source_[f];
-  }
-  tri_.resize(3 * std::size_t(faces.count));
-  face_source_.resize(faces.count);
-  face_alive_.assign(faces.count, 1);
+  // Pairs and faces keep their order, so each one's new id is the count of survivors before it
+  // (nothing else refers to them: the vertex lists are rebuilt after this). Side by side.
+  auto squeeze_pairs = [&] {
+    std::size_t next = 0;
+    for (std::size_t p = 0; p < pairs_.size(); ++p) {
+      if (pairs_[p].state == kDead) continue;
+      PairRecord r = pairs_[p];
+      r.v[0] = vertices.to[r.v[0]], r.v[1] = vertices.to[r.v[1]];
+      pairs_[next] = r, cost_[next] = cost_[p], dirty_[next] = dirty_[p];
+      ++next;
+    }
+    pairs_.resize(next), cost_.resize(next), dirty_.resize(next);
+  };
+  auto squeeze_faces = [&] {
+    std::size_t next = 0;
+    for (std::size_t f = 0; f < face_alive_.size(); ++f) {
+      if (!face_alive_[f]) continue;
+      for (int k = 0; k < 3; ++k) tri_[3 * next + k] = vertices.to[tri_[3 * f + k]];
+      face_source_[next++] = face_source_[f];
+    }
+    tri_.resize(3 * next), face_source_.resize(next);
+    face_alive_.assign(next, 1);
+  };
+  side_by_side(squeeze_pairs, squeeze_faces);
 
   squeeze(pos_, vertices.to, vertices.count);
   squeeze(quadric_, vertices.to, vertices.count);
