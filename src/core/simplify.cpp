@@ -1154,10 +1154,11 @@ void Simplifier::update_cut_after(std::uint32_t a) {
 // neither end is on the cut or next to it. Everything its contraction reads or writes (the faces
 // and pairs of its ends, their neighbours' flags and pairs) is then within two steps of its ends,
 // so inside its region (the vertex lists are only read during a pass); and contractions inside a
-// region never create a pair to another one, so this stays true through the band. So the regions can be made
-// at the same time on several threads, with exactly the result of making them one after another. That is done
-// unless the band could reach the target (the run must stop at exactly the same contraction) or the
-// contractions are recorded; then they are made one after another, in the same schedule.
+// region never create a pair to another one, so this stays true through the band. So the regions
+// can be made at the same time on several threads, with exactly the result of making them one
+// after another. That is done unless the band could reach the target (the run must stop at
+// exactly the same contraction) or the contractions are recorded; then they are made one after
+// another, in the same schedule.
 // Returns false if the caller cancelled.
 bool Simplifier::make_band(const std::uint32_t* band, std::size_t count) {
   // Each pair to its region or to the border group.
