@@ -130,9 +130,10 @@ TEST(VertexLists, CompactionKeepsEveryListWhenTheArenaFills) {
 }
 
 // A pass writes no vertex list: a contraction renames its removed vertex in the faces and pairs,
-// and the survivor reads its own list and the removed vertex's. Checked after every band, on
-// several meshes and option sets, with one thread and with several (the simplifier throws if a
-// list as read differs from the mesh's own).
+// and the survivor reads its own list and the removed vertex's. Checked after every band and at
+// the end of the run (after a greedy tail, or the greedy order alone), on several meshes and
+// option sets, with one thread and with several (the simplifier throws if a list as read differs
+// from the mesh's own).
 TEST(ContractionOrder, ListsReadDuringAPassAreTheMeshsOwn) {
   struct Switch {
     Switch() { core::check_invariants = true; }
@@ -143,7 +144,7 @@ TEST(ContractionOrder, ListsReadDuringAPassAreTheMeshsOwn) {
   const Mesh terrain =
       test::height_field(40, [](double x, double y) { return 0.1 * std::sin(9 * x) * std::cos(7 * y); });
   for (const Mesh* in : {&two_spheres, &terrain}) {
-    for (int variant = 0; variant < 5; ++variant) {
+    for (int variant = 0; variant < 6; ++variant) {
       for (unsigned threads : {1u, 4u}) {
         SimplifyOptions o = scheme_options(Scheme::Passes, 40);
         o.threads = threads;
@@ -151,6 +152,7 @@ TEST(ContractionOrder, ListsReadDuringAPassAreTheMeshsOwn) {
         if (variant == 2) o.preserve_topology = false;
         if (variant == 3) o.threshold = 0.02, o.threshold_is_relative = true;
         if (variant == 4) o.lock_border = true, o.greedy_below_faces = 500;
+        if (variant == 5) o.scheme = Scheme::Greedy;
         SCOPED_TRACE("variant " + std::to_string(variant) + ", threads " + std::to_string(threads));
         SimplifyResult r;
         ASSERT_NO_THROW(r = simplify(*in, o));

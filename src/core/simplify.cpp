@@ -1061,9 +1061,10 @@ void Simplifier::run_passes() {
   }
 }
 
-// For the tests (core::check_invariants): every vertex's lists, as a pass reads them, hold exactly
-// its live faces and its pairs that are not dead. In a pass, a survivor's face list is never read
-// again (it is not contracted twice), and a removed vertex's lists are not read at all.
+// For the tests (core::check_invariants): every vertex's lists, as they are read, hold exactly its
+// live faces and its pairs that are not dead. In a pass, a survivor's face list is never read
+// again (it is not contracted twice), and a removed vertex's lists are not read at all; in the
+// greedy order every list is kept exact.
 void Simplifier::check_lists() const {
   const std::size_t n = pos_.size();
   std::vector<std::vector<std::uint32_t>> faces(n), pairs(n);
@@ -1277,6 +1278,7 @@ SimplifyResult Simplifier::run() {
   result_.stop_reason = StopReason::TargetReached;
   if (passes_) run_passes();
   else run_greedy();
+  if (check_invariants) check_lists();
   if (opt_.progress && result_.stop_reason != StopReason::Cancelled) opt_.progress(1.0);
 
   result_.rejected_topology = blocked_by_topology_;
