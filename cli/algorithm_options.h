@@ -28,7 +28,7 @@ struct AlgorithmArgs {
 
 /// Adds --threshold(-rel), --weighting, --placement, --scheme, --greedy-below, --threads,
 /// --boundary-weight, --lock-border, --inversion, --max-turn, --allow-non-manifold, --weld,
-/// --no-weld, --refit, --refit-rounds to `sub`.
+/// --no-weld, --refit, --refit-rounds, --refit-sample to `sub`.
 void add_algorithm_options(CLI::App* sub, AlgorithmArgs& args);
 
 /// The algorithm part of SimplifyOptions (stop criteria are left to the caller).

@@ -33,14 +33,12 @@ int run_simplify(const SimplifyArgs& a) {
     throw Error("give a target: --faces, --ratio, --vertices, --max-error or --max-error-rel");
   if (a.ratio < 0 || a.ratio > 1) throw Error("--ratio must be in (0, 1]");
   refuse_to_overwrite(a.input, a.output, a.force);
-  if (!a.record.empty() &&
-      (a.algorithm.refit || a.algorithm.refit_rounds > 0 || a.algorithm.refit_sample > 0))
+  SimplifyOptions opt = to_simplify_options(a.algorithm);
+  if (!a.record.empty() && opt.refit_rounds > 0)
     throw Error(
         "--record cannot be combined with --refit: a record replays the contractions, and the refit "
         "moves every vertex after them, so `qem replay` could not give back what simplify wrote; "
         "use `qem lod --refit`, or `qem refit` on a replayed level");
-
-  SimplifyOptions opt = to_simplify_options(a.algorithm);
   opt.target_faces = a.faces;
   opt.target_ratio = a.ratio;
   opt.target_vertices = a.vertices;

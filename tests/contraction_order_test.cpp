@@ -67,7 +67,7 @@ static void rebuild_from(core::VertexLists& lists, std::uint32_t n,
   });
 }
 
-TEST(VertexLists, RebuildGivesEachVertexItsItemsInOrderAndReusesTheArena) {
+TEST(VertexLists, RebuildGivesEachVertexItsItemsInOrderRoundAfterRound) {
   const std::uint32_t n = 300;
   std::mt19937 rng(5);
   core::VertexLists lists;

@@ -795,35 +795,17 @@ void Simplifier::recost_dirty_pairs() {
 // ids, the order of the rebuilt lists, output order), so the result is exactly the same. The
 // vertex lists are rebuilt after it.
 void Simplifier::renumber_densely() {
-  static constexpr std::uint32_t kGone = 0xffffffffu;
-  // Named members, not structured bindings: clang 14 (Debian 12, the fuzz
-  // build) cannot capture structured bindings in a lambda.
-  struct Numbering {
-    std::vector<std::uint32_t> to;
-    std::uint32_t count;
-  };
-  auto numbering = [](std::size_t n, auto keep) {
-    std::vector<std::uint32_t> to(n, kGone);
-    std::uint32_t next = 0;
-    for (std::size_t i = 0; i < n; ++i)
-      if (keep(i)) to[i] = next++;
-    return Numbering{std::move(to), next};
-  };
-  auto squeeze = [](auto& array, const std::vector<std::uint32_t>& to, std::uint32_t count) {
-    for (std::size_t i = 0; i < to.size(); ++i)
-      if (to[i] != kGone) array[to[i]] = array[i];
-    array.resize(count);
-  };
   // A vertex lives on while a live face or a pair that is not dead has it.
-  std::vector<std::uint8_t> used(pos_.size(), 0);
+  static constexpr std::uint32_t kGone = 0xffffffffu;
+  std::vector<std::uint32_t> vertex_to(pos_.size(), kGone);  // kGone, then 0: used, then the new id
   for (std::uint32_t f = 0; f < face_alive_.size(); ++f)
     if (face_alive_[f])
-      used[tri_[3 * std::size_t(f)]] = used[tri_[3 * std::size_t(f) + 1]] =
-          used[tri_[3 * std::size_t(f) + 2]] = 1;
+      for (int k = 0; k < 3; ++k) vertex_to[tri_[3 * std::size_t(f) + k]] = 0;
   for (const PairRecord& r : pairs_)
-    if (r.state != kDead) used[r.v[0]] = used[r.v[1]] = 1;
-  const Numbering vertices = numbering(pos_.size(), [&](std::size_t v) { return used[v] != 0; });
-  std::vector<std::uint8_t>().swap(used);
+    if (r.state != kDead) vertex_to[r.v[0]] = vertex_to[r.v[1]] = 0;
+  std::uint32_t vertex_count = 0;
+  for (std::uint32_t& to : vertex_to)
+    if (to != kGone) to = vertex_count++;
 
   // Pairs and faces keep their order, so each one's new id is the count of survivors before it
   // (nothing else refers to them: the vertex lists are rebuilt after this). Side by side.
@@ -832,7 +814,7 @@ void Simplifier::renumber_densely() {
     for (std::size_t p = 0; p < pairs_.size(); ++p) {
       if (pairs_[p].state == kDead) continue;
       PairRecord r = pairs_[p];
-      r.v[0] = vertices.to[r.v[0]], r.v[1] = vertices.to[r.v[1]];
+      r.v[0] = vertex_to[r.v[0]], r.v[1] = vertex_to[r.v[1]];
       pairs_[next] = r, cost_[next] = cost_[p], dirty_[next] = dirty_[p];
       ++next;
     }
@@ -842,7 +824,7 @@ void Simplifier::renumber_densely() {
     std::size_t next = 0;
     for (std::size_t f = 0; f < face_alive_.size(); ++f) {
       if (!face_alive_[f]) continue;
-      for (int k = 0; k < 3; ++k) tri_[3 * next + k] = vertices.to[tri_[3 * f + k]];
+      for (int k = 0; k < 3; ++k) tri_[3 * next + k] = vertex_to[tri_[3 * f + k]];
       face_source_[next++] = face_source_[f];
     }
     tri_.resize(3 * next), face_source_.resize(next);
@@ -850,15 +832,20 @@ void Simplifier::renumber_densely() {
   };
   side_by_side(squeeze_pairs, squeeze_faces);
 
-  squeeze(pos_, vertices.to, vertices.count);
-  squeeze(quadric_, vertices.to, vertices.count);
-  squeeze(boundary_, vertices.to, vertices.count);
-  squeeze(moved_, vertices.to, vertices.count);
-  squeeze(has_blocked_, vertices.to, vertices.count);
-  squeeze(aggregated_, vertices.to, vertices.count);
-  squeeze(source_vertex_, vertices.to, vertices.count);
-  squeeze(touched_in_pass_, vertices.to, vertices.count);
-  mark_.assign(vertices.count, 0);
+  auto squeeze = [&](auto& array) {
+    for (std::size_t i = 0; i < vertex_to.size(); ++i)
+      if (vertex_to[i] != kGone) array[vertex_to[i]] = array[i];
+    array.resize(vertex_count);
+  };
+  squeeze(pos_);
+  squeeze(quadric_);
+  squeeze(boundary_);
+  squeeze(moved_);
+  squeeze(has_blocked_);
+  squeeze(aggregated_);
+  squeeze(source_vertex_);
+  squeeze(touched_in_pass_);
+  mark_.assign(vertex_count, 0);
 }
 
 // ---------------------------------------------------------------------------------------------
