@@ -2,6 +2,8 @@
 
 #include <map>
 
+#include "qem/error.h"
+
 namespace qem::cli {
 
 void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
@@ -42,7 +44,13 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
   sub->add_flag("--no-weld", a.no_weld, "Never weld on load, not even STL");
   sub->add_flag("--refit", a.refit,
                 "After the last contraction, move the vertices to fit the input surface, faces fixed "
-                "(Hoppe et al. 1993; lowers the error at the same face count, see `qem refit --help`)");
+                "(Hoppe et al. 1993; lowers the error at the same face count, see `qem refit --help`), in " +
+                    std::to_string(RefitOptions{}.rounds) +
+                    " rounds and to every input vertex. Without any refit option, a light refit is made "
+                    "(--refit-rounds " +
+                    std::to_string(kDefaultRefitRounds) + " --refit-sample " +
+                    std::to_string(int(kDefaultRefitSample)) +
+                    ") when --placement is optimal; see --no-refit");
   sub->add_option("--refit-rounds", a.refit_rounds,
                   "Project-and-solve rounds of --refit (implies it; default " +
                       std::to_string(RefitOptions{}.rounds) + ")")
@@ -52,6 +60,8 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
                   "space-filling curve (implies --refit; 0 = all). 4-8 keep most of its gain; the time "
                   "saved grows with the input vertices per output vertex")
       ->check(CLI::Range(0.0, 1e6));
+  sub->add_flag("--no-refit", a.no_refit,
+                "No refit, not even the default's light one: every vertex stays where GH97 placed it");
 }
 
 SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
@@ -80,9 +90,15 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
   opt.max_normal_turn_degrees = a.max_turn;
   opt.lock_border = a.lock_border;
   opt.preserve_topology = !a.allow_non_manifold;
-  if (a.refit || a.refit_rounds > 0 || a.refit_sample > 0)
+  if (a.refit_asked() && a.no_refit)
+    throw Error("--no-refit cannot be combined with --refit, --refit-rounds or --refit-sample");
+  if (a.refit_asked()) {
     opt.refit_rounds = a.refit_rounds > 0 ? a.refit_rounds : RefitOptions{}.rounds;
-  opt.refit_points_per_vertex = a.refit_sample;
+    opt.refit_points_per_vertex = a.refit_sample;
+  } else if (!a.no_refit && opt.placement == Placement::Optimal) {
+    opt.refit_rounds = kDefaultRefitRounds;
+    opt.refit_points_per_vertex = kDefaultRefitSample;
+  }
   return opt;
 }
 

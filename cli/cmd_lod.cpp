@@ -2,7 +2,8 @@
 // a single run yields M_n ... M_g). The run goes to the coarsest level with a contraction record;
 // every level is then a prefix of that record, rebuilt in one pass, and each file is
 // byte-identical to `qem simplify INPUT FILE --faces <level target>` with the same options
-// (with --refit, each level is refitted to the input after it is rebuilt, as simplify does).
+// (with a refit, the default's light one or --refit's, each level is refitted to the input after
+// it is rebuilt, as simplify refits its output).
 // Writes the levels and a manifest.json that `qem view` shows as a chain with a slider.
 #include <algorithm>
 #include <cmath>
@@ -49,8 +50,8 @@ int run_lod(const LodArgs& a) {
   // One run to the coarsest level, recorded. Ratios are taken of the faces the run starts from
   // (degenerate and duplicate input faces dropped), exactly as `qem simplify --ratio` does.
   SimplifyOptions opt = to_simplify_options(a.algorithm);
-  // --refit: each level is refitted below, as `simplify --refit` refits its output; the run itself
-  // only records the contractions.
+  // A refit (the default's, or --refit's): each level is refitted below, as simplify refits its
+  // output; the run itself only records the contractions.
   const RefitOptions refit = refit_options(opt);
   opt.refit_rounds = 0;
   ContractionLog log;

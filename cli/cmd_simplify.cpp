@@ -34,11 +34,14 @@ int run_simplify(const SimplifyArgs& a) {
   if (a.ratio < 0 || a.ratio > 1) throw Error("--ratio must be in (0, 1]");
   refuse_to_overwrite(a.input, a.output, a.force);
   SimplifyOptions opt = to_simplify_options(a.algorithm);
-  if (!a.record.empty() && opt.refit_rounds > 0)
+  // A record replays the contractions, and a refit moves every vertex after them, so `qem replay`
+  // could not give back what simplify wrote: with --record there is no refit (not the default's).
+  if (!a.record.empty() && a.algorithm.refit_asked())
     throw Error(
         "--record cannot be combined with --refit: a record replays the contractions, and the refit "
         "moves every vertex after them, so `qem replay` could not give back what simplify wrote; "
         "use `qem lod --refit`, or `qem refit` on a replayed level");
+  if (!a.record.empty()) opt.refit_rounds = 0;
   opt.target_faces = a.faces;
   opt.target_ratio = a.ratio;
   opt.target_vertices = a.vertices;
@@ -127,9 +130,10 @@ const bool registered = register_command(10, [](CLI::App& app) {
   sub->add_flag("--json", args->json, "Print one JSON line with counts, timings, memory and error on stdout");
   sub->add_flag("--quiet,-q", args->quiet, "No progress and no summary on stderr");
   sub->add_flag("--force", args->force, "Allow the output to overwrite the input file");
-  sub->add_option("--record", args->record,
-                  "Also write the contraction sequence to this file, so `qem replay` / `qem lod` can rebuild "
-                  "any face count between the output's and the input's (docs/record-format.md)");
+  sub->add_option(
+      "--record", args->record,
+      "Also write the contraction sequence to this file, so `qem replay` / `qem lod` can rebuild "
+      "any face count between the output's and the input's (docs/record-format.md); no default refit then");
   return [args] { return run_simplify(*args); };
 });
 

@@ -263,6 +263,46 @@ TEST(Refit, SimplifyRefitsItsOutputWhenAsked) {
   EXPECT_EQ(consumed.mesh.positions, fitted.mesh.positions);
 }
 
+TEST(Refit, SimplifysWalkFromTheContractionMapFindsTheTreesFaces) {
+  // simplify's refit starts each input vertex's first search at the output vertex it was
+  // contracted into, where qem::refit asks a tree: the same faces, so the same bytes, whatever
+  // renamed the vertices on the way (renumbering between passes, chains of contractions in the
+  // greedy order, joins of separate parts, several threads). A wrong map would start searches on
+  // the wrong part of this two-part mesh.
+  const Mesh input =
+      test::concatenated(test::icosphere(5), test::transformed(test::height_field(40, waves), 1, 3, 0, 0));
+  struct Case {
+    const char* name;
+    Scheme scheme;
+    std::size_t greedy_below;
+    double threshold;
+    unsigned threads;
+    double sample;
+  };
+  for (const Case& c :
+       {Case{"passes", Scheme::Passes, 0, 0, 1, 0}, Case{"passes, 4 threads", Scheme::Passes, 0, 0, 4, 0},
+        Case{"greedy", Scheme::Greedy, 0, 0, 1, 0}, Case{"greedy tail", Scheme::Passes, 3000, 0, 2, 2},
+        Case{"joins", Scheme::Passes, 0, 0.05, 2, 0}, Case{"sampled", Scheme::Passes, 0, 0, 2, 2}}) {
+    SCOPED_TRACE(c.name);
+    SimplifyOptions o;
+    o.target_faces = 300;
+    o.scheme = c.scheme;
+    o.greedy_below_faces = c.greedy_below;
+    o.threshold = c.threshold;
+    o.threshold_is_relative = true;
+    o.threads = c.threads;
+    const SimplifyResult plain = simplify(input, o);
+    o.refit_rounds = 2;
+    o.refit_points_per_vertex = c.sample;
+    const SimplifyResult fitted = simplify(input, o);
+    Mesh expected = plain.mesh;
+    const RefitResult r = refit(input, expected, refit_options(o));
+    EXPECT_EQ(fitted.refit_rms_before, r.rms_before);
+    EXPECT_EQ(fitted.mesh.positions, expected.positions);
+    EXPECT_GT(fitted.refit_rounds, 0u);
+  }
+}
+
 TEST(Refit, ThinnedPointsKeepTheFrameAndTheTotalWeight) {
   const Mesh original = test::icosphere(3);
   const std::vector<double> weights = refit_detail::vertex_areas(original);
@@ -358,7 +398,7 @@ TEST(Refit, CliSimplifyRefitEqualsRefitCommandAndLodLevel) {
   save_mesh(in, test::concatenated(test::icosphere(4),
                                    test::transformed(test::height_field(20, waves), 1, 3, 0, 0)));
   ASSERT_EQ(run("simplify " + in + " " + dir + "/fitted.obj --faces 500 --refit"), 0);
-  ASSERT_EQ(run("simplify " + in + " " + dir + "/plain.obj --faces 500"), 0);
+  ASSERT_EQ(run("simplify " + in + " " + dir + "/plain.obj --faces 500 --no-refit"), 0);
   ASSERT_EQ(
       run("simplify " + in + " " + dir + "/json.obj --faces 500 --refit --json > " + dir + "/line.json"), 0);
   const std::string line = slurp(dir + "/line.json");
@@ -392,7 +432,7 @@ TEST(Refit, CliSampledRefitIsTheSameInSimplifyRefitAndLod) {
   save_mesh(in, test::icosphere(5));
   ASSERT_EQ(run("simplify " + in + " " + dir + "/sampled.obj --faces 400 --refit-sample 3"), 0);
   ASSERT_EQ(run("simplify " + in + " " + dir + "/full.obj --faces 400 --refit"), 0);
-  ASSERT_EQ(run("simplify " + in + " " + dir + "/plain.obj --faces 400"), 0);
+  ASSERT_EQ(run("simplify " + in + " " + dir + "/plain.obj --faces 400 --no-refit"), 0);
   ASSERT_EQ(run("refit " + in + " " + dir + "/plain.obj " + dir + "/refitted.obj --sample 3"), 0);
   ASSERT_EQ(run("lod " + in + " " + dir + "/lod --faces 400 --format obj --refit-sample 3"), 0);
   const std::string sampled = slurp(dir + "/sampled.obj");
@@ -405,6 +445,49 @@ TEST(Refit, CliSampledRefitIsTheSameInSimplifyRefitAndLod) {
   EXPECT_FALSE(std::filesystem::exists(dir + "/neg.obj"));
   EXPECT_NE(run("refit " + in + " " + dir + "/plain.obj " + dir + "/neg.obj --sample nan 2>/dev/null"), 0);
   EXPECT_FALSE(std::filesystem::exists(dir + "/neg.obj"));
+}
+
+TEST(Refit, CliDefaultIsALightRefitWithOptimalPlacementOnly) {
+  const std::string dir = test::temp_dir() + "/refit_default_cli";
+  std::filesystem::create_directories(dir);
+  const std::string in = dir + "/in.obj";
+  save_mesh(in, test::concatenated(test::icosphere(5),
+                                   test::transformed(test::height_field(20, waves), 1, 3, 0, 0)));
+  const auto made = [&](const std::string& name, const std::string& options) {
+    EXPECT_EQ(run("simplify " + in + " " + dir + "/" + name + " --faces 600 " + options), 0) << options;
+    return slurp(dir + "/" + name);
+  };
+  // The default is the light refit, and it lowers the fit's error.
+  const std::string fitted = made("default.obj", "");
+  EXPECT_FALSE(fitted.empty());
+  EXPECT_TRUE(fitted == made("light.obj", "--refit-rounds 1 --refit-sample 2"));
+  const std::string plain = made("plain.obj", "--no-refit");
+  EXPECT_NE(fitted, plain);
+  const SimplifyResult gh97 = [&] {
+    SimplifyOptions o;
+    o.target_faces = 600;
+    return simplify(load_mesh(in), o);
+  }();
+  EXPECT_TRUE(plain == [&] {
+    save_mesh(dir + "/library.obj", gh97.mesh);
+    return slurp(dir + "/library.obj");
+  }()) << "--no-refit differs from the library's default (GH97 as published)";
+  ASSERT_EQ(run("simplify " + in + " " + dir + "/j.obj --faces 600 --json > " + dir + "/line.json"), 0);
+  const std::string line = slurp(dir + "/line.json");
+  EXPECT_NE(line.find("\"refit_rounds\":1,"), std::string::npos) << line;
+  // Other placements keep their vertices where they put them: endpoints stay input vertices.
+  EXPECT_TRUE(made("ends.obj", "--placement endpoints") ==
+              made("ends_plain.obj", "--placement endpoints --no-refit"));
+  EXPECT_NE(made("ends_fit.obj", "--placement endpoints --refit-sample 2"),
+            made("ends2.obj", "--placement endpoints"));
+  // A record replays the contractions only, so --record turns the default refit off.
+  EXPECT_TRUE(made("rec.obj", "--record " + dir + "/run.qrec") == plain);
+  // The LOD chain refits its levels the same way.
+  ASSERT_EQ(run("lod " + in + " " + dir + "/lod --faces 600 --format obj"), 0);
+  EXPECT_TRUE(fitted == slurp(dir + "/lod/in_lod0.obj")) << "lod level differs from simplify";
+  // --no-refit with a refit option is a contradiction: refused, nothing written.
+  EXPECT_NE(run("simplify " + in + " " + dir + "/both.obj --faces 600 --no-refit --refit 2>/dev/null"), 0);
+  EXPECT_FALSE(std::filesystem::exists(dir + "/both.obj"));
 }
 
 }  // namespace

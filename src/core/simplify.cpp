@@ -104,6 +104,9 @@ class Simplifier {
   std::vector<std::uint32_t>* consumed_indices = nullptr;
   /// Filled with the input's vertex areas when a refit follows (see simplify_and_refit).
   std::vector<double>* refit_weights = nullptr;
+  /// Filled, when a refit follows, with the output vertex each input vertex was contracted into
+  /// (UINT32_MAX: none), where the refit's search for its closest face starts.
+  std::vector<std::uint32_t>* refit_map = nullptr;
 
   SimplifyResult run();
 
@@ -168,6 +171,7 @@ class Simplifier {
   void block(std::uint32_t p);
   void record_contraction(double error, const Worker& w);
   bool kill_if_coincident(std::uint32_t f, std::size_t own, Worker& w);
+  void follow_contractions(const std::vector<std::uint32_t>& to, std::size_t vertex_count);
   void unblock_around(std::uint32_t v);
   // Calls f(r) for every pair r in the list of v as it is now: in a pass, a vertex's stored list
   // is the one of the pass's start, and a survivor's pairs now are its own and those of the
@@ -256,6 +260,10 @@ class Simplifier {
   // is recorded here (kNoVertex: none), and it is never contracted again in the pass.
   static constexpr std::uint32_t kNoVertex = 0xffffffffu;
   std::vector<std::uint32_t> merged_from_;
+  // The contraction map, kept only for a refit (refit_map): per input vertex, the vertex it is part
+  // of now (kNoVertex: none), as of the last renumbering; per vertex, the one it was contracted
+  // into since then (kNoVertex: none). See follow_contractions.
+  std::vector<std::uint32_t> home_, absorbed_into_;
 
   // Stamps for set membership without clearing (one array, fresh stamp per query).
   std::vector<std::uint32_t> mark_;
@@ -690,6 +698,7 @@ void Simplifier::contract(std::uint32_t p, const Quadric& q, const Vec3& target,
   if (same(target, pos_[b]) && !same(target, pos_[a])) std::swap(a, b);
   moved_[a] |= !same(target, pos_[a]);
   w.last_kept = a, w.last_removed = b;
+  if (!absorbed_into_.empty()) absorbed_into_[b] = a;
   pos_[a] = target;
   quadric_[a] = q;
   boundary_[a] |= boundary_[b];
@@ -846,6 +855,24 @@ void Simplifier::renumber_densely() {
   squeeze(source_vertex_);
   squeeze(touched_in_pass_);
   mark_.assign(vertex_count, 0);
+  if (!home_.empty()) follow_contractions(vertex_to, vertex_count);
+}
+
+// The contraction map: each input vertex's home follows the contractions made since the last
+// renumbering (path halving keeps the chains of a greedy run short), then takes its new id from
+// `to` (kNoVertex: its vertex left the mesh).
+void Simplifier::follow_contractions(const std::vector<std::uint32_t>& to, std::size_t vertex_count) {
+  for (std::uint32_t& home : home_) {
+    if (home == kNoVertex) continue;
+    std::uint32_t v = home;
+    while (absorbed_into_[v] != kNoVertex) {
+      const std::uint32_t next = absorbed_into_[v];
+      if (absorbed_into_[next] != kNoVertex) absorbed_into_[v] = absorbed_into_[next];
+      v = next;
+    }
+    home = to[v];
+  }
+  absorbed_into_.assign(vertex_count, kNoVertex);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1239,6 +1266,13 @@ SimplifyResult Simplifier::run() {
   prepare_input();
   // The refit measures against the input's vertices weighted by area: taken before the faces go.
   if (opt_.refit_rounds > 0 && refit_weights) *refit_weights = refit_detail::vertex_areas(in_);
+  // It starts its search for each input vertex's closest output face at the vertex that input
+  // vertex was contracted into.
+  if (opt_.refit_rounds > 0 && refit_map) {
+    home_.assign(in_.vertex_count(), kNoVertex);
+    for (std::uint32_t v = 0; v < source_vertex_.size(); ++v) home_[source_vertex_[v]] = v;
+    absorbed_into_.assign(pos_.size(), kNoVertex);
+  }
   if (consumed_indices) {
     in_.indices = {};
     std::vector<std::uint32_t>().swap(*consumed_indices);
@@ -1315,6 +1349,10 @@ SimplifyResult Simplifier::build_output() {
   out.indices.reserve(3 * faces.size());
   for (std::uint32_t f : faces)
     for (int k = 0; k < 3; ++k) out.indices.push_back(remap[tri_[3 * f + k]]);
+  if (!home_.empty()) {
+    follow_contractions(remap, 0);
+    *refit_map = std::move(home_);
+  }
   return std::move(result_);
 }
 
@@ -1336,16 +1374,19 @@ namespace {
 SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options,
                                   std::vector<std::uint32_t>* consumed_indices) {
   std::vector<double> weights;
+  std::vector<std::uint32_t> output_vertex;  // of each input vertex
   SimplifyResult out;
   {
     Simplifier s(input, options);
     s.consumed_indices = consumed_indices;
     s.refit_weights = &weights;
+    s.refit_map = &output_vertex;
     out = s.run();
   }
   if (options.refit_rounds > 0 && out.contractions > 0 && out.stop_reason != StopReason::Cancelled) {
-    const RefitResult fit = refit_detail::refit_to_points(refit_detail::FitPoints(input.positions, weights),
-                                                          out.mesh, refit_options(options));
+    const refit_detail::FitPoints points(input.positions, weights);
+    const RefitResult fit =
+        refit_detail::refit_to_points(points, out.mesh, refit_options(options), output_vertex);
     out.refit_rms_before = fit.rms_before;
     out.refit_rms_after = fit.rms_after;
     out.refit_rounds = fit.rounds;

@@ -209,7 +209,7 @@ TriangleBvh::Hit TriangleBvh::search(const double p[3], double best, std::uint32
   stack[top++] = {0, box_d2(p, nodes_[0].lo, nodes_[0].hi)};
   while (top > 0) {
     const Entry e = stack[--top];
-    if (e.d2 >= best) continue;
+    if (e.d2 > best) continue;  // (not >=: a face as close but of a lower index wins the tie)
     const Node& node = nodes_[e.node];
     if (node.count > 0) {
       for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
@@ -217,7 +217,8 @@ TriangleBvh::Hit TriangleBvh::search(const double p[3], double best, std::uint32
         const Vec3 c =
             closest_point_on_triangle(q, {t[0], t[1], t[2]}, {t[3], t[4], t[5]}, {t[6], t[7], t[8]});
         const double d2 = squared_distance(q, c);
-        if (d2 < best) best = d2, best_tri = i;
+        if (d2 < best || (d2 == best && best_tri != UINT32_MAX && ids_[i] < ids_[best_tri]))
+          best = d2, best_tri = i;
       }
       continue;
     }
@@ -226,11 +227,11 @@ TriangleBvh::Hit TriangleBvh::search(const double p[3], double best, std::uint32
     const double dl = box_d2(p, l.lo, l.hi), dr = box_d2(p, r.lo, r.hi);
     // Push the farther child first so the nearer one is searched first and tightens `best`.
     if (dl <= dr) {
-      if (dr < best) stack[top++] = {node.first + 1, dr};
-      if (dl < best) stack[top++] = {node.first, dl};
+      if (dr <= best) stack[top++] = {node.first + 1, dr};
+      if (dl <= best) stack[top++] = {node.first, dl};
     } else {
-      if (dl < best) stack[top++] = {node.first, dl};
-      if (dr < best) stack[top++] = {node.first + 1, dr};
+      if (dl <= best) stack[top++] = {node.first, dl};
+      if (dr <= best) stack[top++] = {node.first + 1, dr};
     }
   }
   if (best_tri != UINT32_MAX) {

@@ -23,7 +23,8 @@ class TriangleBvh {
   /// `corners`: 9 doubles per triangle (a.xyz b.xyz c.xyz).
   explicit TriangleBvh(const std::vector<double>& corners);
 
-  /// The closest point of all triangles to `p`; none closer than sqrt(max_d2) -> Hit with d2 = inf.
+  /// The closest point of all triangles to `p` (of two as close, the one of lower index, so the
+  /// answer does not depend on the tree's layout); none closer than sqrt(max_d2) -> Hit with d2 = inf.
   Hit closest(const double p[3], double max_d2 = std::numeric_limits<double>::infinity()) const;
   /// Same, warm-started: the distance to triangle `*hint` (e.g. the previous query's answer, or
   /// UINT32_MAX for none) bounds the search from the start, which prunes most of the tree when

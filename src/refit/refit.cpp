@@ -5,7 +5,8 @@
 //   project   each original vertex p_i (weight w_i, its area share; with points_per_vertex, every
 //             k-th along the Morton order, carrying the area of its run of k) onto its closest
 //             approximation face t_i, at barycentric coordinates b_i: first a bounding volume
-//             hierarchy query, then (the moves of a round being small) the closest of the faces
+//             hierarchy query, or, after `simplify`, a walk from the output vertex the point was
+//             contracted into; then (the moves of a round being small) the closest of the faces
 //             around the corners of the point's face of the round before; on all threads over
 //             fixed chunks in Morton order (the answer does not depend on the threads);
 //   solve     min over X of  sum_i w_i |b_i . X(t_i) - p_i|^2            (the fit)
@@ -13,15 +14,14 @@
 //                            + lambda sum_v |D_v|^2                          (a small anchor),
 //             a sparse symmetric positive definite system (one per coordinate, same matrix): the
 //             fit is a finite-element mass matrix, well conditioned, so conjugate gradients with a
-//             diagonal preconditioner converge in a few dozen steps. Hoppe's spring term pulls on
-//             the positions, which shrinks curved surfaces; the membrane here pulls on the
-//             displacement, so it only keeps neighbours moving together (no vertex jumps off alone
-//             to fit a few points), and the anchor holds vertices no point reaches;
+//             diagonal preconditioner converge in a dozen steps, the three coordinates together.
+//             Hoppe's spring term pulls on the positions, which shrinks curved surfaces; the
+//             membrane here pulls on the displacement, so it only keeps neighbours moving together
+//             (no vertex jumps off alone to fit a few points), and the anchor holds vertices no
+//             point reaches;
 //   guard     a face whose normal turned by more than the limit undoes its vertices' moves, until
 //             none does (GH97 §6: the refit never folds the surface);
 //   keep      the round only if the fit's error went down; else undo it and stop.
-#include <Eigen/IterativeLinearSolvers>
-#include <Eigen/Sparse>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -108,7 +108,8 @@ FitPoints::FitPoints(std::span<const double> points, std::span<const double> wei
     weight[j] = weights[used[j]];
     total_weight += weight[j];
   }
-  order = core::morton_order(used.size(), [&](std::size_t j) {
+  source = std::move(used);
+  order = core::morton_order(source.size(), [&](std::size_t j) {
     return core::Vec3(position[3 * j], position[3 * j + 1], position[3 * j + 2]);
   });
 }
@@ -125,6 +126,7 @@ FitPoints FitPoints::thinned(std::size_t group) const {
     const std::uint32_t middle = order[begin + (end - begin) / 2];
     out.position.insert(out.position.end(), &position[3 * middle], &position[3 * middle] + 3);
     out.weight.push_back(w);
+    out.source.push_back(source[middle]);
     out.order.push_back(std::uint32_t(out.order.size()));  // runs follow the Morton order
     out.total_weight += w;
   }
@@ -133,13 +135,82 @@ FitPoints FitPoints::thinned(std::size_t group) const {
 
 namespace {
 
+/// The refit's normal equations: a symmetric sparse matrix by rows (compressed), each row's
+/// columns in increasing order.
+struct SparseRows {
+  std::vector<std::uint32_t> start{0}, column;
+  std::vector<double> value, diagonal;
+};
+
+/// y = a x for the three coordinates at once (x, y: 3 per vertex): each row of a read once.
+void multiply(const SparseRows& a, const std::vector<double>& x, std::vector<double>& y) {
+  const std::size_t n = a.diagonal.size();
+  for (std::size_t v = 0; v < n; ++v) {
+    double sum[3] = {0, 0, 0};
+    for (std::uint32_t e = a.start[v]; e < a.start[v + 1]; ++e) {
+      const double* xc = &x[3 * std::size_t(a.column[e])];
+      for (int k = 0; k < 3; ++k) sum[k] += a.value[e] * xc[k];
+    }
+    for (int k = 0; k < 3; ++k) y[3 * v + k] = sum[k];
+  }
+}
+
+/// Solves a x = b for the three coordinates at once, from the x given: conjugate gradients with a
+/// diagonal preconditioner, each coordinate to a residual of kTolerance |b| (then it stops
+/// moving). Eigen's solver takes one right-hand side at a time and so reads the matrix three times
+/// a step; this reads it once (docs/benchmarks.md, "The light refit made the default").
+void conjugate_gradients(const SparseRows& a, const std::vector<double>& b, std::vector<double>& x) {
+  constexpr double kTolerance = 1e-10;
+  constexpr int kMaxSteps = 1000;
+  const std::size_t n = a.diagonal.size();
+  std::vector<double> r(3 * n), z(3 * n), p(3 * n), q(3 * n);
+  double limit[3] = {0, 0, 0}, rz[3] = {0, 0, 0}, rr[3] = {0, 0, 0};
+  multiply(a, x, q);
+  for (std::size_t v = 0; v < n; ++v)
+    for (int k = 0; k < 3; ++k) {
+      const std::size_t i = 3 * v + k;
+      limit[k] += b[i] * b[i];
+      r[i] = b[i] - q[i];
+      z[i] = p[i] = r[i] / a.diagonal[v];
+      rz[k] += r[i] * z[i], rr[k] += r[i] * r[i];
+    }
+  for (double& l : limit) l *= kTolerance * kTolerance;
+  for (int step = 0; step < kMaxSteps; ++step) {
+    bool moving[3], any = false;
+    for (int k = 0; k < 3; ++k) any |= moving[k] = rr[k] > limit[k];
+    if (!any) break;
+    multiply(a, p, q);
+    double pq[3] = {0, 0, 0};
+    for (std::size_t i = 0; i < 3 * n; ++i) pq[i % 3] += p[i] * q[i];
+    double alpha[3];
+    for (int k = 0; k < 3; ++k) alpha[k] = moving[k] && pq[k] > 0 ? rz[k] / pq[k] : 0.0;
+    double rz_next[3] = {0, 0, 0};
+    rr[0] = rr[1] = rr[2] = 0;
+    for (std::size_t v = 0; v < n; ++v)
+      for (int k = 0; k < 3; ++k) {
+        const std::size_t i = 3 * v + k;
+        x[i] += alpha[k] * p[i];
+        r[i] -= alpha[k] * q[i];
+        z[i] = r[i] / a.diagonal[v];
+        rz_next[k] += r[i] * z[i], rr[k] += r[i] * r[i];
+      }
+    for (int k = 0; k < 3; ++k) {
+      const double beta = rz[k] > 0 ? rz_next[k] / rz[k] : 0.0;
+      rz[k] = rz_next[k];
+      for (std::size_t v = 0; v < n; ++v) p[3 * v + k] = z[3 * v + k] + beta * p[3 * v + k];
+    }
+  }
+}
+
 class Refitter {
  public:
-  Refitter(const FitPoints& points, Mesh& approx, const RefitOptions& o)
+  Refitter(const FitPoints& points, Mesh& approx, const RefitOptions& o,
+           std::span<const std::uint32_t> near_vertex)
       : approx_(approx),
         opt_(o),
         tri_(approx.indices),
         pts_(points),
+        near_vertex_(near_vertex),
         centre_(points.centre),
         diag_(points.diag) {
     if (pts_.weight.empty() || approx.indices.empty()) return;
@@ -152,8 +223,12 @@ class Refitter {
     for (std::uint32_t v : tri_) ++ring_start_[v + 1];
     for (std::size_t v = 0; v < approx.vertex_count(); ++v) ring_start_[v + 1] += ring_start_[v];
     ring_faces_.resize(tri_.size());
+    ring_slot_.resize(tri_.size());
     std::vector<std::uint32_t> fill(ring_start_.begin(), ring_start_.end() - 1);
-    for (std::size_t c = 0; c < tri_.size(); ++c) ring_faces_[fill[tri_[c]]++] = std::uint32_t(c / 3);
+    for (std::size_t c = 0; c < tri_.size(); ++c) {
+      ring_slot_[c] = fill[tri_[c]]++;
+      ring_faces_[ring_slot_[c]] = std::uint32_t(c / 3);
+    }
     ready_ = true;
   }
 
@@ -200,14 +275,17 @@ class Refitter {
   }
 
   // Where each point lands on the approximation with vertices x. The first projection asks a tree
-  // of all faces. Later ones (`before`: the round before, whose moves are small) look only at the
+  // of all faces, or, given a vertex near each point (the one `simplify` contracted it into),
+  // walks from a face around that vertex to the closest face around the corners of the closest so
+  // far. Later ones (`before`: the round before, whose moves are small) look only at the
   // faces around the corners of the point's closest face of then: a fixed set, searched whole, so
-  // the answer is the closest of them (a walk from face to face would stop at a local minimum that
-  // rounding chooses between). A point that had no closest face asks the tree.
+  // the answer is the closest of them. A point with neither asks the tree.
   Projection project(const std::vector<double>& x, const Projection* before = nullptr) const {
     const std::size_t count = pts_.weight.size();
-    bool need_tree = before == nullptr;
-    for (std::size_t j = 0; j < count && !need_tree; ++j) need_tree = before->nearest[j] == UINT32_MAX;
+    // Where the search for point j starts: the round before's closest face, or the vertex given near j.
+    const auto start = [&](std::uint32_t j) { return before ? before->nearest[j] : vertex_near(j); };
+    bool need_tree = false;
+    for (std::size_t j = 0; j < count && !need_tree; ++j) need_tree = start(std::uint32_t(j)) == UINT32_MAX;
     measure_detail::TriangleBvh tree;
     if (need_tree) {
       std::vector<double> corners(3 * tri_.size());
@@ -216,7 +294,7 @@ class Refitter {
       tree = measure_detail::TriangleBvh(corners);
     }
     std::vector<double> spheres;  // per face: centre and radius, to skip far faces in closest_around
-    if (before) spheres = bounding_spheres(x);
+    if (before || !near_vertex_.empty()) spheres = bounding_spheres(x);
     Projection p;
     p.nearest.assign(count, UINT32_MAX);
     p.face.assign(count, UINT32_MAX);
@@ -228,9 +306,10 @@ class Refitter {
                        for (std::size_t k = begin; k < end; ++k) {
                          const std::uint32_t j = pts_.order[k];
                          const double* q = &pts_.position[3 * j];
-                         const std::uint32_t was = before ? before->nearest[j] : UINT32_MAX;
-                         const auto hit =
-                             was != UINT32_MAX ? closest_around(x, spheres, q, was) : tree.closest(q, &hint);
+                         const std::uint32_t from = start(j);
+                         const auto hit = from == UINT32_MAX ? tree.closest(q, &hint)
+                                          : before           ? closest_around(x, spheres, q, from)
+                                                             : closest_by_walk(x, spheres, q, from);
                          if (hit.triangle == UINT32_MAX) continue;
                          p.nearest[j] = hit.triangle;
                          d2[j] = hit.d2;  // counted in the error even when the face cannot pull
@@ -280,7 +359,7 @@ class Refitter {
       const std::uint32_t* t = &tri_[3 * std::size_t(g)];
       const Vec3 c = measure_detail::closest_point_on_triangle(point, at(x, t[0]), at(x, t[1]), at(x, t[2]));
       const double d2 = measure_detail::squared_distance(point, c);
-      if (!(d2 < hit.d2)) return;
+      if (!(d2 < hit.d2 || (d2 == hit.d2 && g < hit.triangle))) return;  // ties: the lowest face, as the tree
       hit.d2 = d2, hit.triangle = g, hit.point[0] = c.x, hit.point[1] = c.y, hit.point[2] = c.z;
       reach = std::sqrt(d2);
     };
@@ -300,11 +379,50 @@ class Refitter {
     return hit;
   }
 
+  // The vertex given near point j, if it has a face; else UINT32_MAX.
+  std::uint32_t vertex_near(std::uint32_t j) const {
+    const std::uint32_t source = pts_.source[j];
+    if (source >= near_vertex_.size()) return UINT32_MAX;
+    const std::uint32_t v = near_vertex_[source];
+    if (v >= approx_.vertex_count() || ring_start_[v] == ring_start_[v + 1]) return UINT32_MAX;
+    return v;
+  }
+
+  // From the face around v whose centre is nearest q, to the closest face around the corners of
+  // the closest face so far, until that stays (each step only gets closer, or as close and of a
+  // lower index: the face it starts from is among those tested). The input vertices contracted
+  // into v lie on its faces or their neighbours', so the walk is a step or two; the cap only
+  // bounds a pathological case. It ends in a local minimum: the tree's answer unless a closer face
+  // lies beyond a farther one (never, on the benchmark meshes: docs/benchmarks.md).
+  measure_detail::TriangleBvh::Hit closest_by_walk(const std::vector<double>& x,
+                                                   const std::vector<double>& spheres, const double* q,
+                                                   std::uint32_t v) const {
+    std::uint32_t f = UINT32_MAX;
+    double nearest = HUGE_VAL;
+    for (std::uint32_t i = ring_start_[v]; i < ring_start_[v + 1]; ++i) {
+      const std::uint32_t g = ring_faces_[i];
+      const double* s = &spheres[4 * std::size_t(g)];
+      const double d2 = measure_detail::squared_distance({q[0], q[1], q[2]}, {s[0], s[1], s[2]});
+      if (d2 < nearest) nearest = d2, f = g;
+    }
+    auto hit = closest_around(x, spheres, q, f);
+    for (int step = 0; step < 64 && hit.triangle != f && hit.triangle != UINT32_MAX; ++step) {
+      f = hit.triangle;
+      hit = closest_around(x, spheres, q, f);
+    }
+    return hit;
+  }
+
   // The least squares problem of one round, for all three coordinates at once (same matrix).
   bool solve(const Projection& proj, std::vector<double>& next) const {
     const std::size_t n = approx_.vertex_count(), nf = tri_.size() / 3;
-    // Per face, the 3x3 block sum_i w_i b_i b_i^T; per vertex, sum_i w_i b_i p_i.
+    // Per face, the 3x3 block sum_i w_i b_i b_i^T, each corner's row stored at the corner's place
+    // in its vertex's ring (so that the matrix below reads them in order); per vertex,
+    // sum_i w_i b_i p_i.
     std::vector<double> block(9 * nf, 0.0), rhs(3 * n, 0.0), data(n, 0.0);
+    const auto block_row = [&](std::size_t f, int r) {
+      return &block[3 * std::size_t(ring_slot_[3 * f + r])];
+    };
     for (std::size_t j = 0; j < pts_.weight.size(); ++j) {
       const std::uint32_t f = proj.face[j];
       if (f == UINT32_MAX) continue;
@@ -312,7 +430,8 @@ class Refitter {
       const double w = pts_.weight[j];
       for (int r = 0; r < 3; ++r) {
         const std::uint32_t v = tri_[3 * std::size_t(f) + r];
-        for (int c = 0; c < 3; ++c) block[9 * f + 3 * r + c] += w * b[r] * b[c];
+        double* row = block_row(f, r);
+        for (int c = 0; c < 3; ++c) row[c] += w * b[r] * b[c];
         for (int k = 0; k < 3; ++k) rhs[3 * v + k] += w * b[r] * pts_.position[3 * j + k];
         data[v] += w * b[r] * b[r];
       }
@@ -331,52 +450,53 @@ class Refitter {
       for (int r = 0; r < 3; ++r) {
         const int c = (r + 1) % 3;
         const std::uint32_t vr = tri_[3 * f + r], vc = tri_[3 * f + c];
-        block[9 * f + 3 * r + r] += kappa, block[9 * f + 3 * c + c] += kappa;
-        block[9 * f + 3 * r + c] -= kappa, block[9 * f + 3 * c + r] -= kappa;
+        block_row(f, r)[r] += kappa, block_row(f, c)[c] += kappa;
+        block_row(f, r)[c] -= kappa, block_row(f, c)[r] -= kappa;
         for (int k = 0; k < 3; ++k) {
           const double d = x_[3 * vr + k] - x_[3 * vc + k];
           rhs[3 * vr + k] += kappa * d, rhs[3 * vc + k] -= kappa * d;
         }
       }
-    // Fixed vertices are eliminated: their row is the identity, their column moves to the rhs.
-    std::vector<Eigen::Triplet<double>> entries;
-    entries.reserve(9 * nf + n);
-    for (std::size_t f = 0; f < nf; ++f)
-      for (int r = 0; r < 3; ++r) {
-        const std::uint32_t vr = tri_[3 * f + r];
-        if (fixed_[vr]) continue;
+    // The matrix, row by row: for each face around the row's vertex (in the ring's order: by
+    // face), that vertex's row of the face's block. Fixed vertices are eliminated: their row is
+    // the identity, their column moves to the rhs.
+    SparseRows a;
+    a.column.reserve(8 * n), a.value.reserve(8 * n), a.diagonal.resize(n), a.start.reserve(n + 1);
+    std::vector<std::uint32_t> slot(n, UINT32_MAX);  // where a column is in the row being made
+    std::vector<std::pair<std::uint32_t, double>> row;
+    std::vector<double> b(3 * n);
+    for (std::uint32_t v = 0; v < n; ++v) {
+      row.clear();
+      const auto add = [&](std::uint32_t c, double value) {
+        if (slot[c] == UINT32_MAX) slot[c] = std::uint32_t(row.size()), row.emplace_back(c, 0.0);
+        row[slot[c]].second += value;
+      };
+      for (std::uint32_t i = ring_start_[v]; i < ring_start_[v + 1] && !fixed_[v]; ++i) {
+        const std::uint32_t* t = &tri_[3 * std::size_t(ring_faces_[i])];
         for (int c = 0; c < 3; ++c) {
-          const std::uint32_t vc = tri_[3 * f + c];
-          const double a = block[9 * f + 3 * r + c];
-          if (a == 0) continue;
-          if (fixed_[vc])
-            for (int k = 0; k < 3; ++k) rhs[3 * vr + k] -= a * x_[3 * vc + k];
+          const double entry = block[3 * std::size_t(i) + c];
+          if (entry == 0) continue;
+          if (fixed_[t[c]])
+            for (int k = 0; k < 3; ++k) rhs[3 * v + k] -= entry * x_[3 * t[c] + k];
           else
-            entries.emplace_back(int(vr), int(vc), a);
+            add(t[c], entry);
         }
       }
-    Eigen::MatrixXd b(n, 3), guess(n, 3);
-    for (std::size_t v = 0; v < n; ++v) {
       // Vertices without data stay put (their row is lambda X = lambda X_old at full weight).
       const double lambda = fixed_[v] ? 1.0 : data[v] > 0 ? kAnchor * mean : mean;
-      entries.emplace_back(int(v), int(v), lambda);
-      for (int k = 0; k < 3; ++k) {
-        b(Eigen::Index(v), k) = fixed_[v] ? x_[3 * v + k] : rhs[3 * v + k] + lambda * x_[3 * v + k];
-        guess(Eigen::Index(v), k) = x_[3 * v + k];
+      add(v, lambda);
+      for (const auto& [c, value] : row) slot[c] = UINT32_MAX;
+      std::sort(row.begin(), row.end());
+      for (const auto& [c, value] : row) {
+        a.column.push_back(c), a.value.push_back(value);
+        if (c == v) a.diagonal[v] = value;
       }
+      a.start.push_back(std::uint32_t(a.column.size()));
+      for (int k = 0; k < 3; ++k)
+        b[3 * v + k] = fixed_[v] ? x_[3 * v + k] : rhs[3 * v + k] + lambda * x_[3 * v + k];
     }
-    Eigen::SparseMatrix<double> a{Eigen::Index(n), Eigen::Index(n)};
-    a.setFromTriplets(entries.begin(), entries.end());  // sums the duplicates
-    Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> cg;
-    cg.setTolerance(1e-10);
-    cg.setMaxIterations(1000);
-    cg.compute(a);
-    if (cg.info() != Eigen::Success) return false;
-    next.assign(3 * n, 0.0);
-    for (int k = 0; k < 3; ++k) {
-      const Eigen::VectorXd col = cg.solveWithGuess(b.col(k), guess.col(k));
-      for (std::size_t v = 0; v < n; ++v) next[3 * v + k] = col(Eigen::Index(v));
-    }
+    next = x_;  // the guess: where the vertices are
+    conjugate_gradients(a, b, next);
     for (std::size_t v = 0; v < n; ++v)
       for (int k = 0; k < 3; ++k)
         if (fixed_[v] || !std::isfinite(next[3 * v + k])) next[3 * v + k] = x_[3 * v + k];
@@ -411,11 +531,13 @@ class Refitter {
   const RefitOptions& opt_;
   const std::vector<std::uint32_t>& tri_;
   const FitPoints& pts_;
+  std::span<const std::uint32_t> near_vertex_;
   const double* centre_;
   double diag_;
   std::vector<double> x_;             // approximation vertices, normalised
   std::vector<std::uint8_t> fixed_;
   std::vector<std::uint32_t> ring_start_, ring_faces_;  // faces around each vertex
+  std::vector<std::uint32_t> ring_slot_;  // per corner of a face: its place in its vertex's ring
   bool ready_ = false;
 };
 
@@ -444,14 +566,15 @@ void check_options(const RefitOptions& options) {
     throw Error("refit: the points per vertex must be 0 (all) or a positive number");
 }
 
-RefitResult refit_to_points(const FitPoints& points, Mesh& approx, const RefitOptions& options) {
+RefitResult refit_to_points(const FitPoints& points, Mesh& approx, const RefitOptions& options,
+                            std::span<const std::uint32_t> near_vertex) {
   // points_per_vertex: one point for each run of `group` (fewer than one point wanted: one run).
   const double wanted = options.points_per_vertex * double(approx.vertex_count());
   const std::size_t n = points.weight.size();
   std::size_t group = 0;  // 0 or 1: every point
   if (wanted > 0) group = wanted <= 1 ? n : std::size_t(double(n) / wanted);
   const FitPoints sample = group >= 2 ? points.thinned(group) : FitPoints{};
-  Refitter refitter(group >= 2 ? sample : points, approx, options);
+  Refitter refitter(group >= 2 ? sample : points, approx, options, near_vertex);
   return refitter.run();
 }
 

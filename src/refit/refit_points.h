@@ -28,6 +28,7 @@ struct FitPoints {
   std::vector<double> position;      ///< 3 per kept point, normalised
   std::vector<double> weight;        ///< one per kept point
   std::vector<std::uint32_t> order;  ///< Morton order of the kept points (warm-started queries)
+  std::vector<std::uint32_t> source;  ///< index of each kept point among the points given
   double centre[3] = {0, 0, 0};      ///< the frame: centre and diagonal of the kept points' box
   double diag = 0;
   double total_weight = 0;
@@ -37,7 +38,10 @@ struct FitPoints {
 void check_options(const RefitOptions& options);
 
 /// Refits `approx` (a mesh that has passed check_mesh; the options checked by the caller) to the
-/// points.
-RefitResult refit_to_points(const FitPoints& points, Mesh& approx, const RefitOptions& options);
+/// points. `near_vertex` (optional), per point given to FitPoints: a vertex of `approx` near it
+/// (UINT32_MAX: none), such as the output vertex `simplify` contracted it into; the first search
+/// for its closest face walks from there instead of asking a tree of all faces.
+RefitResult refit_to_points(const FitPoints& points, Mesh& approx, const RefitOptions& options,
+                            std::span<const std::uint32_t> near_vertex = {});
 
 }  // namespace qem::refit_detail
