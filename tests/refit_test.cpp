@@ -457,7 +457,7 @@ TEST(Refit, CliDefaultIsALightRefitWithOptimalPlacementOnly) {
     EXPECT_EQ(run("simplify " + in + " " + dir + "/" + name + " --faces 600 " + options), 0) << options;
     return slurp(dir + "/" + name);
   };
-  // The default is the light refit, and it lowers the fit's error.
+  // The default is the light refit (below: it lowers the fit's error).
   const std::string fitted = made("default.obj", "");
   EXPECT_FALSE(fitted.empty());
   EXPECT_TRUE(fitted == made("light.obj", "--refit-rounds 1 --refit-sample 2"));
@@ -475,6 +475,11 @@ TEST(Refit, CliDefaultIsALightRefitWithOptimalPlacementOnly) {
   ASSERT_EQ(run("simplify " + in + " " + dir + "/j.obj --faces 600 --json > " + dir + "/line.json"), 0);
   const std::string line = slurp(dir + "/line.json");
   EXPECT_NE(line.find("\"refit_rounds\":1,"), std::string::npos) << line;
+  const auto number_after = [&](const std::string& key) {
+    const std::size_t at = line.find("\"" + key + "\":");
+    return at == std::string::npos ? NAN : std::stod(line.substr(at + key.size() + 3));
+  };
+  EXPECT_LT(number_after("refit_rms_after"), number_after("refit_rms_before")) << line;
   // Other placements keep their vertices where they put them: endpoints stay input vertices.
   EXPECT_TRUE(made("ends.obj", "--placement endpoints") ==
               made("ends_plain.obj", "--placement endpoints --no-refit"));
