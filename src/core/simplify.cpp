@@ -805,8 +805,8 @@ void Simplifier::recost_dirty_pairs() {
 // vertex lists are rebuilt after it.
 void Simplifier::renumber_densely() {
   // A vertex lives on while a live face or a pair that is not dead has it.
-  static constexpr std::uint32_t kGone = 0xffffffffu;
-  std::vector<std::uint32_t> vertex_to(pos_.size(), kGone);  // kGone, then 0: used, then the new id
+  // kNoVertex (gone), then 0 (used), then the new id; follow_contractions reads kNoVertex as gone.
+  std::vector<std::uint32_t> vertex_to(pos_.size(), kNoVertex);
   for (std::uint32_t f = 0; f < face_alive_.size(); ++f)
     if (face_alive_[f])
       for (int k = 0; k < 3; ++k) vertex_to[tri_[3 * std::size_t(f) + k]] = 0;
@@ -814,7 +814,7 @@ void Simplifier::renumber_densely() {
     if (r.state != kDead) vertex_to[r.v[0]] = vertex_to[r.v[1]] = 0;
   std::uint32_t vertex_count = 0;
   for (std::uint32_t& to : vertex_to)
-    if (to != kGone) to = vertex_count++;
+    if (to != kNoVertex) to = vertex_count++;
 
   // Pairs and faces keep their order, so each one's new id is the count of survivors before it
   // (nothing else refers to them: the vertex lists are rebuilt after this). Side by side.
@@ -843,7 +843,7 @@ void Simplifier::renumber_densely() {
 
   auto squeeze = [&](auto& array) {
     for (std::size_t i = 0; i < vertex_to.size(); ++i)
-      if (vertex_to[i] != kGone) array[vertex_to[i]] = array[i];
+      if (vertex_to[i] != kNoVertex) array[vertex_to[i]] = array[i];
     array.resize(vertex_count);
   };
   squeeze(pos_);
@@ -1338,7 +1338,7 @@ SimplifyResult Simplifier::build_output() {
     if (used[v]) survivors.push_back(v);
   std::sort(survivors.begin(), survivors.end(),
             [&](std::uint32_t x, std::uint32_t y) { return source_vertex_[x] < source_vertex_[y]; });
-  std::vector<std::uint32_t> remap(n, 0xffffffffu);
+  std::vector<std::uint32_t> remap(n, kNoVertex);  // kNoVertex: dropped
   Mesh& out = result_.mesh;
   out.positions.reserve(3 * survivors.size());
   for (std::uint32_t v : survivors) {
