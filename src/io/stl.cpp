@@ -39,7 +39,7 @@ class CornerSink {
     mesh_.positions.reserve(3 * (weld ? expected_triangles / 2 + 16 : 3 * expected_triangles));
     mesh_.indices.reserve(3 * expected_triangles);
   }
-  void prefetch(double x, double y, double z) const {
+  [[gnu::always_inline]] void prefetch(double x, double y, double z) const {  // see VertexWelder::prefetch
     if (weld_) welder_.prefetch(x, y, z);
   }
   std::uint32_t add(double x, double y, double z) {
