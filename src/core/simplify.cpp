@@ -932,7 +932,7 @@ void Simplifier::absorb(Worker& w) {
 
 // The contractions of a pass are known in advance, so the memory they will touch is requested a
 // few contractions ahead, in stages (a pair's ends must be in cache before their data can be
-// located): the loop then waits far less on memory. Always inlined, or GCC deletes the calls (see
+// located): the loop then waits far less on memory. Always inlined, or GCC drops them (see
 // core::VertexLists::prefetch_slot): 8-13 % of the run on the 1.3M sphere (docs/benchmarks.md).
 [[gnu::always_inline]] inline void Simplifier::prefetch_for_contraction(const std::uint32_t* pairs,
                                                                         std::size_t count,
@@ -955,7 +955,7 @@ void Simplifier::absorb(Worker& w) {
     }
   }
   // Last, the records the checks and contract() read through those lists: the pairs and faces
-  // around both ends (with this stage, 3-5 % less time on the sphere to 10 %).
+  // around both ends (this stage: 3 % less time on the sphere to 10 %, none measurable to 1 %).
   if (i + kNeighbours < count) {
     for (std::uint32_t v : pairs_[pairs[i + kNeighbours]].v) {
       for (std::uint32_t r : vertex_pairs_[v]) __builtin_prefetch(&pairs_[r]);

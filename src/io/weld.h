@@ -41,7 +41,7 @@ class VertexWelder {
   std::size_t size() const { return pos_.size() / 3; }
   /// Starts loading the table slot of (x, y, z): the lookups are random accesses into a table
   /// larger than the caches, so readers prefetch a few vertices ahead of add(). Always inlined,
-  /// or GCC deletes the calls (see core::VertexLists::prefetch_slot).
+  /// or GCC drops the prefetch (see core::VertexLists::prefetch_slot).
   [[gnu::always_inline]] void prefetch(double x, double y, double z) const {
     __builtin_prefetch(&table_[hash(bits(x), bits(y), bits(z)) & (table_.size() - 1)]);
   }
