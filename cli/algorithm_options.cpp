@@ -3,6 +3,7 @@
 #include <map>
 
 #include "qem/error.h"
+#include "qem/refit.h"
 
 namespace qem::cli {
 

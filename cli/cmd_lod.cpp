@@ -21,6 +21,7 @@
 #include "qem/io.h"
 #include "qem/progressive.h"
 #include "qem/refit.h"
+#include "refit/refit_after_simplify.h"
 #include "qem/simplify.h"
 
 namespace qem::cli {
@@ -52,19 +53,18 @@ int run_lod(const LodArgs& a) {
   SimplifyOptions opt = to_simplify_options(a.algorithm);
   // A refit (the default's, or --refit's): each level is refitted below, as simplify refits its
   // output; the run itself only records the contractions.
-  const RefitOptions refit = refit_options(opt);
+  const RefitOptions refit = refit_options_for(opt);
   opt.refit_rounds = 0;
-  ContractionLog log;
-  opt.record = &log;
+  ContractionRecorder recorder;
   if (!a.faces.empty())
     opt.target_faces = *std::min_element(a.faces.begin(), a.faces.end());
   else
     opt.target_ratio = *std::min_element(a.ratios.begin(), a.ratios.end());
   const double cpu_simplify0 = process_cpu_seconds();
-  const SimplifyResult result = simplify(mesh, opt);
+  const SimplifyResult result = simplify(mesh, opt, &recorder);
   const double simplify_cpu = process_cpu_seconds() - cpu_simplify0;
   const double cpu_replay0 = process_cpu_seconds();
-  const Record record = make_record(mesh, log);
+  const Record record = make_record(mesh, recorder.log);
   std::vector<std::size_t> targets = a.faces;
   for (double r : a.ratios) targets.push_back(std::size_t(std::floor(r * double(record.base.face_count()))));
   std::sort(targets.begin(), targets.end(), std::greater<>());  // finest first, as the manifest lists them

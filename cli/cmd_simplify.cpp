@@ -28,6 +28,23 @@ struct SimplifyArgs {
   std::string record;  // --record: the contraction sequence (docs/record-format.md)
 };
 
+// Shows the progress on a terminal and, with --record, keeps the contractions.
+class Watcher : public ContractionRecorder {
+ public:
+  Watcher(bool show_progress, bool record) : show_progress_(show_progress), record_(record) {}
+  bool wants_contractions() const override { return record_; }
+  bool on_progress(double fraction) override {
+    if (show_progress_) {
+      std::fprintf(stderr, "\rqem: simplifying %5.1f%%", 100 * fraction);
+      std::fflush(stderr);
+    }
+    return true;
+  }
+
+ private:
+  bool show_progress_, record_;
+};
+
 int run_simplify(const SimplifyArgs& a) {
   if (a.faces == 0 && a.ratio == 0 && a.vertices == 0 && a.max_error < 0 && a.max_error_rel < 0)
     throw Error("give a target: --faces, --ratio, --vertices, --max-error or --max-error-rel");
@@ -49,12 +66,6 @@ int run_simplify(const SimplifyArgs& a) {
   if (a.max_error_rel >= 0) opt.max_error = a.max_error_rel, opt.max_error_is_relative = true;
 
   const bool show_progress = !a.quiet && !a.json && ::isatty(STDERR_FILENO);
-  if (show_progress)
-    opt.progress = [](double f) {
-      std::fprintf(stderr, "\rqem: simplifying %5.1f%%", 100 * f);
-      std::fflush(stderr);
-      return true;
-    };
 
   Stopwatch total;
   LoadOptions load = to_load_options(a.algorithm);
@@ -65,11 +76,10 @@ int run_simplify(const SimplifyArgs& a) {
 
   Stopwatch t_simplify;
   const double cpu0 = process_cpu_seconds();
-  ContractionLog log;
-  if (!a.record.empty()) opt.record = &log;
+  Watcher watcher(show_progress, !a.record.empty());
   const std::size_t in_faces = mesh.face_count();
   // Without a record the input's faces are not needed afterwards: let the simplifier free them.
-  SimplifyResult r = a.record.empty() ? simplify(std::move(mesh), opt) : simplify(mesh, opt);
+  SimplifyResult r = a.record.empty() ? simplify(std::move(mesh), opt, &watcher) : simplify(mesh, opt, &watcher);
   const double simplify_s = t_simplify.seconds();
   const double simplify_cpu_s = process_cpu_seconds() - cpu0;
   if (show_progress) std::fprintf(stderr, "\n");
@@ -80,7 +90,7 @@ int run_simplify(const SimplifyArgs& a) {
   save.double_precision = a.double_values || report.double_precision;
   save_mesh(a.output, r.mesh, save);
   if (!a.record.empty()) {  // written atomically, like the mesh
-    Record record = make_record(mesh, log);
+    Record record = make_record(mesh, watcher.log);
     record.double_input = report.double_precision;  // so that replay writes what simplify wrote
     write_record(a.record, record);
   }

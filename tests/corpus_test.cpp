@@ -62,10 +62,10 @@ TEST_P(Corpus, SimplifiesCleanlyAtEveryTarget) {
     o.threshold = c.threshold_rel;
     o.threshold_is_relative = true;
     const auto start = std::chrono::steady_clock::now();
-    o.progress = [&](double) {  // the per-run time limit: a hang becomes a cancelled run
+    ProgressCallback time_limit([&](double) {  // a hang becomes a cancelled run
       return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < kSecondsPerRun;
-    };
-    SimplifyResult r = simplify(in, o);
+    });
+    SimplifyResult r = simplify(in, o, &time_limit);
     ASSERT_NE(r.stop_reason, StopReason::Cancelled) << "took longer than " << kSecondsPerRun << " s";
     EXPECT_EQ(test::validity_problem(r.mesh), "");
     const std::size_t target = c.faces > 0 ? c.faces : std::size_t(c.ratio * double(r.input_faces));

@@ -148,11 +148,10 @@ void check_mesh(const std::string& mesh_name, const Mesh& mesh) {
   std::map<std::string, std::string> golden = read_golden();
   for (const Config& c : configs(mesh.face_count())) {
     SimplifyOptions o = c.options;
-    ContractionLog log;
-    if (c.record) o.record = &log;
-    const SimplifyResult r = simplify(MeshView(mesh), o);
+    ContractionRecorder recorder;
+    const SimplifyResult r = simplify(MeshView(mesh), o, c.record ? &recorder : nullptr);
     const std::string key = mesh_name + ":" + c.name;
-    const std::string sum = checksum(r, c.record ? &log : nullptr);
+    const std::string sum = checksum(r, c.record ? &recorder.log : nullptr);
     if (write) {
       golden[key] = sum;
       continue;

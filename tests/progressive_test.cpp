@@ -72,8 +72,10 @@ SimplifyResult simplify_to(const Mesh& m, const std::function<void(SimplifyOptio
   SimplifyOptions o;
   set(o);
   o.target_faces = faces;
-  o.record = log;
-  return simplify(m, o);
+  ContractionRecorder recorder;
+  SimplifyResult r = simplify(m, o, log ? &recorder : nullptr);
+  if (log) *log = std::move(recorder.log);
+  return r;
 }
 
 // --- replay == simplify ----------------------------------------------------------------------

@@ -19,6 +19,7 @@
 #include "qem/io.h"
 #include "qem/measure.h"
 #include "qem/simplify.h"
+#include "refit/refit_after_simplify.h"
 #include "refit/refit_points.h"
 #include "test_meshes.h"
 
@@ -251,7 +252,7 @@ TEST(Refit, SimplifyRefitsItsOutputWhenAsked) {
   o.refit_rounds = 2;
   const SimplifyResult fitted = simplify(input, o);
   Mesh expected = plain.mesh;
-  const RefitResult r = refit(input, expected, refit_options(o));
+  const RefitResult r = refit(input, expected, refit_options_for(o));
   EXPECT_EQ(fitted.mesh.positions, expected.positions);
   EXPECT_EQ(fitted.mesh.indices, plain.mesh.indices);
   EXPECT_EQ(fitted.refit_rms_before, r.rms_before);
@@ -296,7 +297,7 @@ TEST(Refit, SimplifysWalkFromTheContractionMapFindsTheTreesFaces) {
     o.refit_points_per_vertex = c.sample;
     const SimplifyResult fitted = simplify(input, o);
     Mesh expected = plain.mesh;
-    const RefitResult r = refit(input, expected, refit_options(o));
+    const RefitResult r = refit(input, expected, refit_options_for(o));
     EXPECT_EQ(fitted.refit_rms_before, r.rms_before);
     EXPECT_EQ(fitted.mesh.positions, expected.positions);
     EXPECT_GT(fitted.refit_rounds, 0u);

@@ -364,11 +364,11 @@ TEST_P(Simplify, ProgressRisesToOneAndCancelStops) {
   SimplifyOptions o = faces(2000);
   o.greedy_below_faces = 20000;  // under Passes: passes, then the greedy tail, as by default
   std::vector<double> seen;
-  o.progress = [&](double f) {
+  ProgressCallback watch([&](double f) {
     seen.push_back(f);
     return true;
-  };
-  SimplifyResult r = simplify(in, o);
+  });
+  SimplifyResult r = simplify(in, o, &watch);
   ASSERT_GE(seen.size(), 3u);
   EXPECT_EQ(seen.back(), 1.0);
   for (std::size_t i = 1; i < seen.size(); ++i) {
@@ -378,8 +378,8 @@ TEST_P(Simplify, ProgressRisesToOneAndCancelStops) {
   EXPECT_EQ(r.stop_reason, StopReason::TargetReached);
 
   int calls = 0;
-  o.progress = [&](double) { return ++calls < 3; };
-  SimplifyResult cancelled = simplify(in, o);
+  ProgressCallback cancel([&](double) { return ++calls < 3; });
+  SimplifyResult cancelled = simplify(in, o, &cancel);
   EXPECT_EQ(cancelled.stop_reason, StopReason::Cancelled);
   EXPECT_GT(cancelled.mesh.face_count(), 2000u);
   EXPECT_EQ(validity_problem(cancelled.mesh), "");

@@ -6,11 +6,11 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "qem/mesh.h"
-#include "qem/refit.h"
 
 namespace qem {
 
@@ -105,27 +105,22 @@ struct SimplifyOptions {
   /// After the last contraction, refit the vertices to the input surface with the faces fixed
   /// (qem/refit.h, Hoppe et al. 1993) in up to this many rounds; 0 = off (GH97 as published).
   /// Lowers the geometric error at the same face count; `lock_border` and
-  /// `max_normal_turn_degrees` apply to it too. The record (if any) holds the contractions only:
-  /// a replayed level is the unrefitted mesh (refit it with qem::refit to match). The command
-  /// line's default is a light refit, refit_rounds = 1 with refit_points_per_vertex = 2, which
-  /// puts E under the best peer's on the benchmark meshes for 11-14 % of the run's time on the
-  /// 1.3M-face sphere to 10 % (about 0.2 s), 3 % to 1 %.
+  /// `max_normal_turn_degrees` apply to it too. An observer's contractions are those made
+  /// before it: a replayed level is the unrefitted mesh (refit it with qem::refit to match). The
+  /// command line's default is a light refit, refit_rounds = 1 with refit_points_per_vertex = 2
+  /// (what it costs and gains: docs/benchmarks.md).
   unsigned refit_rounds = 0;
   /// The refit's input points per output vertex, 0 = every input vertex (RefitOptions::
-  /// points_per_vertex). 4-8 keep most of the refit's gain; the time saved grows with the input's
-  /// vertices per output vertex (docs/benchmarks.md).
+  /// points_per_vertex): the time saved grows with the input's vertices per output vertex.
   double refit_points_per_vertex = 0;
 
-  /// If set, every contraction is appended to this log (cleared first).
-  ContractionLog* record = nullptr;
-
-  /// Called every so often with the fraction done (0..1); return false to cancel.
-  std::function<bool(double)> progress;
+  /// Fill SimplifyResult::output_vertex_of_input (one entry per input vertex).
+  bool map_input_vertices = false;
 };
 
 struct SimplifyResult {
   Mesh mesh;                        ///< the approximation; unreferenced vertices dropped
-  std::size_t input_faces = 0;      ///< after dropping degenerate input faces
+  std::size_t input_faces = 0;      ///< after dropping degenerate and duplicate input faces
   std::size_t input_vertices = 0;   ///< referenced vertices of the input
   std::size_t contractions = 0;
   std::size_t virtual_pairs = 0;    ///< non-edge pairs found with the threshold t
@@ -139,22 +134,73 @@ struct SimplifyResult {
   /// those it sampled) to the output, before and after it (model units), and the rounds it kept.
   double refit_rms_before = 0, refit_rms_after = 0;
   std::size_t refit_rounds = 0;
+  /// Input faces left out: degenerate (a repeated corner) and duplicates (kept once).
+  std::size_t dropped_degenerate_faces = 0, dropped_duplicate_faces = 0;
+
+  /// Provenance, so that callers can carry their own per-vertex and per-face data across: for
+  /// each output vertex, the input vertex whose position it started from (the survivor of its
+  /// contractions); for each output face, the input face it is.
+  std::vector<std::uint32_t> vertex_source, face_source;
+  /// With SimplifyOptions::map_input_vertices: for each input vertex, the output vertex it was
+  /// contracted into, kUnmapped for unreferenced vertices and for parts that vanished.
+  std::vector<std::uint32_t> output_vertex_of_input;
+  static constexpr std::uint32_t kUnmapped = 0xffffffffu;
 };
 
-/// The refit options `simplify` uses for `options` (qem/refit.h): the same rounds, points per
-/// vertex, border lock, face turn limit and threads. `qem lod` refits each level with them, as
-/// `simplify` would.
-RefitOptions refit_options(const SimplifyOptions& options);
+/// One contraction as it is made: input vertex `removed` went into input vertex `kept`, which now
+/// stands at `position` (output coordinates), at `error` (distance units); `dead_faces` are the
+/// input faces that died with it.
+struct Contraction {
+  std::uint32_t kept, removed;
+  double position[3];
+  double error;
+  std::span<const std::uint32_t> dead_faces;
+};
+
+/// Watches a run, as CGAL's edge-collapse visitor does: told when it starts, of each contraction,
+/// and of its progress, which it may cancel. Every method does nothing by default.
+class SimplifyObserver {
+ public:
+  virtual ~SimplifyObserver() = default;
+  /// Whether on_contraction is wanted. The contractions are then made one after another on the
+  /// calling thread (the output is the same bytes), so say yes only when needed.
+  virtual bool wants_contractions() const { return false; }
+  /// The input faces the run starts from (degenerate and duplicate ones left out), in no order.
+  virtual void on_start(std::span<const std::uint32_t> /*input_faces*/) {}
+  virtual void on_contraction(const Contraction& /*contraction*/) {}
+  /// Called every few thousand contractions with the fraction done (0..1, 1 at the end); return
+  /// false to cancel the run (the result is the mesh so far, StopReason::Cancelled).
+  virtual bool on_progress(double /*fraction*/) { return true; }
+};
+
+/// Keeps the whole contraction sequence in `log` (qem/progressive.h makes records of it).
+class ContractionRecorder : public SimplifyObserver {
+ public:
+  ContractionLog log;
+  bool wants_contractions() const override { return true; }
+  void on_start(std::span<const std::uint32_t> input_faces) override;
+  void on_contraction(const Contraction& contraction) override;
+};
+
+/// Calls a function with the fraction done; it returns false to cancel.
+class ProgressCallback : public SimplifyObserver {
+ public:
+  explicit ProgressCallback(std::function<bool(double)> fn) : fn_(std::move(fn)) {}
+  bool on_progress(double fraction) override { return fn_(fraction); }
+
+ private:
+  std::function<bool(double)> fn_;
+};
 
 /// Simplifies a mesh. Input positions are never normalised in the output: vertices that did not
 /// move keep their exact input coordinates. Deterministic: the same input and options give the
-/// same output. Throws qem::Error on invalid options, an out-of-range index or a
-/// non-finite coordinate.
-SimplifyResult simplify(MeshView input, const SimplifyOptions& options);
+/// same output. `observer` (may be null) watches the run. Throws qem::Error on invalid options,
+/// an out-of-range index or a non-finite coordinate.
+SimplifyResult simplify(MeshView input, const SimplifyOptions& options, SimplifyObserver* observer = nullptr);
 
 /// The same, consuming the input: its index array is released (left empty) as soon as the
 /// simplifier holds its own copy of the faces, which lowers the peak memory on large meshes.
 /// The positions are kept: unmoved vertices are copied from them at the end.
-SimplifyResult simplify(Mesh&& input, const SimplifyOptions& options);
+SimplifyResult simplify(Mesh&& input, const SimplifyOptions& options, SimplifyObserver* observer = nullptr);
 
 }  // namespace qem

@@ -1,11 +1,14 @@
 // Work split into fixed-size chunks on std::threads. The chunks do not depend on the thread count,
 // so anything computed per chunk (a warm-started query run, a partial sum combined in chunk order)
-// is bit-identical for any number of threads. Used by the error metric and the refit.
+// is bit-identical for any number of threads. The one thread helper of the library.
 #pragma once
 
 #include <algorithm>
 #include <atomic>
 #include <cstddef>
+#include <exception>
+#include <future>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -17,20 +20,47 @@ inline unsigned resolve_threads(unsigned requested) {
 }
 
 /// Calls fn(chunk, begin, end) for the chunks [c * chunk_size, (c + 1) * chunk_size) of [0, n) on
-/// `threads` threads, the calling thread among them.
+/// up to `threads` threads, the calling thread among them. If no more threads can be had, the
+/// ones there take the rest (same result); the first exception thrown by fn is rethrown here.
 template <class Fn>
 void for_chunks(std::size_t n, std::size_t chunk_size, unsigned threads, Fn&& fn) {
+  threads = std::max(1u, threads);
   const std::size_t chunks = (n + chunk_size - 1) / chunk_size;
   std::atomic<std::size_t> next{0};
-  auto work = [&] {
-    for (std::size_t c; (c = next.fetch_add(1)) < chunks;)
-      fn(c, c * chunk_size, std::min(n, (c + 1) * chunk_size));
+  std::vector<std::exception_ptr> failures(std::max(1u, threads));
+  auto work = [&](unsigned t) {
+    try {
+      for (std::size_t c; (c = next.fetch_add(1)) < chunks;)
+        fn(c, c * chunk_size, std::min(n, (c + 1) * chunk_size));
+    } catch (...) {
+      failures[t] = std::current_exception();
+      next = chunks;  // the others stop at their next chunk
+    }
   };
   const unsigned extra = unsigned(std::min<std::size_t>(threads, chunks)) - (chunks > 0 ? 1 : 0);
   std::vector<std::thread> pool;
-  for (unsigned t = 0; t < extra; ++t) pool.emplace_back(work);
-  work();
+  try {
+    for (unsigned t = 0; t < extra; ++t) pool.emplace_back(work, t + 1);
+  } catch (const std::system_error&) {
+  }
+  work(0);
   for (std::thread& t : pool) t.join();
+  for (const std::exception_ptr& failure : failures)
+    if (failure) std::rethrow_exception(failure);
+}
+
+/// Two independent pieces of work: side by side when there are threads (the first on a helper
+/// thread), else one after the other. Either way the result is the same.
+template <class First, class Second>
+void side_by_side(unsigned threads, First first, Second second) {
+  if (threads < 2) {
+    first();
+    second();
+    return;
+  }
+  std::future<void> first_done = std::async(std::launch::async, first);
+  second();
+  first_done.get();
 }
 
 }  // namespace qem::core

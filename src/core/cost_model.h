@@ -1,0 +1,56 @@
+// The cost of contracting a pair and where its new vertex goes (GH97 §4): Q = Q_a + Q_b,
+// placed by the chosen policy, cost Q(position), honouring --lock-border and --inversion penalize.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+#include "core/collapse_checks.h"
+#include "core/context.h"
+#include "core/placement.h"
+
+namespace qem::core {
+
+/// Heap and ranking keys are floats (24 significant bits). The same model scaled or moved gives
+/// costs that differ only by rounding noise (~1e-16 relative); rounded to float they tie, ties
+/// break on the pair id, and the contraction order (and so the output) does not depend on the
+/// model's scale or position. It also halves the memory the orders sort and sift.
+inline double round_key(double cost) { return double(float(cost)); }
+
+/// A quadric error as a distance: sqrt(Q / total plane weight), the weighted RMS distance to the
+/// planes it stands for.
+inline double normalized_error(double q_error, double weight) {
+  return weight > 0 ? std::sqrt(q_error / weight) : std::sqrt(q_error);
+}
+
+/// The quadric and placement of pair p. False if the pair can never move (both ends on a locked
+/// border); with one end there, that end is the placement.
+inline bool place_pair(const Context& c, std::uint32_t p, Quadric& q, Placed& placed) {
+  const std::uint32_t a = c.pairs.pairs[p].v[0], b = c.pairs.pairs[p].v[1];
+  const WorkingMesh& m = c.mesh;
+  q = c.quadric[a] + c.quadric[b];
+  if (c.settings.lock_border && (m.boundary[a] || m.boundary[b])) {
+    if (m.boundary[a] && m.boundary[b]) return false;
+    const Vec3& fixed = m.boundary[a] ? m.pos[a] : m.pos[b];
+    placed = {fixed, q.evaluate(fixed)};
+    return true;
+  }
+  placed = place(q, m.pos[a], m.pos[b], c.settings.placement);
+  return true;
+}
+
+/// The ranking key of pair p: the quadric error at its placement, plus, when inversions are
+/// penalised and it would flip a face, a penalty that sorts it after every clean contraction.
+inline bool pair_cost(const Context& c, std::uint32_t p, double& cost) {
+  Quadric q;
+  Placed placed;
+  if (!place_pair(c, p, q, placed)) return false;
+  cost = placed.error;
+  if (c.settings.inversion == InversionPolicy::Penalize &&
+      flips(c.mesh, c.pairs.pairs[p].v[0], c.pairs.pairs[p].v[1], placed.position, c.settings.cos_max_turn))
+    cost += q.weight > 0 ? q.weight : 1;  // as if moved by a whole diagonal
+  cost = round_key(cost);
+  return true;
+}
+
+}  // namespace qem::core

@@ -1,0 +1,26 @@
+// The quadrics every vertex starts with: the fundamental error quadrics of its faces' planes
+// (GH97 §5), weighted (HG99 §2), plus the constraint planes of its border edges (GH97 §6).
+#pragma once
+
+#include <vector>
+
+#include "core/quadric.h"
+#include "core/valid_pairs.h"
+#include "core/working_mesh.h"
+#include "qem/simplify.h"
+
+namespace qem::core {
+
+/// Per vertex, the sum of the plane quadrics K_p of its faces, weighted by area (HG99 §2: the
+/// quadric integrates squared distance over the surface), uniformly (GH97 §5) or by corner angle.
+/// Zero-area faces have no plane and add nothing.
+std::vector<Quadric> face_quadrics(const WorkingMesh& mesh, Weighting weighting);
+
+/// GH97 §6: marks the ends of every border edge (`edges`: unique_edges, with face counts) and, when
+/// `weight` > 0, adds to both ends the plane through the edge perpendicular to its face, weighted
+/// by weight x edge length² under area weighting (so it keeps its proportion to the faces' quadrics
+/// at every resolution and scale), else by weight.
+void add_boundary_planes(WorkingMesh& mesh, const std::vector<Edge>& edges, double weight, Weighting weighting,
+                         std::vector<Quadric>& quadrics);
+
+}  // namespace qem::core

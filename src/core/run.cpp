@@ -1,0 +1,85 @@
+#include "core/run.h"
+
+#include <algorithm>
+#include <optional>
+
+#include "core/context.h"
+#include "core/fundamental_quadrics.h"
+#include "core/order_greedy.h"
+#include "core/order_passes.h"
+#include "core/pair_set.h"
+#include "core/parallel_chunks.h"
+#include "core/settings.h"
+#include "core/valid_pairs.h"
+#include "core/working_mesh.h"
+
+namespace qem::core {
+
+namespace {
+
+// The mesh with what the contractions left of it, and the maps the caller asked for.
+void finish(Context& c, std::optional<ContractionMap>& map, MeshView input, SimplifyResult& result) {
+  std::vector<std::uint32_t> output_index;
+  result.mesh = build_output(c.mesh, input, &result.vertex_source, &result.face_source,
+                             map ? &output_index : nullptr);
+  if (map) {
+    map->renumber(output_index, 0);
+    result.output_vertex_of_input = map->take();
+  }
+}
+
+}  // namespace
+
+SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHooks& hooks) {
+  validate(options);
+  SimplifyResult result;
+  WorkingMesh mesh = prepare_input(input);  // check, drop degenerate and duplicate faces, frame
+  result.input_faces = mesh.faces_alive, result.input_vertices = mesh.vertices_alive;
+  result.dropped_degenerate_faces = mesh.dropped_degenerate, result.dropped_duplicate_faces = mesh.dropped_duplicate;
+  std::optional<ContractionMap> map;
+  if (options.map_input_vertices || hooks.map_input_vertices) map.emplace(input.vertex_count(), mesh.source_vertex);
+  if (hooks.consumed_indices) {
+    if (hooks.before_release) hooks.before_release(input);
+    input.indices = {};
+    std::vector<std::uint32_t>().swap(*hooks.consumed_indices);
+  }
+  const Settings settings = resolve(options, mesh);
+  if (hooks.observer) hooks.observer->on_start(mesh.face_source);
+
+  std::vector<Quadric> quadric;
+  PairSet pairs;
+  Context c{settings, input, mesh, pairs, quadric, hooks.observer,
+            hooks.observer && hooks.observer->wants_contractions(), map ? &*map : nullptr, {}, {}, result};
+  if (c.done()) {
+    result.stop_reason = StopReason::AlreadyBelowTarget;
+    result.stop_detail = stop_detail(result.stop_reason, result, settings.lock_border);
+    finish(c, map, input, result);
+    return result;
+  }
+  mesh.rebuild_face_lists();
+  std::vector<Edge> edges;
+  side_by_side(  // GH97 §5 (HG99 §2) and the edges of §3.2: independent, so side by side
+      settings.threads, [&] { quadric = face_quadrics(mesh, settings.weighting); },
+      [&] { edges = unique_edges(mesh.tri, mesh.vertex_faces, mesh.vertex_count()); });
+  add_boundary_planes(mesh, edges, settings.boundary_weight, settings.weighting, quadric);  // GH97 §6
+  pairs = select_pairs(mesh, std::move(edges), settings.threshold);                         // GH97 §3.2
+  result.virtual_pairs = pairs.virtual_count;
+  c.marks.assign(mesh.vertex_count(), 0);
+
+  result.stop_reason = StopReason::TargetReached;  // GH97 §4: contract until a stop criterion holds
+  if (settings.scheme == Scheme::Passes) {
+    run_passes(c, hooks.after_band);
+  } else {
+    run_greedy(c);
+    if (hooks.after_band) hooks.after_band(c, PassState{});
+  }
+  if (hooks.observer && result.stop_reason != StopReason::Cancelled) hooks.observer->on_progress(1.0);
+
+  result.max_error_relative = c.max_error;
+  result.max_error = c.max_error * mesh.scale;
+  result.stop_detail = stop_detail(result.stop_reason, result, settings.lock_border);
+  finish(c, map, input, result);
+  return result;
+}
+
+}  // namespace qem::core

@@ -1,0 +1,32 @@
+// The simplifier's pipeline (GH97 §4's algorithm summary), without the refit, which follows it
+// outside the core (src/simplify.cpp).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "qem/simplify.h"
+
+namespace qem::core {
+
+struct Context;
+struct PassState;
+
+/// What a caller of the core may ask besides the options.
+struct RunHooks {
+  SimplifyObserver* observer = nullptr;
+  /// The caller's index array, released once the core holds its own copy of the faces.
+  std::vector<std::uint32_t>* consumed_indices = nullptr;
+  /// Called with the input just before its indices are released (what needs the input's faces).
+  std::function<void(MeshView)> before_release;
+  /// Fill SimplifyResult::output_vertex_of_input even when the options do not ask for it.
+  bool map_input_vertices = false;
+  /// For the tests: called after each band of a pass with the state the lists are read through,
+  /// and with an empty one after the greedy order (alone, or as the passes' tail).
+  std::function<void(const Context&, const PassState&)> after_band;
+};
+
+SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHooks& hooks);
+
+}  // namespace qem::core

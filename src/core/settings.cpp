@@ -1,0 +1,64 @@
+#include "core/settings.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/parallel_chunks.h"
+#include "qem/error.h"
+
+namespace qem::core {
+
+void validate(const SimplifyOptions& o) {
+  const bool any = o.target_faces > 0 || o.target_ratio > 0 || o.target_vertices > 0 || std::isfinite(o.max_error);
+  if (o.target_ratio < 0 || o.target_ratio > 1 || std::isnan(o.target_ratio))
+    throw Error("target ratio must be in (0, 1]");
+  if (std::isfinite(o.max_error) && o.max_error < 0) throw Error("max error must not be negative");
+  if (std::isnan(o.max_error)) throw Error("max error must be a number");
+  if (!any) throw Error("no stop criterion: give a face, ratio, vertex or error target");
+  if (!(o.max_normal_turn_degrees > 0 && o.max_normal_turn_degrees < 90))
+    throw Error("the inversion angle limit must be in (0, 90) degrees");
+  if (!(o.threshold >= 0)) throw Error("threshold must not be negative");
+  if (!(o.boundary_weight >= 0)) throw Error("boundary weight must not be negative");
+}
+
+Settings resolve(const SimplifyOptions& o, const WorkingMesh& mesh) {
+  validate(o);
+  Settings s;
+  bool any = false;
+  if (o.target_faces > 0) s.target_faces = o.target_faces, any = true;
+  if (o.target_ratio > 0) {
+    const std::size_t t = std::size_t(std::floor(o.target_ratio * double(mesh.faces_alive)));
+    s.target_faces = any ? std::max(s.target_faces, t) : t;
+  }
+  s.target_vertices = o.target_vertices;
+  s.max_error = std::numeric_limits<double>::infinity();
+  if (std::isfinite(o.max_error)) s.max_error = o.max_error_is_relative ? o.max_error : o.max_error / mesh.scale;
+  s.weighting = o.weighting;
+  s.placement = o.placement;
+  s.threshold = o.threshold_is_relative ? o.threshold : o.threshold / mesh.scale;
+  s.boundary_weight = o.boundary_weight;
+  s.lock_border = o.lock_border;
+  s.inversion = o.inversion;
+  s.cos_max_turn = std::cos(o.max_normal_turn_degrees * 3.14159265358979323846 / 180.0);
+  s.preserve_topology = o.preserve_topology;
+  s.scheme = o.scheme;
+  s.greedy_below_faces = o.greedy_below_faces;
+  s.threads = resolve_threads(o.threads);
+  return s;
+}
+
+std::string stop_detail(StopReason reason, const SimplifyResult& r, bool lock_border) {
+  switch (reason) {
+    case StopReason::TargetReached: return "target reached";
+    case StopReason::ErrorLimit: return "every remaining contraction exceeds the error limit";
+    case StopReason::NoValidPair:
+      return "no valid contraction left (" + std::to_string(r.rejected_topology) + " rejected for topology, " +
+             std::to_string(r.rejected_inversion) + " for face inversion" + (lock_border ? ", border locked" : "") +
+             ")";
+    case StopReason::AlreadyBelowTarget: return "the input already meets the target";
+    default: return to_string(reason);
+  }
+}
+
+}  // namespace qem::core

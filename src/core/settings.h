@@ -1,0 +1,46 @@
+// The options of a run, checked once and turned into the working frame: the stop criteria and
+// the rules each contraction is held to.
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+#include "core/working_mesh.h"
+#include "qem/simplify.h"
+
+namespace qem::core {
+
+struct Settings {
+  // --- stop criteria (the first reached wins) ---
+  std::size_t target_faces = 0, target_vertices = 0;
+  double max_error = 0;  ///< contraction error limit in the working frame (+inf: none)
+  // --- the rules ---
+  Weighting weighting = Weighting::Area;
+  Placement placement = Placement::Optimal;
+  double threshold = 0;       ///< GH97 §3.2's t in the working frame
+  double boundary_weight = 1;
+  bool lock_border = false;
+  InversionPolicy inversion = InversionPolicy::Forbid;
+  double cos_max_turn = 0;    ///< cosine of the largest normal turn of a surviving face (GH97 §6)
+  bool preserve_topology = true;
+  Scheme scheme = Scheme::Passes;
+  std::size_t greedy_below_faces = 0;
+  unsigned threads = 1;       ///< resolved: at least 1
+
+  bool reached(const WorkingMesh& m) const {
+    return m.faces_alive <= target_faces || m.vertices_alive <= target_vertices;
+  }
+};
+
+/// Throws qem::Error, naming the option, for any option out of its range or a missing target.
+/// Checks only the options themselves: the core's one place for them (the command line relies on it).
+void validate(const SimplifyOptions& options);
+
+/// The validated options in the frame of `mesh` (targets from its face count after dropping
+/// degenerate and duplicate faces).
+Settings resolve(const SimplifyOptions& options, const WorkingMesh& mesh);
+
+/// The human-readable reason a run stopped.
+std::string stop_detail(StopReason reason, const SimplifyResult& totals, bool lock_border);
+
+}  // namespace qem::core
