@@ -102,19 +102,23 @@ int run_simplify(const SimplifyArgs& a) {
         "\"load_s\":%s,\"simplify_s\":%s,\"simplify_cpu_s\":%s,\"write_s\":%s,\"total_s\":%s,"
         "\"peak_rss_mb\":%s,\"max_error\":%s,\"max_error_rel\":%s,\"contractions\":%zu,\"virtual_pairs\":%zu,"
         "\"rejected_topology\":%zu,\"rejected_inversion\":%zu,\"rejected_error\":%zu,\"refit_rounds\":%zu,"
-        "\"refit_rms_before\":%s,\"refit_rms_after\":%s,\"stop\":\"%s\"}\n",
+        "\"refit_rms_before\":%s,\"refit_rms_after\":%s,\"dropped_degenerate\":%zu,\"dropped_duplicate\":%zu,"
+        "\"stop\":\"%s\"}\n",
         in_faces, a.faces, r.mesh.face_count(), r.mesh.vertex_count(), json_number(load_s).c_str(),
         json_number(simplify_s).c_str(), json_number(simplify_cpu_s).c_str(), json_number(write_s).c_str(),
         json_number(total.seconds()).c_str(), json_number(peak_rss_mb()).c_str(),
         json_number(r.max_error).c_str(), json_number(r.max_error_relative).c_str(), r.contractions,
         r.virtual_pairs, r.rejected_topology, r.rejected_inversion, r.rejected_error, r.refit_rounds,
         json_number(r.refit_rms_before).c_str(), json_number(r.refit_rms_after).c_str(),
-        to_string(r.stop_reason));
+        r.dropped_degenerate_faces, r.dropped_duplicate_faces, to_string(r.stop_reason));
   }
   if (!a.quiet)
     std::fprintf(stderr, "qem: %zu -> %zu faces, %zu vertices, max error %.4g (%.3g of diagonal), %.3f s; %s\n",
                  r.input_faces, r.mesh.face_count(), r.mesh.vertex_count(), r.max_error, r.max_error_relative,
                  total.seconds(), r.stop_detail.c_str());
+  if (!a.quiet && r.dropped_degenerate_faces + r.dropped_duplicate_faces > 0)
+    std::fprintf(stderr, "qem: left out %zu degenerate and %zu duplicate input faces\n", r.dropped_degenerate_faces,
+                 r.dropped_duplicate_faces);
   if (!a.quiet && opt.refit_rounds > 0)
     std::fprintf(stderr, "qem: refit in %zu round%s: RMS distance of the input's vertices %.4g -> %.4g\n",
                  r.refit_rounds, r.refit_rounds == 1 ? "" : "s", r.refit_rms_before, r.refit_rms_after);

@@ -58,6 +58,20 @@ TEST(CliSimplify, JsonLineHasTheHarnessFields) {
   EXPECT_EQ(load_mesh(out).face_count(), 500u);
 }
 
+TEST(CliSimplify, DroppedInputFacesAreReported) {
+  Mesh in = test::icosphere(3);
+  in.indices.insert(in.indices.end(), {in.indices[0], in.indices[0], in.indices[1]});  // degenerate
+  for (int k : {0, 1, 2, 3, 4, 5}) in.indices.push_back(in.indices[k]);              // two duplicates
+  const std::string dir = test::temp_dir();
+  save_mesh(dir + "/dropped.obj", in);
+  CliRun r = run("simplify " + dir + "/dropped.obj " + dir + "/dropped_out.obj --faces 100 --json --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("\"dropped_degenerate\":1,"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"dropped_duplicate\":2,"), std::string::npos) << r.out;
+  r = run("simplify " + dir + "/dropped.obj " + dir + "/dropped_out.obj --faces 100");
+  EXPECT_NE(r.out.find("left out 1 degenerate and 2 duplicate input faces"), std::string::npos) << r.out;
+}
+
 TEST(CliSimplify, SummaryLineSaysWhyItStopped) {
   const std::string out = test::temp_dir() + "/cli_tetra.obj";
   save_mesh(test::temp_dir() + "/tetra.obj", test::tetrahedron());
