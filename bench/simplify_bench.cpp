@@ -33,7 +33,7 @@ void run_simplify(benchmark::State& state, const qem::SimplifyOptions& base) {
 void BM_Simplify(benchmark::State& state) { run_simplify(state, {}); }
 
 // The strict greedy order (GH97's heap) against the default pass-based order: the gap is what the
-// passes save (the two give the same error within a few percent, docs/benchmarks.md).
+// passes save (the two orders' errors are compared in docs/benchmarks.md).
 void BM_SimplifyGreedy(benchmark::State& state) {
   qem::SimplifyOptions o;
   o.scheme = qem::Scheme::Greedy;

@@ -30,10 +30,12 @@ struct AlgorithmArgs {
 };
 
 /// The command line's default refit (a light one: `--refit-rounds 1 --refit-sample 2`), made
-/// after every run with optimal placement unless --no-refit: it lowers GH97's E by 4-37 % on the
-/// benchmark meshes for 11-14 % of the run's time on the 1.3M sphere to 10 %
-/// (docs/benchmarks.md). Other placements keep their vertices where they put them (endpoints stay
-/// input vertices). The library's SimplifyOptions default stays GH97 as published (no refit).
+/// after every run with optimal placement unless --no-refit: one round on about 2 input vertices
+/// per output vertex is the least refit that puts E under the best peer's on every benchmark case
+/// (fewer points fit a noisy surface's noise), and it costs a small share of the run
+/// (docs/benchmarks.md, "Refit variants"). Other placements keep their vertices where they put
+/// them (endpoints stay input vertices). The library's SimplifyOptions default stays GH97 as
+/// published (no refit).
 inline constexpr unsigned kDefaultRefitRounds = 1;
 inline constexpr double kDefaultRefitSample = 2;
 

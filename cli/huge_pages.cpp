@@ -3,11 +3,12 @@
 // A multi-million-face mesh needs a few hundred MB of flat arrays (positions, quadrics, faces,
 // pairs, per-vertex lists), and each array is written once from start to end right after it is
 // allocated. With 4 KiB pages that is one page fault per 4 KiB: on the virtual machines our users
-// (and our benchmarks) run on, those faults were a third of the simplifier's setup time. Kernels
-// that leave transparent huge pages to `madvise` (Debian's default) serve a region marked
-// MADV_HUGEPAGE with 2 MiB pages, 512 times fewer faults. So the executable replaces the global
-// allocation functions: blocks of 4 MiB or more are 2 MiB-aligned and marked; smaller ones are
-// plain malloc. Everything is released with free(), which accepts both.
+// (and our benchmarks) run on, those faults were a large part of the simplifier's setup time
+// (docs/benchmarks.md, "Measurements behind the code"). Kernels that leave transparent huge pages
+// to `madvise` (Debian's default) serve a region marked MADV_HUGEPAGE with 2 MiB pages, 512 times
+// fewer faults. So the executable replaces the global allocation functions: blocks of 4 MiB or
+// more are 2 MiB-aligned and marked; smaller ones are plain malloc. Everything is released with
+// free(), which accepts both.
 //
 // The library itself does not do this: applications own their allocator. Under AddressSanitizer
 // the replacement is left out, so the sanitizer's own new/delete checks stay in force.

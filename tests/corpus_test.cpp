@@ -30,7 +30,7 @@ std::vector<std::string> corpus_files() {
 }
 
 #ifdef __SANITIZE_ADDRESS__
-constexpr double kSecondsPerRun = 300;  // sanitizers slow everything down ~5x
+constexpr double kSecondsPerRun = 300;  // sanitizers slow everything down several times
 #else
 constexpr double kSecondsPerRun = 60;
 #endif

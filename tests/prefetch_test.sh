@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The software prefetches reach the compiled code. GCC 12 once dropped the prefetches of the
-# helpers that hold nothing else (apparently judged free of side effects), silently: the output was the same and
-# only the time showed it (8-13 % of a run on the 1.3M sphere, docs/benchmarks.md). The helpers
-# are always inlined now; this counts the prefetch instructions in the objects that use them.
+# helpers that hold nothing else (apparently judged free of side effects), silently: the output was
+# the same and only the time showed it (docs/benchmarks.md, "Measurements behind the code"). The
+# helpers are always inlined now; this counts the prefetch instructions in the objects using them.
 #   prefetch_test.sh OBJECTS...   (the qem library's object files)
 set -euo pipefail
 count() {  # prefetch instructions in the object whose path ends with $1

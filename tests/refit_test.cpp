@@ -350,7 +350,7 @@ TEST(Refit, AFitToSampledPointsKeepsMostOfTheGain) {
   const double e_before = measure(original, before, m).E, e_sampled = measure(original, a, m).E;
   const double e_full = measure(original, full, m).E;
   EXPECT_LT(e_sampled, 0.9 * e_before) << e_before << " -> " << e_sampled;
-  // Most of the full fit's gain (here 97 %: E 5.1e-5 -> 2.04e-5 sampled, 1.96e-5 full).
+  // Most of the full fit's gain: at least 80 % of it.
   EXPECT_GT(e_before - e_sampled, 0.8 * (e_before - e_full)) << e_sampled << " full " << e_full;
   ASSERT_EQ(a.indices, before.indices);
 

@@ -45,9 +45,10 @@ std::vector<std::uint32_t> morton_order(std::size_t n, PointOf point_of) {
     code[i] = spread_bits_3d(cell(p.x, lo.x)) | spread_bits_3d(cell(p.y, lo.y)) << 1 |
               spread_bits_3d(cell(p.z, lo.z)) << 2;
   }
-  // Sorted by (code, index): a stable radix sort on the code's top 32 of 63 bits (linear time; the
-  // comparison sort of (code, index) it replaces took about 0.1 s of the set-up on a 655k-vertex
-  // mesh), then each run of equal top bits, almost always a single point, by its full code.
+  // Sorted by (code, index): a stable radix sort on the code's top 32 of 63 bits, then each run of
+  // equal top bits, almost always a single point, by its full code. Linear time, so cheaper on
+  // large meshes than the comparison sort of (code, index) it replaces (docs/benchmarks.md,
+  // "Measurements behind the code").
   std::vector<std::uint32_t> order(n), scratch;
   for (std::size_t i = 0; i < n; ++i) order[i] = std::uint32_t(i);
   radix_sort_by_key(order, scratch, [&](std::uint32_t i) { return std::uint32_t(code[i] >> 31); });

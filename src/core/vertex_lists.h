@@ -66,9 +66,10 @@ class VertexLists {
 
   std::span<const std::uint32_t> operator[](std::uint32_t v) const { return {data_.data() + begin_[v], size_[v]}; }
   /// Hints the cache that the list of v is about to be read: its slot, or (once the slot is
-  /// cached) its items. Always inlined: without it, GCC 12 at -O3 dropped the prefetches of the
-  /// simplifier's passes (one prefetch instruction was left in simplify.cpp.o), apparently
-  /// treating these helpers, which hold nothing else, as free of side effects (docs/benchmarks.md).
+  /// cached) its items. Always inlined: out of line, GCC 12 at -O3 dropped the prefetches of the
+  /// simplifier's passes, apparently treating these helpers, which hold nothing else, as free of
+  /// side effects; the output stays the same, so only the time shows it. tests/prefetch_test.sh
+  /// counts the instructions (docs/benchmarks.md, "Measurements behind the code").
   [[gnu::always_inline]] void prefetch_slot(std::uint32_t v) const {
     __builtin_prefetch(&begin_[v]);
     __builtin_prefetch(&size_[v]);

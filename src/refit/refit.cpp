@@ -46,15 +46,15 @@ using measure_detail::Vec3;
 
 constexpr std::size_t kChunk = 4096;  // queries per work item and per warm-start run
 /// lambda of the anchor, relative to the mean data weight of a vertex: small enough not to hold
-/// the fit back (1e-2 and 1e-3 gave the same E to 0.1 % on the bunny, armadillo and igea), large
-/// enough to make the system definite.
+/// the fit back (a ten times larger one left E practically unchanged), large enough to make the
+/// system definite (docs/benchmarks.md, "Measurements behind the code").
 constexpr double kAnchor = 1e-3;
 /// kappa of the membrane on the displacement, relative to the mean data weight (both scale with
 /// the area per vertex, so the ratio holds at any resolution). Without it a vertex that only a few
-/// points reach, at small barycentric weights, can jump off the surface to fit them: E fell but the
-/// Hausdorff distance rose up to 2.7x (igea to 10 %). Measured on the 12 benchmark cases at 0, 0.03,
-/// 0.1, 0.3 and 1: 0.3 keeps the Hausdorff distance within 5 % of the unrefitted output's (below
-/// it in 9 of 12 cases) while E stays 10-45 % under the best peer's (docs/benchmarks.md).
+/// points reach, at small barycentric weights, can jump off the surface to fit them: E falls but
+/// the Hausdorff distance rises. On the 12 benchmark cases 0.03 still let it rise and 1 gave back
+/// E; 0.3 keeps it close to the unrefitted output's (docs/benchmarks.md: "Measurements behind the
+/// code", "Tried and dropped").
 constexpr double kMembrane = 0.3;
 
 Vec3 at(const std::vector<double>& x, std::uint32_t v) { return {x[3 * v], x[3 * v + 1], x[3 * v + 2]}; }
@@ -158,7 +158,7 @@ void multiply(const SparseRows& a, const std::vector<double>& x, std::vector<dou
 /// Solves a x = b for the three coordinates at once, from the x given: conjugate gradients with a
 /// diagonal preconditioner, each coordinate to a residual of kTolerance |b| (then it stops
 /// moving). Eigen's solver takes one right-hand side at a time and so reads the matrix three times
-/// a step; this reads it once (docs/benchmarks.md, "The light refit made the default").
+/// a step; this reads it once (docs/benchmarks.md, "Measurements behind the code").
 void conjugate_gradients(const SparseRows& a, const std::vector<double>& b, std::vector<double>& x) {
   constexpr double kTolerance = 1e-10;
   constexpr int kMaxSteps = 1000;
