@@ -2,7 +2,7 @@
 //
 // The log speaks in input ids; the record renumbers to base ids (used vertices, initial faces)
 // with order-preserving maps, so a record carries only the part of the input the run saw and
-// still lists vertices and faces in input order, as build_output in src/core/simplify.cpp does.
+// still lists vertices and faces in input order, as build_output in src/core/working_mesh.cpp does.
 #include <cmath>
 #include <string>
 #include <vector>

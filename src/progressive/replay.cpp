@@ -4,7 +4,7 @@
 // a base corner c stands for find(c), the end of the chain c -> kept -> kept of that ... : a
 // union-find without ranks, since each removed vertex points at exactly one survivor. Applying a
 // contraction is O(1 + dead faces); building a mesh is one pass over the faces with path
-// compression, then a pass over the vertices, mirroring build_output in src/core/simplify.cpp:
+// compression, then a pass over the vertices, mirroring build_output in src/core/working_mesh.cpp:
 // survivors in base (= input) order, faces in base (= input) order, moved vertices at their last
 // recorded position, the others at their exact base coordinates.
 #include <algorithm>
