@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
-#include <thread>
 
 #include "core/parallel_chunks.h"
 #include "core/spatial_order.h"
@@ -83,20 +82,16 @@ MeasureResult measure(MeshView original, MeshView approx, const MeasureOptions& 
   // The two trees are independent: build the second on another thread when we have one.
   TriangleBvh tree_n, tree_i;
   std::vector<double> xn, xi;
-  {
-    std::thread helper;
-    auto build_i = [&] {
-      tree_i = TriangleBvh(si.corners);
-      xi = measure_detail::sample_surface(si, ni, options.seed * 2 + 1);
-    };
-    if (threads > 1) helper = std::thread(build_i);
-    tree_n = TriangleBvh(sn.corners);
-    xn = measure_detail::sample_surface(sn, nn, options.seed * 2);
-    if (helper.joinable())
-      helper.join();
-    else
-      build_i();
-  }
+  core::side_by_side(
+      threads,
+      [&] {
+        tree_i = TriangleBvh(si.corners);
+        xi = measure_detail::sample_surface(si, ni, options.seed * 2 + 1);
+      },
+      [&] {
+        tree_n = TriangleBvh(sn.corners);
+        xn = measure_detail::sample_surface(sn, nn, options.seed * 2);
+      });
   static const std::vector<double> kNone;
   const Distances o2a = distances(tree_i, xn, options.include_vertices ? sn.vertices : kNone, threads);
   const Distances a2o = distances(tree_n, xi, options.include_vertices ? si.vertices : kNone, threads);
