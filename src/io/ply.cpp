@@ -338,7 +338,7 @@ class BodyReader {
  private:
   const char* text_end() const { return reinterpret_cast<const char*>(end_); }
   [[noreturn]] void fail_expected_number() const {
-    std::string what = "expected a number";
+    std::string what = "a number";  // fail_expected says "expected "
     if (elem_) what += " in " + elem_->name + " " + std::to_string(index_);
     text_.fail_expected(what.c_str());
   }
