@@ -118,6 +118,28 @@ std::vector<Case> cases() {
        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float128 x\n", "line 4", "unknown PLY type"},
       {"ply unknown format", "f.ply", FileFormat::Ply, "ply\nformat binary_middle_endian 1.0\n", "line 2",
        "unknown PLY format"},
+      // Unknown header keywords are skipped with a warning (io_test.cpp), but a layout line that
+      // cannot be read is still an error: skipping it would read the body with the wrong layout.
+      {"ply property bad list count type", "lc.ply", FileFormat::Ply,
+       "ply\nformat ascii 1.0\nelement face 1\nproperty list float int vertex_indices\n", "line 4",
+       "must be an integer type"},
+      {"ply property bad list item type", "li.ply", FileFormat::Ply,
+       "ply\nformat ascii 1.0\nelement face 1\nproperty list uchar integer vertex_indices\n", "line 4",
+       "unknown PLY type 'integer'"},
+      {"ply property without name", "pn.ply", FileFormat::Ply,
+       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float\n", "line 4", "property without a name"},
+      {"ply element bad count", "ec.ply", FileFormat::Ply, "ply\nformat ascii 1.0\nelement vertex three\n",
+       "line 3", "expected a non-negative element count, found 'three'"},
+      {"ply element without count", "en.ply", FileFormat::Ply, "ply\nformat ascii 1.0\nelement vertex\n",
+       "line 3", "expected a non-negative element count, found end of line"},
+      {"ply element without name", "ew.ply", FileFormat::Ply, "ply\nformat ascii 1.0\nelement\n", "line 3",
+       "element without a name"},
+      // A misspelled `element` is skipped as an unknown keyword; its properties then belong to no
+      // element, which is still refused.
+      {"ply misspelled element", "me.ply", FileFormat::Ply,
+       "ply\nformat ascii 1.0\nelment vertex 3\nproperty float x\n", "line 4", "before any element"},
+      {"ply unknown lines but no end_header", "ue.ply", FileFormat::Ply,
+       "ply\nformat ascii 1.0\nCreated by hand\n\x01\x02\x03\n", "line 5", "no end_header"},
       {"ply property before element", "p.ply", FileFormat::Ply, "ply\nformat ascii 1.0\nproperty float x\n",
        "line 3", "before any element"},
       {"ply negative element count", "c.ply", FileFormat::Ply, "ply\nformat ascii 1.0\nelement vertex -3\n",
