@@ -11,6 +11,14 @@
 
 namespace qem::cli {
 
+Mesh load_input(const std::string& path, const LoadOptions& options, LoadReport* report) {
+  LoadReport local;
+  LoadReport& r = report ? *report : local;
+  Mesh mesh = load_mesh(path, options, &r);
+  for (const std::string& w : r.warnings) std::fprintf(stderr, "qem: warning: %s\n", w.c_str());
+  return mesh;
+}
+
 double process_cpu_seconds() {
   timespec ts{};
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);

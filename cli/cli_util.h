@@ -1,8 +1,10 @@
-// Small helpers shared by the subcommands: timing, memory, paths, JSON numbers.
+// Small helpers shared by the subcommands: loading, timing, memory, paths, JSON numbers.
 #pragma once
 
 #include <chrono>
 #include <string>
+
+#include "qem/io.h"
 
 namespace qem::cli {
 
@@ -17,6 +19,11 @@ class Stopwatch {
  private:
   std::chrono::steady_clock::time_point start_;
 };
+
+/// load_mesh, then each of the reader's warnings on stderr as "qem: warning: <text>", so a file read
+/// leniently says so whichever command read it (`qem info` lists them in its report instead). Not
+/// silenced by --quiet, which is about progress and summaries, not about what happened to the input.
+Mesh load_input(const std::string& path, const LoadOptions& options = {}, LoadReport* report = nullptr);
 
 /// CPU seconds used by this process so far (user + system).
 double process_cpu_seconds();

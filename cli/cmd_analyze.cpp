@@ -84,7 +84,7 @@ void print_summary(const char* name, const stats::Summary& s) {
 int run_analyze(const AnalyzeArgs& args) {
   LoadOptions lo;
   lo.keep_vertex_properties = true;
-  const Mesh mesh = load_mesh(args.mesh, lo);
+  const Mesh mesh = load_input(args.mesh, lo);
   const Analysis a = analyze(mesh);
 
   stats::Summary aspect = stats::summarize(a.aspect);

@@ -37,7 +37,7 @@ int run_cluster(const ClusterArgs& a) {
   }
   o.placement = a.placement == "mean" ? ClusterPlacement::Mean : ClusterPlacement::Quadric;
   LoadReport report;
-  const Mesh in = load_mesh(a.input, {}, &report);
+  const Mesh in = load_input(a.input, {}, &report);
   const Mesh out = cluster(in, o);
   SaveOptions save;
   save.double_precision = report.double_precision;  // a double PLY stays double, as in `qem simplify`

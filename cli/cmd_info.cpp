@@ -47,6 +47,9 @@ void print_json(const std::string& path, const LoadReport& r, const MeshInfo& m)
   s += ",\"binary\":" + std::string(r.binary ? "true" : "false");
   s += ",\"polygons_triangulated\":" + z(r.polygons_triangulated);
   s += ",\"vertices_welded\":" + z(r.vertices_welded);
+  s += ",\"warnings\":[";
+  for (std::size_t i = 0; i < r.warnings.size(); ++i) s += (i ? "," : "") + json_string(r.warnings[i]);
+  s += "]";
   s += ",\"vertices\":" + z(m.vertices) + ",\"faces\":" + z(m.faces);
   s += ",\"unreferenced_vertices\":" + z(m.unreferenced_vertices);
   s += ",\"edges\":" + z(m.edges) + ",\"boundary_edges\":" + z(m.boundary_edges);
@@ -77,6 +80,8 @@ void print_report(const std::string& path, const LoadReport& r, const MeshInfo& 
                   : "");
   std::printf("  polygons triangulated  %zu\n", r.polygons_triangulated);
   std::printf("  vertices welded        %zu\n", r.vertices_welded);
+  // What the reader skipped belongs with what it did: the report is where `info` users look.
+  for (const std::string& w : r.warnings) std::printf("  warning                %s\n", w.c_str());
   std::printf("  vertices               %zu (%zu unreferenced)\n", m.vertices, m.unreferenced_vertices);
   std::printf("  faces                  %zu\n", m.faces);
   std::printf("  edges                  %zu\n", m.edges);

@@ -46,7 +46,7 @@ int run_lod(const LodArgs& a) {
   const double cpu_start = process_cpu_seconds();
 
   LoadReport report;
-  Mesh mesh = load_mesh(a.input, to_load_options(a.algorithm), &report);
+  Mesh mesh = load_input(a.input, to_load_options(a.algorithm), &report);
 
   // One run to the coarsest level, recorded. Ratios are taken of the faces the run starts from
   // (degenerate and duplicate input faces dropped), exactly as `qem simplify --ratio` does.

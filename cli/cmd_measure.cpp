@@ -82,9 +82,9 @@ int run_measure(MeasureArgs& a) {
   const Stopwatch clock;
   if (!a.per_vertex.empty() && format_from_extension(a.per_vertex) != FileFormat::Ply)
     throw Error(a.per_vertex + ": --per-vertex writes a PLY file (the only format with vertex properties)");
-  const Mesh original = load_mesh(a.original);
+  const Mesh original = load_input(a.original);
   LoadReport approx_report;
-  Mesh approx = load_mesh(a.approx, {}, &approx_report);
+  Mesh approx = load_input(a.approx, {}, &approx_report);
   a.options.per_vertex = !a.per_vertex.empty();
   MeasureResult r = measure(original, approx, a.options);
   const double seconds = clock.seconds();

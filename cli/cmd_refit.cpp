@@ -25,9 +25,9 @@ int run_refit(RefitArgs& a) {
   refuse_to_overwrite(a.approx, a.output, a.force);
   refuse_to_overwrite(a.original, a.output, a.force);
   const Stopwatch clock;
-  const Mesh original = load_mesh(a.original);
+  const Mesh original = load_input(a.original);
   LoadReport report;
-  Mesh approx = load_mesh(a.approx, {}, &report);
+  Mesh approx = load_input(a.approx, {}, &report);
   const RefitResult r = refit(original, approx, a.options);
   SaveOptions save;
   save.binary = !a.ascii;

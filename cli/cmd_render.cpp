@@ -4,6 +4,7 @@
 #include <memory>
 #include <string>
 
+#include "cli_util.h"
 #include "command.h"
 #include "qem/io.h"
 #include "view/png.h"
@@ -21,7 +22,7 @@ struct RenderArgs {
 int run_render(const RenderArgs& a) {
   LoadOptions lo;
   lo.keep_vertex_properties = true;  // the `distance` heat map
-  Mesh mesh = load_mesh(a.input, lo);
+  Mesh mesh = load_input(a.input, lo);
   view::Image image = view::render_mesh(mesh, a.options);
   view::save_png(a.output, image);
   std::printf("qem render: %s (%zu faces) -> %s (%dx%d)\n", a.input.c_str(), mesh.face_count(),

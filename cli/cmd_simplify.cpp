@@ -71,7 +71,7 @@ int run_simplify(const SimplifyArgs& a) {
   LoadOptions load = to_load_options(a.algorithm);
   LoadReport report;
   Stopwatch t_load;
-  Mesh mesh = load_mesh(a.input, load, &report);
+  Mesh mesh = load_input(a.input, load, &report);
   const double load_s = t_load.seconds();
 
   Stopwatch t_simplify;

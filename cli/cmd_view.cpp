@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_util.h"
 #include "command.h"
 #include "qem/error.h"
 #include "qem/io.h"
@@ -101,7 +102,7 @@ view::ViewScene build_scene(const ViewArgs& a) {
     const view::ManifestLevel& e = entries[i];
     view::ViewLevel level;
     level.name = std::filesystem::path(e.path).filename().string();
-    level.mesh = load_mesh(e.path, lo);
+    level.mesh = load_input(e.path, lo);
     level.error = e.error;
     if (e.faces && e.faces != level.mesh.face_count())
       throw Error(a.inputs[0] + ": level " + std::to_string(i) + " lists " + std::to_string(e.faces) +

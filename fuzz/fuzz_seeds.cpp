@@ -1,7 +1,8 @@
 // fuzz_seeds OUTDIR: writes the seed corpora and dictionaries the fuzzers start from, all made in
 // code (no copied files): small meshes serialised by qem's own writers in every format and variant,
 // plus hand-written files that use the format features the writers never emit (polygons, comments,
-// negative OBJ indices, PLY extra properties and big-endian data, COFF colours...).
+// negative OBJ indices, PLY extra properties, big-endian data and header lines without a keyword,
+// COFF colours...).
 //
 //   OUTDIR/{obj,ply,stl,off,simplify}/seed_*   one file per seed
 //   OUTDIR/{obj,ply,stl,off}.dict              libFuzzer dictionaries (-dict=)
@@ -147,6 +148,12 @@ void handwritten_seeds(const fs::path& out) {
              "element edge 1\nproperty int vertex1\nproperty int vertex2\nend_header\n"
              "0 0 0 1 0.5\n1 0 0 1 0.5\n1 1 0 0.5 1\n0 1 0 0.25 0\n3 0 1 2 7\n4 0 1 2 3 9\n0 1\n");
   write_file(out / "ply" / "hand_big_endian", ply_big_endian());
+  // Old Blender exporters: a credit line without `comment`, skipped with a warning.
+  write_file(out / "ply" / "hand_blender_header",
+             "ply\nformat ascii 1.0\nCreated by Blender3D 247 - www.blender.org, source file: 'x.blend'\n"
+             "element vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\n"
+             "property float ny\nproperty float nz\nelement face 1\nproperty list uchar uint vertex_indices\n"
+             "end_header\n0 0 0 0 0 1\n1 0 0 0 0 1\n1 1 0 0 0 1\n0 1 0 0 0 1\n4 0 1 2 3\n");
   write_file(
       out / "stl" / "hand_ascii",
       "solid part\n  facet normal 0 0 1\n    outer loop\n      vertex 0 0 0\n      vertex 1 0 0\n"

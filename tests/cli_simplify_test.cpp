@@ -113,6 +113,28 @@ TEST(CliSimplify, FailedRunLeavesNoOutputAndNamesTheProblem) {
     EXPECT_EQ(e.path().filename().string().find("cli_never"), std::string::npos) << e.path();
 }
 
+TEST(CliSimplify, ReaderWarningsArePrinted) {
+  // An old Blender PLY: its credit line has no `comment` keyword, so the reader skips it and says so.
+  const std::string in = test::temp_dir() + "/cli_blender.ply",
+                    out = test::temp_dir() + "/cli_blender_out.obj";
+  std::ofstream(in) << "ply\nformat ascii 1.0\nCreated by Blender3D 247 - www.blender.org\nelement vertex 4\n"
+                       "property float x\nproperty float y\nproperty float z\nelement face 2\n"
+                       "property list uchar int vertex_indices\nend_header\n"
+                       "0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n";
+  const std::string warning = in + ", line 3: unknown PLY header keyword 'Created', line skipped";
+  // On stderr, even with --quiet (which silences progress and the summary, not news of the input).
+  CliRun r = run("simplify " + in + " " + out + " --faces 1 --quiet");
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("qem: warning: " + warning + "\n"), std::string::npos) << r.out;
+  // `qem info` lists it in its report and in its JSON.
+  r = run("info " + in);
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("  warning                " + warning + "\n"), std::string::npos) << r.out;
+  r = run("info --json " + in);  // the temporary folder's path needs no JSON escaping
+  EXPECT_NE(r.out.find("\"warnings\":[\"" + warning + "\"]"), std::string::npos) << r.out;
+  EXPECT_NE(run("info --json " + sphere_file()).out.find("\"warnings\":[]"), std::string::npos);
+}
+
 TEST(CliSimplify, DoublePlyInputGivesDoublePlyOutput) {
   // Georeferenced coordinates (UTM northings near 5e6 m) lose centimetres in float: a PLY that
   // stores doubles is written back with doubles, and --double asks for them on any input.

@@ -402,6 +402,67 @@ TEST(IoPly, TristripsWithRestarts) {
   EXPECT_EQ(m.indices, (std::vector<std::uint32_t>{0, 1, 2, 2, 1, 3, 2, 3, 4, 4, 3, 5}));
 }
 
+// The header of Blender 2.4x's PLY exporter, whose credit line lacks the `comment` keyword; assimp
+// and MeshLab read such files (issue 21). A quad, so the body is read past the skipped line.
+std::string blender_head(const std::string& format) {
+  return "ply\nformat " + format +
+         " 1.0\nCreated by Blender3D 247 - www.blender.org, source file: 'x.blend'\n"
+         "element vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\n"
+         "property float ny\nproperty float nz\nelement face 1\nproperty list uchar uint vertex_indices\n"
+         "end_header\n";
+}
+
+TEST(IoPly, HeaderLineWithAnUnknownKeywordIsSkippedWithAWarning) {
+  const std::vector<double> pos = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+  const std::string ascii =
+      blender_head("ascii") + "0 0 0 0 0 1\n1 0 0 0 0 1\n1 1 0 0 0 1\n0 1 0 0 0 1\n4 0 1 2 3\n";
+  Bytes bin;
+  bin.text(blender_head("binary_little_endian"));
+  for (std::size_t i = 0; i < 4; ++i) {
+    for (int k = 0; k < 3; ++k) bin.put(static_cast<float>(pos[3 * i + k]));
+    bin.put(0.0f).put(0.0f).put(1.0f);
+  }
+  bin.put<std::uint8_t>(4)
+      .put<std::uint32_t>(0)
+      .put<std::uint32_t>(1)
+      .put<std::uint32_t>(2)
+      .put<std::uint32_t>(3);
+  for (const std::string& bytes : {ascii, bin.s}) {
+    LoadReport rep;
+    Mesh m = qem::parse_mesh(bytes, FileFormat::Ply, "blender.ply", {}, &rep);
+    EXPECT_EQ(m.positions, pos);
+    EXPECT_EQ(m.indices, (std::vector<std::uint32_t>{0, 1, 2, 0, 2, 3}));
+    EXPECT_EQ(rep.polygons_triangulated, 1u);
+    EXPECT_EQ(rep.warnings, (std::vector<std::string>{
+                                "blender.ply, line 3: unknown PLY header keyword 'Created', line skipped"}));
+    // A report reused for the next file starts empty.
+    qem::parse_mesh(qem::serialize_mesh(m, FileFormat::Ply), FileFormat::Ply, "clean.ply", {}, &rep);
+    EXPECT_TRUE(rep.warnings.empty());
+  }
+  // `comment` and `obj_info` are part of the format: no warning.
+  LoadReport rep;
+  std::string commented = ascii;
+  commented.replace(commented.find("Created"), 7, "comment Created");
+  commented.replace(commented.find("element vertex"), 0, "obj_info made by hand\n");
+  EXPECT_EQ(qem::parse_mesh(commented, FileFormat::Ply, "c.ply", {}, &rep).positions, pos);
+  EXPECT_TRUE(rep.warnings.empty());
+}
+
+TEST(IoPly, ManySkippedHeaderLinesAreCountedNotListed) {
+  std::string junk;
+  for (int i = 0; i < 12; ++i) junk += "junk " + std::to_string(i) + "\n";
+  const std::string ply = "ply\nformat ascii 1.0\n" + junk +
+                          "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                          "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                          "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  LoadReport rep;
+  EXPECT_EQ(qem::parse_mesh(ply, FileFormat::Ply, "j.ply", {}, &rep).face_count(), 1u);
+  ASSERT_EQ(rep.warnings.size(), 9u);
+  EXPECT_EQ(rep.warnings[0], "j.ply, line 3: unknown PLY header keyword 'junk', line skipped");
+  EXPECT_EQ(rep.warnings[7], "j.ply, line 10: unknown PLY header keyword 'junk', line skipped");
+  EXPECT_EQ(rep.warnings[8], "j.ply: 4 more header lines with an unknown keyword skipped");
+}
+
 TEST(IoPly, VertexPropertiesRoundTripInEveryPlyEncoding) {
   Mesh m = qem::test::tetrahedron();
   m.vertex_properties.push_back({"k1", {0.5, -1.25, 3.0, 1e-3}});

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "qem/error.h"
 #include "qem/mesh.h"
@@ -35,6 +36,9 @@ struct LoadReport {
   std::size_t polygons_triangulated = 0;  ///< input faces with more than 3 corners
   std::size_t vertices_welded = 0;        ///< vertices removed by welding
   bool double_precision = false;          ///< PLY: coordinates were stored as double
+  /// What was read leniently instead of refused (e.g. a PLY header line with an unknown keyword,
+  /// skipped), each as "<name>, line <line>: <what>" like an error message; the CLI prints them.
+  std::vector<std::string> warnings;
 };
 
 /// Reads a mesh file. Throws qem::Error on any malformed input; never crashes or hangs.

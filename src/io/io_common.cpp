@@ -19,8 +19,12 @@ namespace qem::io {
 
 void fail(const std::string& name, const std::string& what) { throw Error(name + ": " + what); }
 
+std::string at_line(const std::string& name, std::size_t line, const std::string& what) {
+  return name + ", line " + std::to_string(line) + ": " + what;
+}
+
 void fail_line(const std::string& name, std::size_t line, const std::string& what) {
-  throw Error(name + ", line " + std::to_string(line) + ": " + what);
+  throw Error(at_line(name, line, what));
 }
 
 void fail_element(const std::string& name, std::string_view element, std::size_t index,

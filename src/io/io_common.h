@@ -19,7 +19,9 @@ namespace qem::io {
 
 /// "<name>: <what>".
 [[noreturn]] void fail(const std::string& name, const std::string& what);
-/// "<name>, line <line>: <what>" (text formats).
+/// "<name>, line <line>: <what>": the text of a located error or warning.
+std::string at_line(const std::string& name, std::size_t line, const std::string& what);
+/// Throws at_line(...) (text formats).
 [[noreturn]] void fail_line(const std::string& name, std::size_t line, const std::string& what);
 /// "<name>, <element> <index>: <what>" (binary formats; index is 0-based).
 [[noreturn]] void fail_element(const std::string& name, std::string_view element, std::size_t index,

@@ -30,11 +30,11 @@ Mesh parse_obj(std::string_view bytes, const std::string& name, const LoadOption
     std::string_view keyword = in.word();
     if (keyword == "v") {
       in.skip_blank();
-      double x = in.number("x coordinate");
+      double x = in.number("an x coordinate");
       in.skip_blank();
-      double y = in.number("y coordinate");
+      double y = in.number("a y coordinate");
       in.skip_blank();
-      double z = in.number("z coordinate");
+      double z = in.number("a z coordinate");
       if (!finite3(x, y, z)) in.fail("vertex coordinate is not finite");
       mesh.positions.push_back(x);
       mesh.positions.push_back(y);

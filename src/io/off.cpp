@@ -38,7 +38,7 @@ Mesh parse_off(std::string_view bytes, const std::string& name, const LoadOption
   if (!parse_keyword(kw, h)) {
     if (kw.substr(0, 4) == "nOFF" || kw.find("nOFF") != std::string_view::npos)
       in.fail("n-dimensional nOFF is not supported");
-    in.fail("not an OFF file (expected 'OFF' header)");
+    in.fail("not an OFF file (expected an 'OFF' header)");
   }
   in.skip_blank();
   if (in.starts_with("BINARY")) in.fail("binary OFF is not supported");

@@ -1,6 +1,7 @@
 // Stanford PLY: ascii, binary_little_endian and binary_big_endian bodies; every scalar type and its
-// sized alias; extra properties and elements skipped; faces from a `vertex_indices` /
-// `vertex_index` list (fan-triangulated) or from `tristrips` (-1 restarts a strip).
+// sized alias; extra properties and elements skipped; header lines with an unknown keyword skipped
+// with a warning; faces from a `vertex_indices` / `vertex_index` list (fan-triangulated) or from
+// `tristrips` (-1 restarts a strip).
 //
 // Every count in the header is checked against the bytes that remain before anything is reserved,
 // so a header that lies cannot make the reader allocate memory the file does not back. The common
@@ -90,8 +91,22 @@ struct Header {
 
 // --- header --------------------------------------------------------------------------------------
 
-Header parse_header(std::string_view bytes, const std::string& name) {
+/// At most this many skipped header lines are reported one by one; the rest are counted, so a long
+/// run of junk before end_header cannot grow the report without bound.
+constexpr std::size_t kMaxHeaderWarnings = 8;
+
+/// Up to 32 characters of a header word for a message, control and non-ASCII bytes shown as '?'
+/// (the word comes from a file that may be binary garbage and ends up on a terminal).
+std::string shown_word(std::string_view w) {
+  std::string s(w.substr(0, 32));
+  for (char& c : s)
+    if (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) >= 127) c = '?';
+  return s;
+}
+
+Header parse_header(std::string_view bytes, const std::string& name, std::vector<std::string>& warnings) {
   Header h;
+  std::size_t skipped = 0;
   TextCursor in(bytes, name, 0, false);
   in.skip_blank();
   if (in.word() != "ply") in.fail("not a PLY file (first line must be 'ply')");
@@ -154,10 +169,19 @@ Header parse_header(std::string_view bytes, const std::string& name) {
     } else if (kw == "comment" || kw == "obj_info" || kw.empty()) {
       // ignored
     } else {
-      in.fail("unknown PLY header keyword '" + std::string(kw.substr(0, 32)) + "'");
+      // Free text without `comment`, as old exporters wrote (Blender 2.4x: "Created by Blender3D
+      // 247 - www.blender.org, ..."); assimp and MeshLab skip such lines too. The layout comes only
+      // from format / element / property lines, which are never skipped (a malformed one is still
+      // an error); the warning is there because the line may be a misspelled one of them.
+      if (++skipped <= kMaxHeaderWarnings)
+        warnings.push_back(
+            at_line(name, in.line(), "unknown PLY header keyword '" + shown_word(kw) + "', line skipped"));
     }
     in.next_line();
   }
+  if (skipped > kMaxHeaderWarnings)
+    warnings.push_back(name + ": " + std::to_string(skipped - kMaxHeaderWarnings) +
+                       " more header lines with an unknown keyword skipped");
   if (!have_format) fail(name, "PLY header has no format line");
   h.body_offset = static_cast<std::size_t>(in.pos() - bytes.data());
   h.lines = in.line();
@@ -338,7 +362,7 @@ class BodyReader {
  private:
   const char* text_end() const { return reinterpret_cast<const char*>(end_); }
   [[noreturn]] void fail_expected_number() const {
-    std::string what = "expected a number";
+    std::string what = "a number";  // fail_expected says "expected "
     if (elem_) what += " in " + elem_->name + " " + std::to_string(index_);
     text_.fail_expected(what.c_str());
   }
@@ -627,7 +651,7 @@ void skip_element(BodyReader& in, const Element& e) {
 Mesh parse_ply(std::string_view bytes, const std::string& name, const LoadOptions& options,
                LoadReport& report) {
   if (bytes.empty()) fail(name, "empty file");
-  Header h = parse_header(bytes, name);
+  Header h = parse_header(bytes, name, report.warnings);
   report.format = FileFormat::Ply;
   report.binary = h.encoding != Encoding::Ascii;
 
