@@ -134,10 +134,14 @@ std::vector<Case> cases() {
        "line 3", "expected a non-negative element count, found end of line"},
       {"ply element without name", "ew.ply", FileFormat::Ply, "ply\nformat ascii 1.0\nelement\n", "line 3",
        "element without a name"},
-      // A misspelled `element` is skipped as an unknown keyword; its properties then belong to no
-      // element, which is still refused.
+      // A word within two letters of a layout keyword is taken for a misspelling and refused:
+      // skipped, it would leave the body read with a wrong layout.
       {"ply misspelled element", "me.ply", FileFormat::Ply,
-       "ply\nformat ascii 1.0\nelment vertex 3\nproperty float x\n", "line 4", "before any element"},
+       "ply\nformat ascii 1.0\nelment vertex 3\nproperty float x\n", "line 3", "a misspelled layout keyword?"},
+      {"ply misspelled property", "mp.ply", FileFormat::Ply,
+       "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+       "propery float z\nend_header\n",
+       "line 6", "unknown PLY header keyword 'propery' (a misspelled layout keyword?)"},
       {"ply unknown lines but no end_header", "ue.ply", FileFormat::Ply,
        "ply\nformat ascii 1.0\nCreated by hand\n\x01\x02\x03\n", "line 5", "no end_header"},
       {"ply property before element", "p.ply", FileFormat::Ply, "ply\nformat ascii 1.0\nproperty float x\n",

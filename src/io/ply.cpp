@@ -97,6 +97,28 @@ constexpr std::size_t kMaxHeaderWarnings = 8;
 
 /// Up to 32 characters of a header word for a message, control and non-ASCII bytes shown as '?'
 /// (the word comes from a file that may be binary garbage and ends up on a terminal).
+// Levenshtein distance of at most two to a keyword that decides the body's layout.
+bool near_layout_keyword(std::string_view word) {
+  auto distance = [](std::string_view a, std::string_view b) {
+    std::vector<std::size_t> row(b.size() + 1);
+    for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i) {
+      std::size_t diagonal = row[0];
+      row[0] = i;
+      for (std::size_t j = 1; j <= b.size(); ++j) {
+        const std::size_t up = row[j];
+        row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+        diagonal = up;
+      }
+    }
+    return row[b.size()];
+  };
+  if (word.size() > 16) return false;
+  for (std::string_view k : {"format", "element", "property", "end_header"})
+    if (distance(word, k) <= 2) return true;
+  return false;
+}
+
 std::string shown_word(std::string_view w) {
   std::string s(w.substr(0, 32));
   for (char& c : s)
@@ -172,7 +194,10 @@ Header parse_header(std::string_view bytes, const std::string& name, std::vector
       // Free text without `comment`, as old exporters wrote (Blender 2.4x: "Created by Blender3D
       // 247 - www.blender.org, ..."); assimp and MeshLab skip such lines too. The layout comes only
       // from format / element / property lines, which are never skipped (a malformed one is still
-      // an error); the warning is there because the line may be a misspelled one of them.
+      // an error). A word within two letters of one of them is taken for a misspelling and refused:
+      // skipping it would read the body with a wrong layout.
+      if (near_layout_keyword(kw))
+        fail_line(name, in.line(), "unknown PLY header keyword '" + shown_word(kw) + "' (a misspelled layout keyword?)");
       if (++skipped <= kMaxHeaderWarnings)
         warnings.push_back(
             at_line(name, in.line(), "unknown PLY header keyword '" + shown_word(kw) + "', line skipped"));
