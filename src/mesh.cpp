@@ -11,6 +11,12 @@ const VertexProperty* Mesh::find_property(const std::string& name) const {
   return nullptr;
 }
 
+const VertexAttribute* Mesh::find_attribute(AttributeKind kind) const {
+  for (const VertexAttribute& a : attributes)
+    if (a.kind == kind) return &a;
+  return nullptr;
+}
+
 double Box::diagonal() const {
   double dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
   return std::sqrt(dx * dx + dy * dy + dz * dz);
