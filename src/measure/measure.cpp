@@ -11,6 +11,7 @@
 
 #include "core/parallel_chunks.h"
 #include "core/spatial_order.h"
+#include "geometry/vec3.h"
 #include "measure/bvh.h"
 #include "measure/surface_sampling.h"
 #include "qem/error.h"
@@ -37,8 +38,9 @@ Distances distances(const TriangleBvh& tree, const std::vector<double>& samples,
   const std::size_t ns = samples.size() / 3;
   std::vector<double> points = samples;
   points.insert(points.end(), vertices.begin(), vertices.end());
-  const std::vector<std::uint32_t> order = core::morton_order(
-      points.size() / 3, [&](std::size_t i) { return core::Vec3(points[3 * i], points[3 * i + 1], points[3 * i + 2]); });
+  const std::vector<std::uint32_t> order = core::morton_order(points.size() / 3, [&](std::size_t i) {
+    return Vec3(points[3 * i], points[3 * i + 1], points[3 * i + 2]);
+  });
   std::vector<double> d2(order.size());
   core::for_chunks(order.size(), kChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
     std::uint32_t hint = UINT32_MAX;  // reset per chunk: the warm start never crosses chunks

@@ -31,6 +31,7 @@
 #include "check_mesh.h"
 #include "core/parallel_chunks.h"
 #include "core/spatial_order.h"
+#include "geometry/vec3.h"
 #include "measure/bvh.h"
 #include "measure/point_triangle.h"
 #include "qem/error.h"
@@ -41,8 +42,6 @@ namespace qem {
 namespace refit_detail {
 
 namespace {
-
-using measure_detail::Vec3;
 
 constexpr std::size_t kChunk = 4096;  // queries per work item and per warm-start run
 /// lambda of the anchor, relative to the mean data weight of a vertex: small enough not to hold
@@ -60,12 +59,11 @@ constexpr double kMembrane = 0.3;
 Vec3 at(const std::vector<double>& x, std::uint32_t v) { return {x[3 * v], x[3 * v + 1], x[3 * v + 2]}; }
 
 Vec3 face_normal(const std::vector<double>& x, const std::uint32_t* t) {
-  return measure_detail::cross(at(x, t[1]) - at(x, t[0]), at(x, t[2]) - at(x, t[0]));
+  return cross(at(x, t[1]) - at(x, t[0]), at(x, t[2]) - at(x, t[0]));
 }
 
 /// Barycentric coordinates of q (a point of triangle abc) in abc; false if abc has no area.
 bool barycentric(Vec3 q, Vec3 a, Vec3 b, Vec3 c, double out[3]) {
-  using measure_detail::dot;
   const Vec3 e0 = b - a, e1 = c - a, d = q - a;
   const double d00 = dot(e0, e0), d01 = dot(e0, e1), d11 = dot(e1, e1), d20 = dot(d, e0), d21 = dot(d, e1);
   const double den = d00 * d11 - d01 * d01;
@@ -110,7 +108,7 @@ FitPoints::FitPoints(std::span<const double> points, std::span<const double> wei
   }
   source = std::move(used);
   order = core::morton_order(source.size(), [&](std::size_t j) {
-    return core::Vec3(position[3 * j], position[3 * j + 1], position[3 * j + 2]);
+    return Vec3(position[3 * j], position[3 * j + 1], position[3 * j + 2]);
   });
 }
 
@@ -514,9 +512,9 @@ class Refitter {
       for (std::size_t f = 0; f < tri_.size(); f += 3) {
         const std::uint32_t* t = &tri_[f];
         const Vec3 before = face_normal(x_, t), after = face_normal(next, t);
-        const double bb = measure_detail::dot(before, before), aa = measure_detail::dot(after, after);
+        const double bb = dot(before, before), aa = dot(after, after);
         if (!(bb > 0)) continue;  // no area before: no direction to keep
-        if (measure_detail::dot(before, after) > cos_limit * std::sqrt(bb * aa)) continue;
+        if (dot(before, after) > cos_limit * std::sqrt(bb * aa)) continue;
         for (int k = 0; k < 3; ++k) {
           if (held[t[k]]) continue;
           held[t[k]] = 1, ++count, again = true;
@@ -551,8 +549,8 @@ std::vector<double> vertex_areas(MeshView mesh) {
       const double* q = &mesh.positions[3 * std::size_t(t[k])];
       return Vec3{q[0], q[1], q[2]};
     };
-    const Vec3 n = measure_detail::cross(p(1) - p(0), p(2) - p(0));
-    const double third = std::sqrt(measure_detail::dot(n, n)) / 6;  // a third of half the cross product
+    const Vec3 n = cross(p(1) - p(0), p(2) - p(0));
+    const double third = std::sqrt(dot(n, n)) / 6;  // a third of half the cross product
     if (!std::isfinite(third)) continue;
     for (int k = 0; k < 3; ++k) area[t[k]] += third;
   }
