@@ -15,6 +15,7 @@
 
 #include "check_mesh.h"
 #include "cluster/cluster_quadric.h"
+#include "geometry/box.h"
 #include "qem/error.h"
 
 namespace qem {
@@ -46,21 +47,14 @@ struct Grid {
 
 Grid grid_of(MeshView mesh, const std::vector<char>& used, const ClusterOptions& o) {
   Grid g;
-  double hi[3];
-  bool first = true;
-  for (std::size_t v = 0; v < used.size(); ++v) {
-    if (!used[v]) continue;
-    const double* p = &mesh.positions[3 * v];
-    for (int k = 0; k < 3; ++k) {
-      g.lo[k] = first ? p[k] : std::min(g.lo[k], p[k]);
-      hi[k] = first ? p[k] : std::max(hi[k], p[k]);
-    }
-    first = false;
-  }
-  if (first) return g;  // no faces
+  BoxOfPoints points;
+  for (std::size_t v = 0; v < used.size(); ++v)
+    if (used[v]) points.add(&mesh.positions[3 * v]);
+  if (points.empty()) return g;  // no faces
+  const Box box = points.box();
   double extent[3];
-  for (int k = 0; k < 3; ++k) extent[k] = hi[k] - g.lo[k];
-  g.diag = std::sqrt(extent[0] * extent[0] + extent[1] * extent[1] + extent[2] * extent[2]);
+  for (int k = 0; k < 3; ++k) g.lo[k] = box.lo[k], extent[k] = box.hi[k] - box.lo[k];
+  g.diag = box.diagonal();
   const bool use_grid = o.grid[0] > 0 && o.grid[1] > 0 && o.grid[2] > 0;
   if (use_grid) {
     for (int k = 0; k < 3; ++k) {

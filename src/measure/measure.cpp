@@ -11,6 +11,7 @@
 
 #include "core/parallel_chunks.h"
 #include "core/spatial_order.h"
+#include "geometry/box.h"
 #include "geometry/vec3.h"
 #include "measure/bvh.h"
 #include "measure/surface_sampling.h"
@@ -55,15 +56,6 @@ Distances distances(const TriangleBvh& tree, const std::vector<double>& samples,
   return total;
 }
 
-double diagonal_of(const std::vector<double>& xyz) {
-  if (xyz.empty()) return 0;
-  double lo[3] = {xyz[0], xyz[1], xyz[2]}, hi[3] = {xyz[0], xyz[1], xyz[2]};
-  for (std::size_t i = 0; i < xyz.size(); i += 3)
-    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], xyz[i + k]), hi[k] = std::max(hi[k], xyz[i + k]);
-  return std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                   (hi[2] - lo[2]) * (hi[2] - lo[2]));
-}
-
 }  // namespace
 
 MeasureResult measure(MeshView original, MeshView approx, const MeasureOptions& options) {
@@ -104,7 +96,7 @@ MeasureResult measure(MeshView original, MeshView approx, const MeasureOptions& 
   const Distances a2o = distances(tree_n, xi, options.include_vertices ? si.vertices : kNone, threads);
 
   MeasureResult r;
-  r.bbox_diag = diagonal_of(sn.vertices);
+  r.bbox_diag = box_of_points(sn.vertices).diagonal();
   r.area_original = sn.area, r.area_approx = si.area;
   r.samples_original = nn, r.samples_approx = ni;
   r.degenerate_original = sn.degenerate, r.degenerate_approx = si.degenerate;

@@ -31,6 +31,8 @@
 #include "check_mesh.h"
 #include "core/parallel_chunks.h"
 #include "core/spatial_order.h"
+#include "geometry/box.h"
+#include "geometry/frame.h"
 #include "geometry/vec3.h"
 #include "measure/bvh.h"
 #include "measure/point_triangle.h"
@@ -90,19 +92,18 @@ FitPoints::FitPoints(std::span<const double> points, std::span<const double> wei
   std::vector<std::uint32_t> used;  // the points with a weight
   for (std::size_t i = 0; i < weights.size(); ++i)
     if (weights[i] > 0) used.push_back(std::uint32_t(i));
-  // The frame: centre and diagonal of the points' box (the approximation's vertices lie near them).
-  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
-  for (std::uint32_t i : used)
-    for (int k = 0; k < 3; ++k)
-      lo[k] = std::min(lo[k], points[3 * i + k]), hi[k] = std::max(hi[k], points[3 * i + k]);
-  double d2 = 0;
-  for (int k = 0; k < 3; ++k) centre[k] = 0.5 * (lo[k] + hi[k]), d2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
-  diag = std::sqrt(d2);
-  if (used.empty() || !(diag > 0)) return;
+  // The frame of the points' box (the approximation's vertices lie near them). Points that all
+  // coincide leave nothing to fit.
+  const Box box = box_of_points(points, used);
+  const Frame f = frame_of_box(box);
+  centre = f.center, diag = f.scale;
+  if (used.empty() || !(box.diagonal() > 0)) return;
   position.resize(3 * used.size());
   weight.resize(used.size());
   for (std::size_t j = 0; j < used.size(); ++j) {
-    for (int k = 0; k < 3; ++k) position[3 * j + k] = (points[3 * used[j] + k] - centre[k]) / diag;
+    const double* p = &points[3 * std::size_t(used[j])];
+    const Vec3 q = f.to_frame({p[0], p[1], p[2]});
+    position[3 * j] = q.x, position[3 * j + 1] = q.y, position[3 * j + 2] = q.z;
     weight[j] = weights[used[j]];
     total_weight += weight[j];
   }
@@ -114,8 +115,7 @@ FitPoints::FitPoints(std::span<const double> points, std::span<const double> wei
 
 FitPoints FitPoints::thinned(std::size_t group) const {
   FitPoints out;
-  std::copy(centre, centre + 3, out.centre);
-  out.diag = diag;
+  out.centre = centre, out.diag = diag;
   const std::size_t n = order.size();
   for (std::size_t begin = 0; begin < n; begin += group) {
     const std::size_t end = std::min(n, begin + group);
@@ -209,11 +209,13 @@ class Refitter {
         tri_(approx.indices),
         pts_(points),
         near_vertex_(near_vertex),
-        centre_(points.centre),
-        diag_(points.diag) {
+        frame_(points.frame()) {
     if (pts_.weight.empty() || approx.indices.empty()) return;
     x_.resize(approx.positions.size());
-    for (std::size_t i = 0; i < x_.size(); ++i) x_[i] = (approx.positions[i] - centre_[i % 3]) / diag_;
+    for (std::size_t v = 0; v < approx.vertex_count(); ++v) {
+      const Vec3 q = frame_.to_frame(at(approx.positions, std::uint32_t(v)));
+      x_[3 * v] = q.x, x_[3 * v + 1] = q.y, x_[3 * v + 2] = q.z;
+    }
     fixed_.assign(approx.vertex_count(), 0);
     if (o.lock_border) mark_border();
     // Faces around each vertex (CSR), for the projections after the first.
@@ -235,7 +237,7 @@ class Refitter {
     if (!ready_) return r;
     const std::vector<double> start = x_;
     Projection proj = project(x_);
-    r.rms_before = r.rms_after = std::sqrt(proj.energy / pts_.total_weight) * diag_;
+    r.rms_before = r.rms_after = std::sqrt(proj.energy / pts_.total_weight) * frame_.scale;
     for (unsigned round = 0; round < opt_.rounds; ++round) {
       std::vector<double> next;
       if (!solve(proj, next)) break;
@@ -246,12 +248,16 @@ class Refitter {
       proj = std::move(next_proj);
       ++r.rounds;
       r.vertices_held += held;
-      r.rms_after = std::sqrt(proj.energy / pts_.total_weight) * diag_;
+      r.rms_after = std::sqrt(proj.energy / pts_.total_weight) * frame_.scale;
     }
     // Back to model coordinates; a vertex that did not move keeps its exact input coordinates.
-    for (std::size_t v = 0; v < approx_.vertex_count(); ++v)
-      if (x_[3 * v] != start[3 * v] || x_[3 * v + 1] != start[3 * v + 1] || x_[3 * v + 2] != start[3 * v + 2])
-        for (int k = 0; k < 3; ++k) approx_.positions[3 * v + k] = centre_[k] + x_[3 * v + k] * diag_;
+    for (std::size_t v = 0; v < approx_.vertex_count(); ++v) {
+      const double *now = &x_[3 * v], *was = &start[3 * v];
+      if (now[0] == was[0] && now[1] == was[1] && now[2] == was[2]) continue;
+      const Vec3 p = frame_.to_model({now[0], now[1], now[2]});
+      double* out = &approx_.positions[3 * v];
+      out[0] = p.x, out[1] = p.y, out[2] = p.z;
+    }
     return r;
   }
 
@@ -530,9 +536,8 @@ class Refitter {
   const std::vector<std::uint32_t>& tri_;
   const FitPoints& pts_;
   std::span<const std::uint32_t> near_vertex_;
-  const double* centre_;
-  double diag_;
-  std::vector<double> x_;             // approximation vertices, normalised
+  const Frame frame_;      // of the points: x_ = frame_.to_frame(approx_'s positions)
+  std::vector<double> x_;  // approximation vertices, normalised
   std::vector<std::uint8_t> fixed_;
   std::vector<std::uint32_t> ring_start_, ring_faces_;  // faces around each vertex
   std::vector<std::uint32_t> ring_slot_;  // per corner of a face: its place in its vertex's ring

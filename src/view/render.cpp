@@ -6,6 +6,7 @@
 #include <numbers>
 #include <vector>
 
+#include "geometry/box.h"
 #include "geometry/vec3.h"
 #include "qem/error.h"
 #include "view/scene.h"
@@ -52,7 +53,7 @@ Image render_mesh(const Mesh& mesh, const RenderOptions& o) {
 
   // Frame the bounding sphere of the box, as the page does (scene.cpp's centre and radius).
   Box box = bounding_box(mesh);
-  Vec3 center{0.5 * (box.lo[0] + box.hi[0]), 0.5 * (box.lo[1] + box.hi[1]), 0.5 * (box.lo[2] + box.hi[2])};
+  Vec3 center = box_center(box);
   double radius = 0.5 * box.diagonal();
   if (!(radius > 0)) radius = 1;
   const double deg = std::numbers::pi / 180;
