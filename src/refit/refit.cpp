@@ -31,6 +31,8 @@
 #include "check_mesh.h"
 #include "core/parallel_chunks.h"
 #include "core/spatial_order.h"
+#include "core/valid_pairs.h"
+#include "core/vertex_lists.h"
 #include "geometry/box.h"
 #include "geometry/frame.h"
 #include "geometry/vec3.h"
@@ -262,20 +264,15 @@ class Refitter {
   }
 
  private:
-  // Border vertices: on an edge that only one face has (edges as sorted vertex pairs, counted).
+  // Border vertices: on an edge that only one face has, found as the simplifier finds them
+  // (core::unique_edges), so that --lock-border holds the same vertices in both.
   void mark_border() {
-    std::vector<std::uint64_t> edges;
-    edges.reserve(tri_.size());
-    for (std::size_t f = 0; f < tri_.size(); f += 3)
-      for (int k = 0; k < 3; ++k) {
-        const std::uint64_t a = tri_[f + k], b = tri_[f + (k + 1) % 3];
-        edges.push_back(std::min(a, b) << 32 | std::max(a, b));
-      }
-    std::sort(edges.begin(), edges.end());
-    for (std::size_t i = 0, j; i < edges.size(); i = j) {
-      for (j = i + 1; j < edges.size() && edges[j] == edges[i];) ++j;
-      if (j - i == 1) fixed_[edges[i] >> 32] = fixed_[edges[i] & 0xffffffffu] = 1;
-    }
+    core::VertexLists faces;
+    faces.rebuild(fixed_.size(), [&](auto emit) {
+      for (std::size_t c = 0; c < tri_.size(); ++c) emit(tri_[c], std::uint32_t(c / 3));
+    });
+    for (const core::Edge& e : core::unique_edges(tri_, faces, fixed_.size()))
+      if (e.faces == 1) fixed_[e.lo] = fixed_[e.hi] = 1;
   }
 
   // Where each point lands on the approximation with vertices x. The first projection asks a tree
