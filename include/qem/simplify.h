@@ -53,6 +53,18 @@ const char* to_string(StopReason reason);
 const char* to_string(Weighting w);
 const char* to_string(Placement p);
 const char* to_string(Scheme s);
+// The names above and below come from one table per enum (src/option_names.cpp).
+const char* to_string(InversionPolicy policy);
+/// The value called `name` (a to_string name, which is also the command line's: "area", "off"):
+/// true and `out` set, or false and `out` unchanged if no value has that name.
+bool from_string(const std::string& name, Weighting& out);
+bool from_string(const std::string& name, Placement& out);
+bool from_string(const std::string& name, Scheme& out);
+bool from_string(const std::string& name, InversionPolicy& out);
+/// The names of all values of an option enum (Weighting, Placement, Scheme, InversionPolicy; no
+/// other is defined), in declaration order: the choices a front end offers.
+template <class Enum>
+std::vector<std::string> option_names();
 
 /// The whole contraction sequence of one run (GH97 §3: M_n, M_n-1, ..., M_g), in input vertex and
 /// face indices, so that any intermediate mesh can be rebuilt (see qem/progressive.h).

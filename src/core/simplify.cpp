@@ -43,41 +43,6 @@
 
 namespace qem {
 
-const char* to_string(StopReason reason) {
-  switch (reason) {
-    case StopReason::TargetReached: return "target reached";
-    case StopReason::ErrorLimit: return "error limit reached";
-    case StopReason::NoValidPair: return "no valid contraction left";
-    case StopReason::AlreadyBelowTarget: return "input already at or below target";
-    case StopReason::Cancelled: return "cancelled";
-  }
-  return "?";
-}
-const char* to_string(Weighting w) {
-  switch (w) {
-    case Weighting::Area: return "area";
-    case Weighting::Uniform: return "uniform";
-    case Weighting::Angle: return "angle";
-  }
-  return "?";
-}
-const char* to_string(Placement p) {
-  switch (p) {
-    case Placement::Optimal: return "optimal";
-    case Placement::Segment: return "segment";
-    case Placement::Midpoint: return "midpoint";
-    case Placement::Endpoints: return "endpoints";
-  }
-  return "?";
-}
-const char* to_string(Scheme s) {
-  switch (s) {
-    case Scheme::Greedy: return "greedy";
-    case Scheme::Passes: return "passes";
-  }
-  return "?";
-}
-
 namespace {
 
 using namespace core;
