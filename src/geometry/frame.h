@@ -17,10 +17,14 @@ namespace qem {
 
 struct Frame {
   Vec3 center;       ///< the box's midpoint (box_center)
-  double scale = 1;  ///< the box's diagonal; 1 when that is 0 (one point, or none) or not finite
+  double scale = 1;  ///< the box's diagonal; 1 when that is 0 (no point, or one) or not finite
 
-  /// Model to frame coordinates: (p - center) / scale, correctly rounded per component.
+  /// Model to frame coordinates: (p - center) / scale, correctly rounded per component (the refit).
   Vec3 to_frame(const Vec3& p) const { return (p - center) / scale; }
+  /// (p - center) * (1 / scale), as the simplifier has always normalised its input. A component
+  /// can differ from to_frame's in the last bit, and the simplifier's output bytes
+  /// (tests/golden_checksums.txt) change if it uses to_frame instead.
+  Vec3 to_frame_by_reciprocal(const Vec3& p) const { return (p - center) * (1.0 / scale); }
   /// Frame to model coordinates: center + q * scale.
   Vec3 to_model(const Vec3& q) const { return center + q * scale; }
 };
