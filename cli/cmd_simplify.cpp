@@ -29,9 +29,9 @@ struct SimplifyArgs {
 };
 
 int run_simplify(const SimplifyArgs& a) {
-  if (a.faces == 0 && a.ratio == 0 && a.vertices == 0 && a.max_error < 0 && a.max_error_rel < 0)
-    throw Error("give a target: --faces, --ratio, --vertices, --max-error or --max-error-rel");
-  if (a.ratio < 0 || a.ratio > 1) throw Error("--ratio must be in (0, 1]");
+  // The core checks the targets (none given, a ratio above 1) and says what is wrong; it takes a
+  // ratio <= 0 as "no ratio target", so a negative one, which can only be a slip, is refused here.
+  if (a.ratio < 0) throw Error("--ratio must be in (0, 1]");
   refuse_to_overwrite(a.input, a.output, a.force);
   SimplifyOptions opt = to_simplify_options(a.algorithm);
   // A record replays the contractions, and a refit moves every vertex after them, so `qem replay`
