@@ -1,6 +1,6 @@
 #include "algorithm_options.h"
 
-#include <map>
+#include <string>
 
 #include "qem/error.h"
 #include "qem/refit.h"
@@ -13,16 +13,16 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
                   "separate parts can join (0 = edges only)");
   sub->add_option("--threshold-rel", a.threshold_rel, "As --threshold, relative to the bounding-box diagonal");
   sub->add_option("--weighting", a.weighting, "Plane weighting: area (HG99), uniform (GH97), angle")
-      ->check(CLI::IsMember({"area", "uniform", "angle"}))
+      ->check(CLI::IsMember(option_names<Weighting>()))
       ->capture_default_str();
   sub->add_option("--placement", a.placement,
                   "Where the new vertex goes: optimal (then segment, then endpoints), segment, midpoint, endpoints")
-      ->check(CLI::IsMember({"optimal", "segment", "midpoint", "endpoints"}))
+      ->check(CLI::IsMember(option_names<Placement>()))
       ->capture_default_str();
   sub->add_option("--scheme", a.scheme,
                   "Order of contractions: greedy (strictly cheapest first, GH97's heap) or passes (rank, sort, "
                   "contract each vertex at most once a pass; faster)")
-      ->check(CLI::IsMember({"greedy", "passes"}))
+      ->check(CLI::IsMember(option_names<Scheme>()))
       ->capture_default_str();
   sub->add_option("--greedy-below", a.greedy_below,
                   "With --scheme passes, finish in the greedy order below this many faces (0 = never)")
@@ -35,7 +35,7 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
       ->capture_default_str();
   sub->add_flag("--lock-border", a.lock_border, "Boundary vertices never move");
   sub->add_option("--inversion", a.inversion, "Contractions that flip a face: forbid, penalize, or off (GH97 6)")
-      ->check(CLI::IsMember({"forbid", "penalize", "off"}))
+      ->check(CLI::IsMember(option_names<InversionPolicy>()))
       ->capture_default_str();
   sub->add_option("--max-turn", a.max_turn, "A face normal turning by more than this (degrees, < 90) is a flip")
       ->capture_default_str();
@@ -65,15 +65,19 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
                 "No refit, not even the default's light one: every vertex stays where GH97 placed it");
 }
 
+namespace {
+
+/// The value named by an option that IsMember(option_names<Enum>()) has already checked.
+template <class Enum>
+Enum parsed(const char* flag, const std::string& name) {
+  Enum value{};
+  if (!from_string(name, value)) throw Error(std::string(flag) + ": unknown value '" + name + "'");
+  return value;
+}
+
+}  // namespace
+
 SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
-  static const std::map<std::string, Weighting> weightings{
-      {"area", Weighting::Area}, {"uniform", Weighting::Uniform}, {"angle", Weighting::Angle}};
-  static const std::map<std::string, Placement> placements{{"optimal", Placement::Optimal},
-                                                           {"segment", Placement::Segment},
-                                                           {"midpoint", Placement::Midpoint},
-                                                           {"endpoints", Placement::Endpoints}};
-  static const std::map<std::string, InversionPolicy> inversions{
-      {"forbid", InversionPolicy::Forbid}, {"penalize", InversionPolicy::Penalize}, {"off", InversionPolicy::Ignore}};
   SimplifyOptions opt;
   if (a.threshold_rel > 0) {
     opt.threshold = a.threshold_rel;
@@ -81,10 +85,10 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
   } else {
     opt.threshold = a.threshold;
   }
-  opt.weighting = weightings.at(a.weighting);
-  opt.placement = placements.at(a.placement);
-  opt.inversion = inversions.at(a.inversion);
-  opt.scheme = a.scheme == "passes" ? Scheme::Passes : Scheme::Greedy;
+  opt.weighting = parsed<Weighting>("--weighting", a.weighting);
+  opt.placement = parsed<Placement>("--placement", a.placement);
+  opt.inversion = parsed<InversionPolicy>("--inversion", a.inversion);
+  opt.scheme = parsed<Scheme>("--scheme", a.scheme);
   opt.greedy_below_faces = a.greedy_below;
   opt.threads = a.threads;
   opt.boundary_weight = a.boundary_weight;

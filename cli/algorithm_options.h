@@ -13,8 +13,10 @@ namespace qem::cli {
 
 struct AlgorithmArgs {
   double threshold = 0, threshold_rel = 0;
-  std::string weighting = "area", placement = "optimal", inversion = "forbid";
-  std::string scheme = "passes";
+  std::string weighting = to_string(SimplifyOptions{}.weighting);
+  std::string placement = to_string(SimplifyOptions{}.placement);
+  std::string inversion = to_string(SimplifyOptions{}.inversion);
+  std::string scheme = to_string(SimplifyOptions{}.scheme);
   std::size_t greedy_below = SimplifyOptions{}.greedy_below_faces;
   unsigned threads = 0;
   double boundary_weight = SimplifyOptions{}.boundary_weight;

@@ -46,9 +46,6 @@ class Watcher : public ContractionRecorder {
 };
 
 int run_simplify(const SimplifyArgs& a) {
-  if (a.faces == 0 && a.ratio == 0 && a.vertices == 0 && a.max_error < 0 && a.max_error_rel < 0)
-    throw Error("give a target: --faces, --ratio, --vertices, --max-error or --max-error-rel");
-  if (a.ratio < 0 || a.ratio > 1) throw Error("--ratio must be in (0, 1]");
   refuse_to_overwrite(a.input, a.output, a.force);
   SimplifyOptions opt = to_simplify_options(a.algorithm);
   // A record replays the contractions, and a refit moves every vertex after them, so `qem replay`
@@ -64,6 +61,7 @@ int run_simplify(const SimplifyArgs& a) {
   opt.target_vertices = a.vertices;
   if (a.max_error >= 0) opt.max_error = a.max_error;
   if (a.max_error_rel >= 0) opt.max_error = a.max_error_rel, opt.max_error_is_relative = true;
+  check_options(opt);  // before the input is read: a slip in the options is said at once
 
   const bool show_progress = !a.quiet && !a.json && ::isatty(STDERR_FILENO);
 

@@ -1,7 +1,8 @@
 #include "qem/mesh.h"
 
 #include <cmath>
-#include <limits>
+
+#include "geometry/box.h"
 
 namespace qem {
 
@@ -22,19 +23,6 @@ double Box::diagonal() const {
   return std::sqrt(dx * dx + dy * dy + dz * dz);
 }
 
-Box bounding_box(MeshView mesh) {
-  Box box;
-  if (mesh.positions.size() < 3) return box;
-  for (int k = 0; k < 3; ++k) {
-    box.lo[k] = std::numeric_limits<double>::infinity();
-    box.hi[k] = -std::numeric_limits<double>::infinity();
-  }
-  for (std::size_t i = 0; i + 2 < mesh.positions.size(); i += 3)
-    for (int k = 0; k < 3; ++k) {
-      box.lo[k] = std::fmin(box.lo[k], mesh.positions[i + k]);
-      box.hi[k] = std::fmax(box.hi[k], mesh.positions[i + k]);
-    }
-  return box;
-}
+Box bounding_box(MeshView mesh) { return box_of_points(mesh.positions); }
 
 }  // namespace qem

@@ -6,46 +6,12 @@
 #include <algorithm>
 
 #include "core/run.h"
+#include "core/settings.h"
 #include "qem/error.h"
 #include "refit/refit_after_simplify.h"
 #include "refit/refit_points.h"
 
 namespace qem {
-
-const char* to_string(StopReason reason) {
-  switch (reason) {
-    case StopReason::TargetReached: return "target reached";
-    case StopReason::ErrorLimit: return "error limit reached";
-    case StopReason::NoValidPair: return "no valid contraction left";
-    case StopReason::AlreadyBelowTarget: return "input already at or below target";
-    case StopReason::Cancelled: return "cancelled";
-  }
-  return "?";
-}
-const char* to_string(Weighting w) {
-  switch (w) {
-    case Weighting::Area: return "area";
-    case Weighting::Uniform: return "uniform";
-    case Weighting::Angle: return "angle";
-  }
-  return "?";
-}
-const char* to_string(Placement p) {
-  switch (p) {
-    case Placement::Optimal: return "optimal";
-    case Placement::Segment: return "segment";
-    case Placement::Midpoint: return "midpoint";
-    case Placement::Endpoints: return "endpoints";
-  }
-  return "?";
-}
-const char* to_string(Scheme s) {
-  switch (s) {
-    case Scheme::Greedy: return "greedy";
-    case Scheme::Passes: return "passes";
-  }
-  return "?";
-}
 
 RefitOptions refit_options_for(const SimplifyOptions& options) {
   RefitOptions r;
@@ -57,12 +23,17 @@ RefitOptions refit_options_for(const SimplifyOptions& options) {
   return r;
 }
 
+void check_options(const SimplifyOptions& options) {
+  core::validate(options);
+  if (options.refit_rounds > 0) refit_detail::check_options(refit_options_for(options));
+}
+
 namespace {
 
 SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options, SimplifyObserver* observer,
                                   std::vector<std::uint32_t>* consumed_indices) {
+  check_options(options);
   const bool refit = options.refit_rounds > 0;
-  if (refit) refit_detail::check_options(refit_options_for(options));
   // The refit fits the input's vertices weighted by their share of the area: taken before the
   // core releases a consumed input's faces.
   std::vector<double> weights;

@@ -53,6 +53,18 @@ const char* to_string(StopReason reason);
 const char* to_string(Weighting w);
 const char* to_string(Placement p);
 const char* to_string(Scheme s);
+// The names above and below come from one table per enum (src/option_names.cpp).
+const char* to_string(InversionPolicy policy);
+/// The value called `name` (a to_string name, which is also the command line's: "area", "off"):
+/// true and `out` set, or false and `out` unchanged if no value has that name.
+bool from_string(const std::string& name, Weighting& out);
+bool from_string(const std::string& name, Placement& out);
+bool from_string(const std::string& name, Scheme& out);
+bool from_string(const std::string& name, InversionPolicy& out);
+/// The names of all values of an option enum (Weighting, Placement, Scheme, InversionPolicy; no
+/// other is defined), in declaration order: the choices a front end offers.
+template <class Enum>
+std::vector<std::string> option_names();
 
 /// The whole contraction sequence of one run (GH97 §3: M_n, M_n-1, ..., M_g), in input vertex and
 /// face indices, so that any intermediate mesh can be rebuilt (see qem/progressive.h).
@@ -191,6 +203,10 @@ class ProgressCallback : public SimplifyObserver {
  private:
   std::function<bool(double)> fn_;
 };
+
+/// Throws qem::Error naming the first option out of its range, or a missing stop criterion.
+/// `simplify` checks its options first with it; callers can check before loading a large mesh.
+void check_options(const SimplifyOptions& options);
 
 /// Simplifies a mesh. Input positions are never normalised in the output: vertices that did not
 /// move keep their exact input coordinates. Deterministic: the same input and options give the

@@ -5,6 +5,7 @@
 
 #include "core/quadric.h"
 #include "core/valid_pairs.h"
+#include "geometry/vec3.h"
 #include "io/io_common.h"
 #include "qem/analyze.h"
 #include "qem/error.h"
@@ -110,7 +111,7 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> valid_pairs(const Mesh& mes
     std::vector<core::Edge> edges;
     edges.reserve(pairs.size());
     for (auto& [a, b] : pairs) edges.push_back({a, b, 1});
-    std::vector<core::Vec3> pos(nv);
+    std::vector<Vec3> pos(nv);
     for (std::size_t v = 0; v < nv; ++v)
       pos[v] = {mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2]};
     std::vector<std::uint32_t> candidates;

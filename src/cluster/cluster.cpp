@@ -15,13 +15,14 @@
 
 #include "check_mesh.h"
 #include "cluster/cluster_quadric.h"
+#include "core/quadric.h"
+#include "geometry/box.h"
+#include "geometry/vec3.h"
 #include "qem/error.h"
 
 namespace qem {
 
 namespace {
-
-using cluster_detail::ClusterQuadric;
 
 // 2^21 cells per axis keep the linear cell key within 63 bits.
 constexpr std::int64_t kMaxCellsPerAxis = std::int64_t(1) << 21;
@@ -46,21 +47,14 @@ struct Grid {
 
 Grid grid_of(MeshView mesh, const std::vector<char>& used, const ClusterOptions& o) {
   Grid g;
-  double hi[3];
-  bool first = true;
-  for (std::size_t v = 0; v < used.size(); ++v) {
-    if (!used[v]) continue;
-    const double* p = &mesh.positions[3 * v];
-    for (int k = 0; k < 3; ++k) {
-      g.lo[k] = first ? p[k] : std::min(g.lo[k], p[k]);
-      hi[k] = first ? p[k] : std::max(hi[k], p[k]);
-    }
-    first = false;
-  }
-  if (first) return g;  // no faces
+  BoxOfPoints points;
+  for (std::size_t v = 0; v < used.size(); ++v)
+    if (used[v]) points.add(&mesh.positions[3 * v]);
+  if (points.empty()) return g;  // no faces
+  const Box box = points.box();
   double extent[3];
-  for (int k = 0; k < 3; ++k) extent[k] = hi[k] - g.lo[k];
-  g.diag = std::sqrt(extent[0] * extent[0] + extent[1] * extent[1] + extent[2] * extent[2]);
+  for (int k = 0; k < 3; ++k) g.lo[k] = box.lo[k], extent[k] = box.hi[k] - box.lo[k];
+  g.diag = box.diagonal();
   const bool use_grid = o.grid[0] > 0 && o.grid[1] > 0 && o.grid[2] > 0;
   if (use_grid) {
     for (int k = 0; k < 3; ++k) {
@@ -125,22 +119,24 @@ std::vector<double> place(MeshView mesh, const std::vector<std::uint32_t>& clust
 
   // Lindstrom 2000: each face adds its area-weighted plane quadric to every distinct cluster it
   // touches, including faces that are about to vanish, so the cluster sees all the surface it covers.
-  std::vector<ClusterQuadric> quadric(count);
-  const double* P = mesh.positions.data();
+  std::vector<core::Quadric> quadric(count);
+  const auto point = [&](std::uint32_t v) {
+    const double* p = &mesh.positions[3 * std::size_t(v)];
+    return Vec3(p[0], p[1], p[2]);
+  };
   for (std::size_t f = 0; f < mesh.face_count(); ++f) {
     const std::uint32_t* t = &mesh.indices[3 * f];
-    const double *a = &P[3 * t[0]], *b = &P[3 * t[1]], *c = &P[3 * t[2]];
-    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]},
-                 w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
-    const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    const Vec3 a = point(t[0]);
+    const Vec3 n = cross(point(t[1]) - a, point(t[2]) - a);
+    const double len = length(n);
     if (!(len > 0)) continue;  // zero-area face: no plane
-    for (double& x : n) x /= len;
-    const double area = 0.5 * len;
+    // The plane through corner a with unit normal n / len (n.x + d = 0, d = -n.a), weighted by area.
+    const Vec3 unit = n / len;
+    const core::Quadric plane = core::Quadric::plane(unit, -dot(unit, a), 0.5 * len);
     const std::uint32_t c0 = cluster[t[0]], c1 = cluster[t[1]], c2 = cluster[t[2]];
-    quadric[c0].add_plane(n, a, area);
-    if (c1 != c0) quadric[c1].add_plane(n, a, area);
-    if (c2 != c0 && c2 != c1) quadric[c2].add_plane(n, a, area);
+    quadric[c0] += plane;
+    if (c1 != c0) quadric[c1] += plane;
+    if (c2 != c0 && c2 != c1) quadric[c2] += plane;
   }
   // Which cell each cluster is, to reject minimisers that leave it (a nearly parallel pair of
   // planes can put the minimiser far away, making a spike): those keep the mean.

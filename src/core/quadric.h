@@ -3,24 +3,9 @@
 // matrix, plus the total plane weight so that errors can be reported in distance units.
 #pragma once
 
-#include <cmath>
+#include "geometry/vec3.h"
 
 namespace qem::core {
-
-struct Vec3 {
-  double x = 0, y = 0, z = 0;
-  Vec3() = default;
-  Vec3(double x_, double y_, double z_) : x(x_), y(y_), z(z_) {}
-  Vec3 operator+(const Vec3& o) const { return {x + o.x, y + o.y, z + o.z}; }
-  Vec3 operator-(const Vec3& o) const { return {x - o.x, y - o.y, z - o.z}; }
-  Vec3 operator*(double s) const { return {x * s, y * s, z * s}; }
-  double operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }
-};
-inline double dot(const Vec3& a, const Vec3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-inline Vec3 cross(const Vec3& a, const Vec3& b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-inline double length(const Vec3& a) { return std::sqrt(dot(a, a)); }
 
 struct Quadric {
   // A (symmetric 3x3), b, c: the 10 numbers of GH97 §4.

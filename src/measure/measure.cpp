@@ -10,6 +10,8 @@
 
 #include "core/parallel_chunks.h"
 #include "core/spatial_order.h"
+#include "geometry/box.h"
+#include "geometry/vec3.h"
 #include "measure/bvh.h"
 #include "measure/surface_sampling.h"
 #include "qem/error.h"
@@ -36,8 +38,9 @@ Distances distances(const TriangleBvh& tree, const std::vector<double>& samples,
   const std::size_t ns = samples.size() / 3;
   std::vector<double> points = samples;
   points.insert(points.end(), vertices.begin(), vertices.end());
-  const std::vector<std::uint32_t> order = core::morton_order(
-      points.size() / 3, [&](std::size_t i) { return core::Vec3(points[3 * i], points[3 * i + 1], points[3 * i + 2]); });
+  const std::vector<std::uint32_t> order = core::morton_order(points.size() / 3, [&](std::size_t i) {
+    return Vec3(points[3 * i], points[3 * i + 1], points[3 * i + 2]);
+  });
   std::vector<double> d2(order.size());
   core::for_chunks(order.size(), kChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
     std::uint32_t hint = UINT32_MAX;  // reset per chunk: the warm start never crosses chunks
@@ -50,15 +53,6 @@ Distances distances(const TriangleBvh& tree, const std::vector<double>& samples,
     total.max_d = std::max(total.max_d, dist);
   }
   return total;
-}
-
-double diagonal_of(const std::vector<double>& xyz) {
-  if (xyz.empty()) return 0;
-  double lo[3] = {xyz[0], xyz[1], xyz[2]}, hi[3] = {xyz[0], xyz[1], xyz[2]};
-  for (std::size_t i = 0; i < xyz.size(); i += 3)
-    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], xyz[i + k]), hi[k] = std::max(hi[k], xyz[i + k]);
-  return std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                   (hi[2] - lo[2]) * (hi[2] - lo[2]));
 }
 
 }  // namespace
@@ -97,7 +91,7 @@ MeasureResult measure(MeshView original, MeshView approx, const MeasureOptions& 
   const Distances a2o = distances(tree_n, xi, options.include_vertices ? si.vertices : kNone, threads);
 
   MeasureResult r;
-  r.bbox_diag = diagonal_of(sn.vertices);
+  r.bbox_diag = box_of_points(sn.vertices).diagonal();
   r.area_original = sn.area, r.area_approx = si.area;
   r.samples_original = nn, r.samples_approx = ni;
   r.degenerate_original = sn.degenerate, r.degenerate_approx = si.degenerate;

@@ -31,6 +31,11 @@
 #include "check_mesh.h"
 #include "core/parallel_chunks.h"
 #include "core/spatial_order.h"
+#include "core/valid_pairs.h"
+#include "core/vertex_lists.h"
+#include "geometry/box.h"
+#include "geometry/frame.h"
+#include "geometry/vec3.h"
 #include "measure/bvh.h"
 #include "measure/point_triangle.h"
 #include "qem/error.h"
@@ -41,8 +46,6 @@ namespace qem {
 namespace refit_detail {
 
 namespace {
-
-using measure_detail::Vec3;
 
 constexpr std::size_t kChunk = 4096;  // queries per work item and per warm-start run
 /// lambda of the anchor, relative to the mean data weight of a vertex: small enough not to hold
@@ -60,12 +63,11 @@ constexpr double kMembrane = 0.3;
 Vec3 at(const std::vector<double>& x, std::uint32_t v) { return {x[3 * v], x[3 * v + 1], x[3 * v + 2]}; }
 
 Vec3 face_normal(const std::vector<double>& x, const std::uint32_t* t) {
-  return measure_detail::cross(at(x, t[1]) - at(x, t[0]), at(x, t[2]) - at(x, t[0]));
+  return cross(at(x, t[1]) - at(x, t[0]), at(x, t[2]) - at(x, t[0]));
 }
 
 /// Barycentric coordinates of q (a point of triangle abc) in abc; false if abc has no area.
 bool barycentric(Vec3 q, Vec3 a, Vec3 b, Vec3 c, double out[3]) {
-  using measure_detail::dot;
   const Vec3 e0 = b - a, e1 = c - a, d = q - a;
   const double d00 = dot(e0, e0), d01 = dot(e0, e1), d11 = dot(e1, e1), d20 = dot(d, e0), d21 = dot(d, e1);
   const double den = d00 * d11 - d01 * d01;
@@ -92,32 +94,30 @@ FitPoints::FitPoints(std::span<const double> points, std::span<const double> wei
   std::vector<std::uint32_t> used;  // the points with a weight
   for (std::size_t i = 0; i < weights.size(); ++i)
     if (weights[i] > 0) used.push_back(std::uint32_t(i));
-  // The frame: centre and diagonal of the points' box (the approximation's vertices lie near them).
-  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
-  for (std::uint32_t i : used)
-    for (int k = 0; k < 3; ++k)
-      lo[k] = std::min(lo[k], points[3 * i + k]), hi[k] = std::max(hi[k], points[3 * i + k]);
-  double d2 = 0;
-  for (int k = 0; k < 3; ++k) centre[k] = 0.5 * (lo[k] + hi[k]), d2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
-  diag = std::sqrt(d2);
-  if (used.empty() || !(diag > 0)) return;
+  // The frame of the points' box (the approximation's vertices lie near them). Points that all
+  // coincide leave nothing to fit.
+  const Box box = box_of_points(points, used);
+  const Frame f = frame_of_box(box);
+  centre = f.center, diag = f.scale;
+  if (used.empty() || !(box.diagonal() > 0)) return;
   position.resize(3 * used.size());
   weight.resize(used.size());
   for (std::size_t j = 0; j < used.size(); ++j) {
-    for (int k = 0; k < 3; ++k) position[3 * j + k] = (points[3 * used[j] + k] - centre[k]) / diag;
+    const double* p = &points[3 * std::size_t(used[j])];
+    const Vec3 q = f.to_frame({p[0], p[1], p[2]});
+    position[3 * j] = q.x, position[3 * j + 1] = q.y, position[3 * j + 2] = q.z;
     weight[j] = weights[used[j]];
     total_weight += weight[j];
   }
   source = std::move(used);
   order = core::morton_order(source.size(), [&](std::size_t j) {
-    return core::Vec3(position[3 * j], position[3 * j + 1], position[3 * j + 2]);
+    return Vec3(position[3 * j], position[3 * j + 1], position[3 * j + 2]);
   });
 }
 
 FitPoints FitPoints::thinned(std::size_t group) const {
   FitPoints out;
-  std::copy(centre, centre + 3, out.centre);
-  out.diag = diag;
+  out.centre = centre, out.diag = diag;
   const std::size_t n = order.size();
   for (std::size_t begin = 0; begin < n; begin += group) {
     const std::size_t end = std::min(n, begin + group);
@@ -211,11 +211,13 @@ class Refitter {
         tri_(approx.indices),
         pts_(points),
         near_vertex_(near_vertex),
-        centre_(points.centre),
-        diag_(points.diag) {
+        frame_(points.frame()) {
     if (pts_.weight.empty() || approx.indices.empty()) return;
     x_.resize(approx.positions.size());
-    for (std::size_t i = 0; i < x_.size(); ++i) x_[i] = (approx.positions[i] - centre_[i % 3]) / diag_;
+    for (std::size_t v = 0; v < approx.vertex_count(); ++v) {
+      const Vec3 q = frame_.to_frame(at(approx.positions, std::uint32_t(v)));
+      x_[3 * v] = q.x, x_[3 * v + 1] = q.y, x_[3 * v + 2] = q.z;
+    }
     fixed_.assign(approx.vertex_count(), 0);
     if (o.lock_border) mark_border();
     // Faces around each vertex (CSR), for the projections after the first.
@@ -237,7 +239,7 @@ class Refitter {
     if (!ready_) return r;
     const std::vector<double> start = x_;
     Projection proj = project(x_);
-    r.rms_before = r.rms_after = std::sqrt(proj.energy / pts_.total_weight) * diag_;
+    r.rms_before = r.rms_after = std::sqrt(proj.energy / pts_.total_weight) * frame_.scale;
     for (unsigned round = 0; round < opt_.rounds; ++round) {
       std::vector<double> next;
       if (!solve(proj, next)) break;
@@ -248,30 +250,29 @@ class Refitter {
       proj = std::move(next_proj);
       ++r.rounds;
       r.vertices_held += held;
-      r.rms_after = std::sqrt(proj.energy / pts_.total_weight) * diag_;
+      r.rms_after = std::sqrt(proj.energy / pts_.total_weight) * frame_.scale;
     }
     // Back to model coordinates; a vertex that did not move keeps its exact input coordinates.
-    for (std::size_t v = 0; v < approx_.vertex_count(); ++v)
-      if (x_[3 * v] != start[3 * v] || x_[3 * v + 1] != start[3 * v + 1] || x_[3 * v + 2] != start[3 * v + 2])
-        for (int k = 0; k < 3; ++k) approx_.positions[3 * v + k] = centre_[k] + x_[3 * v + k] * diag_;
+    for (std::size_t v = 0; v < approx_.vertex_count(); ++v) {
+      const double *now = &x_[3 * v], *was = &start[3 * v];
+      if (now[0] == was[0] && now[1] == was[1] && now[2] == was[2]) continue;
+      const Vec3 p = frame_.to_model({now[0], now[1], now[2]});
+      double* out = &approx_.positions[3 * v];
+      out[0] = p.x, out[1] = p.y, out[2] = p.z;
+    }
     return r;
   }
 
  private:
-  // Border vertices: on an edge that only one face has (edges as sorted vertex pairs, counted).
+  // Border vertices: on an edge that only one face has, found as the simplifier finds them
+  // (core::unique_edges), so that --lock-border holds the same vertices in both.
   void mark_border() {
-    std::vector<std::uint64_t> edges;
-    edges.reserve(tri_.size());
-    for (std::size_t f = 0; f < tri_.size(); f += 3)
-      for (int k = 0; k < 3; ++k) {
-        const std::uint64_t a = tri_[f + k], b = tri_[f + (k + 1) % 3];
-        edges.push_back(std::min(a, b) << 32 | std::max(a, b));
-      }
-    std::sort(edges.begin(), edges.end());
-    for (std::size_t i = 0, j; i < edges.size(); i = j) {
-      for (j = i + 1; j < edges.size() && edges[j] == edges[i];) ++j;
-      if (j - i == 1) fixed_[edges[i] >> 32] = fixed_[edges[i] & 0xffffffffu] = 1;
-    }
+    core::VertexLists faces;
+    faces.rebuild(fixed_.size(), [&](auto emit) {
+      for (std::size_t c = 0; c < tri_.size(); ++c) emit(tri_[c], std::uint32_t(c / 3));
+    });
+    for (const core::Edge& e : core::unique_edges(tri_, faces, fixed_.size()))
+      if (e.faces == 1) fixed_[e.lo] = fixed_[e.hi] = 1;
   }
 
   // Where each point lands on the approximation with vertices x. The first projection asks a tree
@@ -514,9 +515,9 @@ class Refitter {
       for (std::size_t f = 0; f < tri_.size(); f += 3) {
         const std::uint32_t* t = &tri_[f];
         const Vec3 before = face_normal(x_, t), after = face_normal(next, t);
-        const double bb = measure_detail::dot(before, before), aa = measure_detail::dot(after, after);
+        const double bb = dot(before, before), aa = dot(after, after);
         if (!(bb > 0)) continue;  // no area before: no direction to keep
-        if (measure_detail::dot(before, after) > cos_limit * std::sqrt(bb * aa)) continue;
+        if (dot(before, after) > cos_limit * std::sqrt(bb * aa)) continue;
         for (int k = 0; k < 3; ++k) {
           if (held[t[k]]) continue;
           held[t[k]] = 1, ++count, again = true;
@@ -532,9 +533,8 @@ class Refitter {
   const std::vector<std::uint32_t>& tri_;
   const FitPoints& pts_;
   std::span<const std::uint32_t> near_vertex_;
-  const double* centre_;
-  double diag_;
-  std::vector<double> x_;             // approximation vertices, normalised
+  const Frame frame_;      // of the points: x_ = frame_.to_frame(approx_'s positions)
+  std::vector<double> x_;  // approximation vertices, normalised
   std::vector<std::uint8_t> fixed_;
   std::vector<std::uint32_t> ring_start_, ring_faces_;  // faces around each vertex
   std::vector<std::uint32_t> ring_slot_;  // per corner of a face: its place in its vertex's ring
@@ -551,8 +551,8 @@ std::vector<double> vertex_areas(MeshView mesh) {
       const double* q = &mesh.positions[3 * std::size_t(t[k])];
       return Vec3{q[0], q[1], q[2]};
     };
-    const Vec3 n = measure_detail::cross(p(1) - p(0), p(2) - p(0));
-    const double third = std::sqrt(measure_detail::dot(n, n)) / 6;  // a third of half the cross product
+    const Vec3 n = cross(p(1) - p(0), p(2) - p(0));
+    const double third = std::sqrt(dot(n, n)) / 6;  // a third of half the cross product
     if (!std::isfinite(third)) continue;
     for (int k = 0; k < 3; ++k) area[t[k]] += third;
   }

@@ -6,6 +6,8 @@
 #include <span>
 #include <vector>
 
+#include "geometry/frame.h"
+#include "geometry/vec3.h"
 #include "qem/mesh.h"
 #include "qem/refit.h"
 
@@ -29,8 +31,11 @@ struct FitPoints {
   std::vector<double> weight;        ///< one per kept point
   std::vector<std::uint32_t> order;  ///< Morton order of the kept points (warm-started queries)
   std::vector<std::uint32_t> source;  ///< index of each kept point among the points given
-  double centre[3] = {0, 0, 0};      ///< the frame: centre and diagonal of the kept points' box
-  double diag = 0;
+  /// The frame of the kept points' box (geometry/frame.h), in which `position` is given: its
+  /// centre and scale (the box's diagonal).
+  Vec3 centre;
+  double diag = 1;
+  Frame frame() const { return {centre, diag}; }
   double total_weight = 0;
 };
 

@@ -6,6 +6,8 @@
 #include <numbers>
 #include <vector>
 
+#include "geometry/box.h"
+#include "geometry/vec3.h"
 #include "qem/error.h"
 #include "view/scene.h"
 
@@ -30,19 +32,6 @@ std::array<double, 3> heat_color(double t) {
 
 namespace {
 
-struct Vec3 {
-  double x, y, z;
-};
-Vec3 operator-(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-Vec3 operator+(Vec3 a, Vec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-Vec3 operator*(Vec3 a, double s) { return {a.x * s, a.y * s, a.z * s}; }
-double dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-Vec3 cross(Vec3 a, Vec3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
-Vec3 normalized(Vec3 a) {
-  double l = std::sqrt(dot(a, a));
-  return l > 0 ? a * (1 / l) : Vec3{0, 0, 0};
-}
-
 // The page's look: light grey-blue surface on a light background.
 constexpr double kBase[3] = {0.72, 0.76, 0.82};
 constexpr double kBackground[3] = {0.96, 0.96, 0.96};
@@ -64,7 +53,7 @@ Image render_mesh(const Mesh& mesh, const RenderOptions& o) {
 
   // Frame the bounding sphere of the box, as the page does (scene.cpp's centre and radius).
   Box box = bounding_box(mesh);
-  Vec3 center{0.5 * (box.lo[0] + box.hi[0]), 0.5 * (box.lo[1] + box.hi[1]), 0.5 * (box.lo[2] + box.hi[2])};
+  Vec3 center = box_center(box);
   double radius = 0.5 * box.diagonal();
   if (!(radius > 0)) radius = 1;
   const double deg = std::numbers::pi / 180;

@@ -5,6 +5,8 @@
 #include <bit>
 #include <cstdint>
 
+#include "geometry/box.h"
+#include "geometry/vec3.h"
 #include "qem/error.h"
 #include "view/json.h"
 
@@ -43,14 +45,11 @@ std::map<std::string, std::string> scene_files(const ViewScene& scene) {
                 std::to_string(scene.levels.size()));
 
   // One frame for all levels: the page centres and zooms once, so switching levels never jumps.
-  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  BoxOfPoints all;
   double dlo = INFINITY, dhi = -INFINITY;
   for (const ViewLevel& level : scene.levels) {
     const Mesh& m = level.mesh;
-    for (std::size_t i = 0; i < m.positions.size(); ++i) {
-      lo[i % 3] = std::min(lo[i % 3], m.positions[i]);
-      hi[i % 3] = std::max(hi[i % 3], m.positions[i]);
-    }
+    all.add_all(m.positions);
     for (std::uint32_t idx : m.indices)
       if (idx >= m.vertex_count())
         throw Error(level.name + ": face index " + std::to_string(idx) + " out of range (" +
@@ -59,12 +58,10 @@ std::map<std::string, std::string> scene_files(const ViewScene& scene) {
       for (double x : d->values)
         if (std::isfinite(x)) dlo = std::min(dlo, x), dhi = std::max(dhi, x);
   }
-  double center[3] = {0, 0, 0}, radius = 1;
-  if (lo[0] <= hi[0]) {
-    double d2 = 0;
-    for (int k = 0; k < 3; ++k) center[k] = 0.5 * (lo[k] + hi[k]), d2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
-    radius = d2 > 0 ? 0.5 * std::sqrt(d2) : 1;
-  }
+  // The bounding sphere of the box (no vertex, or one point: centre 0 or that point, radius 1).
+  const Box box = all.box();
+  const Vec3 center = box_center(box);
+  const double radius = box.diagonal() > 0 ? 0.5 * box.diagonal() : 1;
 
   std::map<std::string, std::string> files;
   std::string json = "{\n  \"format\": \"qem-view\",\n  \"version\": 1,\n";
@@ -82,7 +79,7 @@ std::map<std::string, std::string> scene_files(const ViewScene& scene) {
     std::string base = "data/level" + std::to_string(li);
     std::string pos, idx, dist;
     pos.reserve(m.positions.size() * 4);
-    for (std::size_t i = 0; i < m.positions.size(); ++i) put_f32(pos, m.positions[i] - center[i % 3]);
+    for (std::size_t i = 0; i < m.positions.size(); ++i) put_f32(pos, m.positions[i] - center[int(i % 3)]);
     idx.reserve(m.indices.size() * 4);
     for (std::uint32_t v : m.indices) put_u32(idx, v);
     files[base + ".pos.f32"] = std::move(pos);
