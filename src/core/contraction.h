@@ -158,7 +158,7 @@ inline void report_contraction(Context& c, double error, Worker& w) {
   const WorkingMesh& m = c.mesh;
   const Vec3 p = m.output_position(w.last_kept, c.input);
   const Contraction event{m.source_vertex[w.last_kept], m.source_vertex[w.last_removed], {p.x, p.y, p.z},
-                          error * m.scale, w.dead_faces};
+                          error * m.frame.scale, w.dead_faces};
   c.observer->on_contraction(event);
   w.dead_faces.clear();
 }

@@ -76,7 +76,7 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   if (hooks.observer && result.stop_reason != StopReason::Cancelled) hooks.observer->on_progress(1.0);
 
   result.max_error_relative = c.max_error;
-  result.max_error = c.max_error * mesh.scale;
+  result.max_error = c.max_error * mesh.frame.scale;
   result.stop_detail = stop_detail(result.stop_reason, result, settings.lock_border);
   finish(c, map, input, result);
   return result;

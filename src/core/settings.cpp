@@ -33,10 +33,10 @@ Settings resolve(const SimplifyOptions& o, const WorkingMesh& mesh) {
   }
   s.target_vertices = o.target_vertices;
   s.max_error = std::numeric_limits<double>::infinity();
-  if (std::isfinite(o.max_error)) s.max_error = o.max_error_is_relative ? o.max_error : o.max_error / mesh.scale;
+  if (std::isfinite(o.max_error)) s.max_error = o.max_error_is_relative ? o.max_error : o.max_error / mesh.frame.scale;
   s.weighting = o.weighting;
   s.placement = o.placement;
-  s.threshold = o.threshold_is_relative ? o.threshold : o.threshold / mesh.scale;
+  s.threshold = o.threshold_is_relative ? o.threshold : o.threshold / mesh.frame.scale;
   s.boundary_weight = o.boundary_weight;
   s.lock_border = o.lock_border;
   s.inversion = o.inversion;

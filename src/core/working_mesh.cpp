@@ -36,28 +36,19 @@ std::vector<std::uint32_t> referenced_vertices(MeshView in, std::size_t& degener
 // The frame: centre and diagonal of the referenced vertices' bounding box.
 void set_frame(MeshView in, const std::vector<std::uint32_t>& used, WorkingMesh& m) {
   if (used.empty()) return;
-  constexpr double kInf = std::numeric_limits<double>::infinity();
-  double lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
-  for (std::uint32_t v : used)
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], in.positions[3 * v + k]);
-      hi[k] = std::max(hi[k], in.positions[3 * v + k]);
-    }
+  const Box box = box_of_points(in.positions, used);
   // Beyond 1e300 the quadrics (squared distances times areas) overflow double precision.
   for (int k = 0; k < 3; ++k)
-    if (!(std::fabs(lo[k]) <= 1e300 && std::fabs(hi[k]) <= 1e300))
+    if (!(std::fabs(box.lo[k]) <= 1e300 && std::fabs(box.hi[k]) <= 1e300))
       throw Error("coordinates beyond 1e300 in magnitude cannot be simplified in double precision");
-  m.center = {lo[0] / 2 + hi[0] / 2, lo[1] / 2 + hi[1] / 2, lo[2] / 2 + hi[2] / 2};
-  m.scale = length(Vec3(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]));
-  if (!(m.scale > 0) || !std::isfinite(m.scale)) m.scale = 1;
+  m.frame = frame_of_box(box);
 }
 
 // Working vertices numbered along a Morton curve (memory locality, spatial_order.h); returns each
 // input vertex's working index.
 std::vector<std::uint32_t> number_vertices(MeshView in, std::vector<std::uint32_t> used, WorkingMesh& m) {
   auto normalized = [&](std::uint32_t v) {
-    return (Vec3(in.positions[3 * v], in.positions[3 * v + 1], in.positions[3 * v + 2]) - m.center) *
-           (1.0 / m.scale);
+    return m.frame.to_frame_by_reciprocal(Vec3(in.positions[3 * v], in.positions[3 * v + 1], in.positions[3 * v + 2]));
   };
   m.source_vertex = morton_order(used.size(), [&](std::size_t i) { return normalized(used[i]); });
   for (std::uint32_t& v : m.source_vertex) v = used[v];

@@ -10,6 +10,7 @@
 
 #include "core/quadric.h"
 #include "core/vertex_lists.h"
+#include "geometry/frame.h"
 #include "qem/mesh.h"
 
 namespace qem::core {
@@ -18,9 +19,7 @@ namespace qem::core {
 inline constexpr std::uint32_t kNoVertex = 0xffffffffu;
 
 struct WorkingMesh {
-  // The normalised frame: p_work = (p_in - center) / scale (unit bounding-box diagonal).
-  Vec3 center;
-  double scale = 1;
+  Frame frame;  ///< of the referenced vertices: p_work = (p_in - center) * (1 / scale)
 
   std::vector<Vec3> pos;
   std::vector<std::uint32_t> tri;            ///< 3 per working face
@@ -52,7 +51,7 @@ struct WorkingMesh {
   }
   /// A vertex's position in the input's frame: its exact input coordinates if it never moved.
   Vec3 output_position(std::uint32_t v, MeshView input) const {
-    if (moved[v]) return pos[v] * scale + center;
+    if (moved[v]) return frame.to_model(pos[v]);
     const double* p = &input.positions[3 * std::size_t(source_vertex[v])];
     return {p[0], p[1], p[2]};
   }
