@@ -1,8 +1,8 @@
 // The local HTTP server of `qem view`: serves a FileSet from memory, GET and HEAD only, on
 // 127.0.0.1 only (never another interface: the page is for the local user). Requests are parsed by
-// cpp-httplib, a maintained parser, so no HTTP parsing of our own faces the network. Each
-// connection is answered once and closed, so a browser's idle pre-connected sockets never hold a
-// worker that the requests that matter need.
+// cpp-httplib, a maintained parser, not by code of our own. Each connection is answered once and
+// closed, and up to 32 are served at once, so a browser's idle pre-connected sockets (dropped after
+// httplib's 5 s timeout) never hold up the requests that matter.
 #pragma once
 
 #include <atomic>
