@@ -1,11 +1,13 @@
-// A tiny HTTP/1.1 static file server for `qem view`: serves a FileSet from memory, GET and HEAD
-// only, on 127.0.0.1 only (never another interface: the page is for the local user). Each
-// connection is answered once and closed; one thread per connection so a browser's idle
-// pre-connected sockets never hold up the requests that matter.
+// The local HTTP server of `qem view`: serves a FileSet from memory, GET and HEAD only, on
+// 127.0.0.1 only (never another interface: the page is for the local user). Requests are parsed by
+// cpp-httplib, a maintained parser, not by code of our own. Each connection is answered once and
+// closed, and up to 32 are served at once, so a browser's idle pre-connected sockets (dropped after
+// httplib's 5 s timeout) never hold up the requests that matter.
 #pragma once
 
 #include <atomic>
 #include <cstdint>
+#include <memory>
 #include <string>
 
 #include "view/web_assets.h"
@@ -14,7 +16,7 @@ namespace qem::view {
 
 class HttpServer {
  public:
-  /// Binds 127.0.0.1:`port` (0 = any free port) and listens. Throws qem::Error on failure.
+  /// Binds 127.0.0.1:`port` (0 = any free port). Throws qem::Error on failure (e.g. port in use).
   HttpServer(FileSet files, std::uint16_t port);
   ~HttpServer();
   HttpServer(const HttpServer&) = delete;
@@ -25,16 +27,17 @@ class HttpServer {
   /// "http://127.0.0.1:PORT/".
   std::string url() const;
   /// Answers requests until `stop` becomes true (checked at least every 100 ms), then waits for
-  /// the connections in flight.
+  /// the connections in flight. Throws qem::Error if the server fails before that.
   void serve(const std::atomic<bool>& stop);
   /// The number of requests answered so far (for tests and the log).
   std::size_t requests() const { return requests_.load(); }
 
  private:
-  void handle(int fd);
-
+  // The httplib::Server, behind a pointer so that only http_server.cpp sees httplib.h and the
+  // build options it needs.
+  class Impl;
   FileSet files_;
-  int listen_fd_ = -1;
+  std::unique_ptr<Impl> server_;
   std::uint16_t port_ = 0;
   std::atomic<std::size_t> requests_{0};
 };

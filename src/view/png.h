@@ -1,6 +1,4 @@
-// A dependency-free PNG encoder for `qem render`: 8-bit RGB, zlib stream of stored (uncompressed)
-// deflate blocks, CRC-32 and Adler-32 computed here. Larger than a compressed PNG but exact,
-// deterministic and needing no library.
+// The pictures of `qem render` and their PNG encoding (8-bit RGB, through libpng).
 #pragma once
 
 #include <cstdint>
@@ -14,11 +12,8 @@ struct Image {
   std::vector<std::uint8_t> rgb;  ///< 3 bytes per pixel, rows top to bottom
 };
 
-/// The PNG file bytes of an image.
+/// The PNG file bytes of an image. Throws qem::Error when the pixels do not match the size.
 std::string encode_png(const Image& image);
-
-/// CRC-32 (ISO 3309, as PNG chunks use) of `size` bytes.
-std::uint32_t crc32(const std::uint8_t* data, std::size_t size, std::uint32_t crc = 0);
 
 /// Writes the PNG atomically (temporary file, then rename). Throws qem::Error on failure.
 void save_png(const std::string& path, const Image& image);

@@ -4,11 +4,11 @@
 #include <algorithm>
 #include <bit>
 #include <cstdint>
+#include <nlohmann/json.hpp>
 
 #include "geometry/box.h"
 #include "geometry/vec3.h"
 #include "qem/error.h"
-#include "view/json.h"
 
 namespace qem::view {
 
@@ -63,16 +63,17 @@ std::map<std::string, std::string> scene_files(const ViewScene& scene) {
   const Vec3 center = box_center(box);
   const double radius = box.diagonal() > 0 ? 0.5 * box.diagonal() : 1;
 
+  // Keys in the order docs/viewer.md lists them, for whoever reads the file.
+  using json = nlohmann::ordered_json;
+  json doc = {{"format", "qem-view"},
+              {"version", 1},
+              {"mode", to_string(scene.mode)},
+              {"title", scene.title},
+              {"center", {center[0], center[1], center[2]}},
+              {"radius", radius},
+              {"distance_range", dlo <= dhi ? json{dlo, dhi} : json()},
+              {"levels", json::array()}};
   std::map<std::string, std::string> files;
-  std::string json = "{\n  \"format\": \"qem-view\",\n  \"version\": 1,\n";
-  json += "  \"mode\": " + json_quote(to_string(scene.mode)) + ",\n";
-  json += "  \"title\": " + json_quote(scene.title) + ",\n";
-  json += "  \"center\": [" + json_number(center[0]) + ", " + json_number(center[1]) + ", " +
-          json_number(center[2]) + "],\n";
-  json += "  \"radius\": " + json_number(radius) + ",\n";
-  json += "  \"distance_range\": " +
-          (dlo <= dhi ? "[" + json_number(dlo) + ", " + json_number(dhi) + "]" : std::string("null")) + ",\n";
-  json += "  \"levels\": [";
   for (std::size_t li = 0; li < scene.levels.size(); ++li) {
     const ViewLevel& level = scene.levels[li];
     const Mesh& m = level.mesh;
@@ -84,24 +85,21 @@ std::map<std::string, std::string> scene_files(const ViewScene& scene) {
     for (std::uint32_t v : m.indices) put_u32(idx, v);
     files[base + ".pos.f32"] = std::move(pos);
     files[base + ".idx.u32"] = std::move(idx);
-    json += li ? ",\n    {" : "\n    {";
-    json += "\"name\": " + json_quote(level.name);
-    json += ", \"faces\": " + std::to_string(m.face_count());
-    json += ", \"vertices\": " + std::to_string(m.vertex_count());
-    json += ", \"error\": " + json_number(level.error);
-    json += ", \"positions\": " + json_quote(base + ".pos.f32");
-    json += ", \"indices\": " + json_quote(base + ".idx.u32");
+    // An unknown error (NaN) is written as null.
+    json entry = {{"name", level.name},   {"faces", m.face_count()},        {"vertices", m.vertex_count()},
+                  {"error", level.error}, {"positions", base + ".pos.f32"}, {"indices", base + ".idx.u32"}};
     const VertexProperty* d = m.find_property(kHeatProperty);
     if (d && d->values.size() == m.vertex_count()) {
       dist.reserve(d->values.size() * 4);
       for (double x : d->values) put_f32(dist, std::isfinite(x) ? x : 0.0);
       files[base + ".dist.f32"] = std::move(dist);
-      json += ", \"distance\": " + json_quote(base + ".dist.f32");
+      entry["distance"] = base + ".dist.f32";
     }
-    json += "}";
+    doc["levels"].push_back(std::move(entry));
   }
-  json += "\n  ]\n}\n";
-  files["data/scene.json"] = std::move(json);
+  // Names and titles come from file names, which need not be UTF-8: such bytes become U+FFFD
+  // rather than an exception (JSON text must be UTF-8).
+  files["data/scene.json"] = doc.dump(2, ' ', false, json::error_handler_t::replace) + "\n";
   return files;
 }
 

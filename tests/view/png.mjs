@@ -1,5 +1,5 @@
-// Decodes the PNGs Chromium writes (8-bit RGB or RGBA, not interlaced) with Node's zlib, so the
-// test can look at the pixels of a screenshot without any image package.
+// Decodes the PNGs Chromium and `qem render` write (8-bit RGB or RGBA, not interlaced) with Node's
+// zlib, so the test can look at the pixels of a screenshot without any image package.
 import { inflateSync } from 'node:zlib';
 
 export function decodePng(buf) {

@@ -63,6 +63,7 @@ TEST_F(ViewHttp, ServesFilesWithTypesAndLengths) {
   EXPECT_NE(r.find("Content-Type: text/html"), std::string::npos);
   EXPECT_NE(r.find("Content-Length: 18\r\n"), std::string::npos);
   EXPECT_EQ(r.substr(r.size() - 18), "<html>hello</html>");
+  EXPECT_NE(r.find("Cache-Control: no-store\r\n"), std::string::npos);  // the data changes between runs
   r = get("/data/scene.json?x=1");
   EXPECT_NE(r.find("application/json"), std::string::npos) << r;
   r = get("/data/level0.pos.f32");
@@ -73,7 +74,9 @@ TEST_F(ViewHttp, ServesFilesWithTypesAndLengths) {
 TEST_F(ViewHttp, AnswersErrorsWithoutTouchingTheFileSystem) {
   EXPECT_EQ(get("/missing.js").rfind("HTTP/1.1 404", 0), 0u);
   EXPECT_EQ(get("/../../etc/passwd").rfind("HTTP/1.1 404", 0), 0u);
-  EXPECT_EQ(request(server_->port(), "POST / HTTP/1.1\r\n\r\n").rfind("HTTP/1.1 405", 0), 0u);
+  std::string post = request(server_->port(), "POST / HTTP/1.1\r\nContent-Length: 3\r\n\r\nabc");
+  EXPECT_EQ(post.rfind("HTTP/1.1 405", 0), 0u) << post;
+  EXPECT_NE(post.find("Allow: GET, HEAD\r\n"), std::string::npos);
   EXPECT_EQ(request(server_->port(), "garbage\r\n\r\n").rfind("HTTP/1.1 400", 0), 0u);
   std::string head = request(server_->port(), "HEAD /index.html HTTP/1.1\r\n\r\n");
   EXPECT_EQ(head.rfind("HTTP/1.1 200", 0), 0u);
@@ -96,8 +99,18 @@ TEST_F(ViewHttp, AClientThatSaysNothingDoesNotBlockOthers) {
 
 TEST(ViewHttpBind, APortInUseIsAClearError) {
   HttpServer server({}, 0);
-  // The port is taken on 127.0.0.1: a second server on it must throw qem::Error, not crash.
+  // The port is taken on 127.0.0.1: a second server on it must throw qem::Error, not crash, and
+  // not share the port either (httplib's default SO_REUSEPORT would let it).
   EXPECT_THROW(HttpServer({}, server.port()), Error);
+}
+
+TEST(ViewHttpBind, AServerDestroyedWithoutServingFreesItsPort) {
+  std::uint16_t port = 0;
+  {
+    HttpServer unused({}, 0);
+    port = unused.port();
+  }
+  EXPECT_NO_THROW(HttpServer({}, port));
 }
 
 }  // namespace

@@ -2,14 +2,16 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <nlohmann/json.hpp>
 
 #include "qem/error.h"
 #include "test_meshes.h"
-#include "view/json.h"
 #include "view/scene.h"
 
 namespace qem::view {
 namespace {
+
+using nlohmann::json;
 
 std::vector<float> floats(const std::string& bytes) {
   std::vector<float> out(bytes.size() / 4);
@@ -30,27 +32,27 @@ ViewScene chain_scene() {
 TEST(ViewScene, DescribesEveryLevelAndWritesItsBuffers) {
   auto files = scene_files(chain_scene());
   ASSERT_TRUE(files.count("data/scene.json"));
-  JsonValue doc = parse_json(files["data/scene.json"], "scene.json");
-  EXPECT_EQ(doc.find("format")->string, "qem-view");
-  EXPECT_EQ(doc.find("mode")->string, "chain");
-  EXPECT_TRUE(doc.find("distance_range")->is_null());
-  const auto& levels = doc.find("levels")->array;
+  json doc = json::parse(files["data/scene.json"]);
+  EXPECT_EQ(doc["format"], "qem-view");
+  EXPECT_EQ(doc["mode"], "chain");
+  EXPECT_TRUE(doc["distance_range"].is_null());
+  const json& levels = doc["levels"];
   ASSERT_EQ(levels.size(), 2u);
-  EXPECT_EQ(levels[0].find("faces")->number, 320);
-  EXPECT_EQ(levels[0].find("vertices")->number, 162);
-  EXPECT_EQ(levels[1].find("faces")->number, 80);
-  EXPECT_EQ(levels[1].find("error")->number, 0.05);
-  for (const JsonValue& l : levels) {
-    const std::string& pos = files.at(l.find("positions")->string);
-    const std::string& idx = files.at(l.find("indices")->string);
-    EXPECT_EQ(pos.size(), 12 * static_cast<std::size_t>(l.find("vertices")->number));
-    EXPECT_EQ(idx.size(), 12 * static_cast<std::size_t>(l.find("faces")->number));
-    EXPECT_EQ(l.find("distance"), nullptr);
+  EXPECT_EQ(levels[0]["faces"], 320);
+  EXPECT_EQ(levels[0]["vertices"], 162);
+  EXPECT_EQ(levels[1]["faces"], 80);
+  EXPECT_EQ(levels[1]["error"], 0.05);
+  for (const json& l : levels) {
+    const std::string& pos = files.at(l["positions"]);
+    const std::string& idx = files.at(l["indices"]);
+    EXPECT_EQ(pos.size(), 12 * l["vertices"].get<std::size_t>());
+    EXPECT_EQ(idx.size(), 12 * l["faces"].get<std::size_t>());
+    EXPECT_FALSE(l.contains("distance"));
   }
   // Centred: the stored coordinates lie within the unit sphere, the centre holds the offset.
-  EXPECT_NEAR(doc.find("center")->array[0].number, 1000, 1e-9);
+  EXPECT_NEAR(doc["center"][0].get<double>(), 1000, 1e-9);
   for (float x : floats(files.at("data/level0.pos.f32"))) EXPECT_LE(std::abs(x), 1.0001f);
-  EXPECT_NEAR(doc.find("radius")->number, std::sqrt(3.0), 1e-3);
+  EXPECT_NEAR(doc["radius"].get<double>(), std::sqrt(3.0), 1e-3);
 }
 
 TEST(ViewScene, IndicesAreStoredUnchanged) {
@@ -61,8 +63,9 @@ TEST(ViewScene, IndicesAreStoredUnchanged) {
   std::vector<std::uint32_t> got(idx.size() / 4);
   std::memcpy(got.data(), idx.data(), idx.size());
   EXPECT_EQ(got, s.levels[0].mesh.indices);
-  EXPECT_EQ(parse_json(files["data/scene.json"], "s").find("mode")->string, "single");
-  EXPECT_TRUE(parse_json(files["data/scene.json"], "s").find("levels")->array[0].find("error")->is_null());
+  json doc = json::parse(files["data/scene.json"]);
+  EXPECT_EQ(doc["mode"], "single");
+  EXPECT_TRUE(doc["levels"][0]["error"].is_null());  // unknown (NaN) is null, not invalid JSON
 }
 
 TEST(ViewScene, ExportsTheDistancePropertyAndItsRange) {
@@ -73,14 +76,27 @@ TEST(ViewScene, ExportsTheDistancePropertyAndItsRange) {
   m.vertex_properties.push_back(d);
   s.levels.push_back({"heat", m});
   auto files = scene_files(s);
-  JsonValue doc = parse_json(files["data/scene.json"], "s");
-  const auto& range = doc.find("distance_range")->array;
+  json doc = json::parse(files["data/scene.json"]);
+  const json& range = doc["distance_range"];
   ASSERT_EQ(range.size(), 2u);
-  EXPECT_NEAR(range[0].number, -0.5, 1e-12);
-  EXPECT_NEAR(range[1].number, 1.5, 1e-12);
-  auto values = floats(files.at(doc.find("levels")->array[0].find("distance")->string));
+  EXPECT_NEAR(range[0].get<double>(), -0.5, 1e-12);
+  EXPECT_NEAR(range[1].get<double>(), 1.5, 1e-12);
+  auto values = floats(files.at(doc["levels"][0]["distance"]));
   ASSERT_EQ(values.size(), m.vertex_count());
   EXPECT_FLOAT_EQ(values[3], static_cast<float>(d.values[3]));
+}
+
+TEST(ViewScene, NamesThatAreNotUtf8StillGiveValidJson) {
+  // File names are bytes: a Latin-1 "café.ply" must not break the page's JSON.
+  ViewScene s;
+  s.title = "caf\xe9";
+  s.levels.push_back({"caf\xe9.ply", test::cube()});
+  auto files = scene_files(s);
+  json doc = json::parse(files["data/scene.json"]);  // throws on invalid UTF-8
+  EXPECT_EQ(doc["title"], "caf\xef\xbf\xbd");        // U+FFFD
+  EXPECT_EQ(doc["levels"][0]["name"], "caf\xef\xbf\xbd.ply");
+  s.title = "quote \" backslash \\ newline \n";
+  EXPECT_EQ(json::parse(scene_files(s)["data/scene.json"])["title"], s.title);
 }
 
 TEST(ViewScene, IsDeterministic) { EXPECT_EQ(scene_files(chain_scene()), scene_files(chain_scene())); }

@@ -2,7 +2,8 @@
 // playwright-core; no browser download). Starts `qem view` servers on free ports of 127.0.0.1,
 // loads the page, moves the LOD slider, toggles shading / wireframe / heat map, orbits and zooms
 // with the mouse, checks compare mode and a static export served by a plain HTTP server, and
-// checks that every screenshot shows a mesh (decoded with node:zlib, see png.mjs).
+// checks that every screenshot shows a mesh (decoded with node:zlib, see png.mjs). Also checks
+// that Chromium decodes a `qem render` PNG to the pixels the file holds.
 // Env: QEM (the qem binary), MESH_DIR (from make_meshes.mjs), OUT_DIR (screenshots).
 // Prints one line per check and a final `N passed, M failed`; exits non-zero on any failure.
 import { spawn, spawnSync } from 'node:child_process';
@@ -235,6 +236,33 @@ test('several meshes on the command line form a chain; errors are measured when 
     check(e > 0.03 && e < 0.3, `measured error ${e} out of the plausible range`);
     await page.close();
   } finally { stopQem(s); }
+});
+
+test('qem render: Chromium reads its PNG and sees the same pixels', async (ctx) => {
+  const dir = mkdtempSync(join(tmpdir(), 'qem-render-'));
+  try {
+    const file = join(dir, 'render.png');
+    const r = spawnSync(QEM, ['render', 'sphere_distance.ply', file, '--width', '160', '--height', '120'],
+      { cwd: MESH_DIR, encoding: 'utf8' });
+    check(r.status === 0, `qem render failed: ${r.stderr}`);
+    const bytes = readFileSync(file), want = decodePng(bytes);
+    const page = await ctx.browser.newPage();
+    await page.setContent(`<img src="data:image/png;base64,${bytes.toString('base64')}">`);
+    const got = await page.evaluate(async () => {
+      const img = document.querySelector('img');
+      await img.decode();
+      const c = document.createElement('canvas');
+      c.width = img.naturalWidth; c.height = img.naturalHeight;
+      const g = c.getContext('2d');
+      g.drawImage(img, 0, 0);
+      return { width: c.width, height: c.height, data: Array.from(g.getImageData(0, 0, c.width, c.height).data) };
+    });
+    await page.close();
+    check(got.width === 160 && got.height === 120, `Chromium sees a ${got.width}x${got.height} picture`);
+    const wrong = differs(want, { data: got.data });
+    check(wrong === 0, `${wrong} pixels differ between Chromium's decoding and the file's`);
+    check(regionStats(want).saturated > 500, 'the heat map is missing from the picture');
+  } finally { rmSync(dir, { recursive: true, force: true }); }
 });
 
 async function run() {

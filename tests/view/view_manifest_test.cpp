@@ -1,49 +1,40 @@
-// The viewer's JSON reader/writer and the LOD manifest format (src/view/json.h, lod_manifest.h).
+// The LOD manifest format (src/view/lod_manifest.h): levels, counts, errors, and malformed JSON.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "qem/error.h"
-#include "view/json.h"
 #include "view/lod_manifest.h"
 
 namespace qem::view {
 namespace {
 
-TEST(ViewJson, ParsesNestedValuesAndEscapes) {
-  JsonValue v = parse_json(R"({"a": [1, -2.5e3, true, false, null], "s": "x\"\u00e9\n", "o": {}})", "t.json");
-  ASSERT_TRUE(v.is_object());
-  const JsonValue* a = v.find("a");
-  ASSERT_TRUE(a && a->is_array());
-  ASSERT_EQ(a->array.size(), 5u);
-  EXPECT_EQ(a->array[0].number, 1);
-  EXPECT_EQ(a->array[1].number, -2500);
-  EXPECT_TRUE(a->array[2].boolean);
-  EXPECT_TRUE(a->array[4].is_null());
-  EXPECT_EQ(v.find("s")->string, "x\"\xc3\xa9\n");
-  EXPECT_TRUE(v.find("o")->is_object());
-  EXPECT_EQ(v.find("missing"), nullptr);
-}
-
-TEST(ViewJson, ErrorsNameTheFileAndLine) {
+TEST(ViewManifest, JsonErrorsNameTheFileLineAndColumn) {
   try {
-    parse_json("{\n  \"a\": 1,\n  \"b\": tru\n}", "m.json");
+    parse_lod_manifest("{\n  \"levels\": [\"a.ply\",\n  tru]\n}", "m.json");
     FAIL() << "no error";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("m.json:3:"), std::string::npos) << e.what();
+    // The end of the bad token "tru]": line 3, column 6.
+    EXPECT_EQ(std::string(e.what()).rfind("m.json:3:6: invalid JSON: ", 0), 0u) << e.what();
   }
-  EXPECT_THROW(parse_json("[1, 2", "x"), Error);
-  EXPECT_THROW(parse_json("[1] 2", "x"), Error);
-  EXPECT_THROW(parse_json("\"unterminated", "x"), Error);
-  EXPECT_THROW(parse_json(std::string(1000, '['), "x"), Error);  // depth limit, not a stack overflow
+  EXPECT_THROW(parse_lod_manifest("[\"caf\xe9.ply\"]", "x"), Error);  // JSON text is UTF-8
+  EXPECT_THROW(parse_lod_manifest("[\"a.ply\", ", "x"), Error);
+  EXPECT_THROW(parse_lod_manifest("[\"a.ply\"] 2", "x"), Error);
+  EXPECT_THROW(parse_lod_manifest("[\"unterminated", "x"), Error);
+  EXPECT_THROW(parse_lod_manifest("", "x"), Error);
 }
 
-TEST(ViewJson, WritesQuotedStringsAndNumbers) {
-  EXPECT_EQ(json_quote("a\"b\\c\n\x01"), "\"a\\\"b\\\\c\\n\\u0001\"");
-  EXPECT_EQ(json_number(0.1), "0.1");
-  EXPECT_EQ(json_number(1280), "1280");
-  EXPECT_EQ(json_number(NAN), "null");
-  EXPECT_EQ(json_number(INFINITY), "null");
+TEST(ViewManifest, DeepNestingIsAnErrorNotAStackOverflow) {
+  EXPECT_THROW(parse_lod_manifest(std::string(100000, '['), "x"), Error);
+  EXPECT_THROW(parse_lod_manifest(std::string(100000, '[') + std::string(100000, ']'), "x"), Error);
+}
+
+TEST(ViewManifest, ReadsEscapedAndNonAsciiPaths) {
+  auto levels = parse_lod_manifest(R"(["caf\u00e9.ply", "a\"b.ply", "\ud83d\ude00.ply"])", "m.json");
+  ASSERT_EQ(levels.size(), 3u);
+  EXPECT_EQ(levels[0].path, "caf\xc3\xa9.ply");
+  EXPECT_EQ(levels[1].path, "a\"b.ply");
+  EXPECT_EQ(levels[2].path, "\xf0\x9f\x98\x80.ply");
 }
 
 TEST(ViewManifest, ReadsLevelsWithCountsAndErrors) {
