@@ -33,7 +33,9 @@ namespace {
 SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options, SimplifyObserver* observer,
                                   std::vector<std::uint32_t>* consumed_indices) {
   check_options(options);
-  const bool refit = options.refit_rounds > 0;
+  // The refit moves vertices to the input surface, which would pull seam vertices off their seams
+  // and leave the attributes fitted to the old positions: not made with attributes.
+  const bool refit = options.refit_rounds > 0 && input.attributes.empty();
   // The refit fits the input's vertices weighted by their share of the area: taken before the
   // core releases a consumed input's faces.
   std::vector<double> weights;
@@ -64,7 +66,10 @@ SimplifyResult simplify(MeshView input, const SimplifyOptions& options, Simplify
 }
 
 SimplifyResult simplify(Mesh&& input, const SimplifyOptions& options, SimplifyObserver* observer) {
-  return simplify_and_refit(input, options, observer, &input.indices);
+  SimplifyResult out = simplify_and_refit(input, options, observer, &input.indices);
+  out.mesh.material_names = std::move(input.material_names);
+  out.mesh.material_library = std::move(input.material_library);
+  return out;
 }
 
 void ContractionRecorder::on_start(std::span<const std::uint32_t> input_faces) {

@@ -11,6 +11,7 @@
 #include "core/parallel_chunks.h"
 #include "core/settings.h"
 #include "core/valid_pairs.h"
+#include "core/wedges.h"
 #include "core/working_mesh.h"
 
 namespace qem::core {
@@ -19,6 +20,11 @@ namespace {
 
 // The mesh with what the contractions left of it, and the maps the caller asked for.
 void finish(Context& c, std::optional<ContractionMap>& map, MeshView input, SimplifyResult& result) {
+  if (c.wedges) {
+    result.mesh = build_wedge_output(c.mesh, *c.wedges, input, result.vertex_source, result.face_source,
+                                     map ? &result.output_vertex_of_input : nullptr);
+    return;
+  }
   std::vector<std::uint32_t> output_index;
   result.mesh = build_output(c.mesh, input, &result.vertex_source, &result.face_source,
                              map ? &output_index : nullptr);
@@ -33,7 +39,11 @@ void finish(Context& c, std::optional<ContractionMap>& map, MeshView input, Simp
 SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHooks& hooks) {
   validate(options);
   SimplifyResult result;
-  WorkingMesh mesh = prepare_input(input);  // check, drop degenerate and duplicate faces, frame
+  std::vector<std::uint32_t> internal;  // with attributes: each input vertex's working vertex
+  WorkingMesh mesh = prepare_input(input, &internal);  // check, drop degenerate and duplicate faces, frame
+  std::optional<Wedges> wedges;  // with attributes, on the input's vertices (Hoppe 1999)
+  if (!input.attributes.empty()) wedges.emplace(build_wedges(input, internal, mesh, options));
+  std::vector<std::uint32_t>().swap(internal);
   result.input_faces = mesh.faces_alive, result.input_vertices = mesh.vertices_alive;
   result.dropped_degenerate_faces = mesh.dropped_degenerate, result.dropped_duplicate_faces = mesh.dropped_duplicate;
   std::optional<ContractionMap> map;
@@ -50,6 +60,7 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   PairSet pairs;
   Context c{settings, input, mesh, pairs, quadric, hooks.observer,
             hooks.observer && hooks.observer->wants_contractions(), map ? &*map : nullptr, {}, {}, result};
+  if (wedges) c.wedges = &*wedges;
   if (c.done()) {
     result.stop_reason = StopReason::AlreadyBelowTarget;
     result.stop_detail = stop_detail(result.stop_reason, result, settings.lock_border);

@@ -23,6 +23,7 @@ struct WorkingMesh {
 
   std::vector<Vec3> pos;
   std::vector<std::uint32_t> tri;            ///< 3 per working face
+  std::vector<std::uint32_t> corner_wedge;   ///< with attributes, 3 per working face (wedges.h)
   std::vector<std::uint8_t> face_alive;
   std::vector<std::uint32_t> face_source;    ///< input face of each working face
   std::vector<std::uint32_t> source_vertex;  ///< input vertex of each working vertex
@@ -74,7 +75,9 @@ void squeeze_by(const std::vector<std::uint32_t>& vertex_to, std::size_t count, 
 
 /// Checks the input (check_mesh), keeps its referenced vertices and its faces that are neither
 /// degenerate nor duplicates (kept once, the first in input order), and normalises the frame.
-WorkingMesh prepare_input(MeshView input);
+/// With attributes, the working vertices are the input's distinct positions, and `internal` (if
+/// given) gets each input vertex's working vertex.
+WorkingMesh prepare_input(MeshView input, std::vector<std::uint32_t>* internal = nullptr);
 
 /// The output: surviving vertices and faces in input order. Fills, when not null, each output
 /// vertex's and face's input index, and the new index of each working vertex (kNoVertex: dropped).
