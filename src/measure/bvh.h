@@ -11,6 +11,9 @@
 
 namespace qem::measure_detail {
 
+/// Queries per work item, and per warm-started run: fixed, so results never depend on the threads.
+inline constexpr std::size_t kQueryChunk = 4096;
+
 class TriangleBvh {
  public:
   struct Hit {
