@@ -77,44 +77,76 @@ std::uint32_t material_of(MeshView mesh, std::uint32_t face) {
   return mesh.face_materials.empty() ? 0 : mesh.face_materials[face];
 }
 
-/// The closest triangle of `si` to each sample among the faces of the sample's material, the
-/// script's rule when both meshes have the same material set: a sample on the original's leather
-/// is compared with the approximation's leather, not with the metal that came closer. A material
-/// with no face of non-zero area in the approximation keeps the unrestricted answer (the script
-/// falls back to all faces when a group has none). Queries run in Morton order within fixed chunks
-/// and the answer never depends on the warm start, so the result is the same for any thread count.
-void restrict_to_materials(MeshView original, const Surface& sn, MeshView approx, const Surface& si,
-                           const std::vector<std::uint32_t>& materials, const std::vector<double>& samples,
-                           const std::vector<SamplePlace>& places, std::vector<std::uint32_t>& hits,
-                           unsigned threads) {
-  const std::size_t ng = materials.size();
-  auto group_of = [&](std::uint32_t material) {
-    return std::size_t(std::lower_bound(materials.begin(), materials.end(), material) - materials.begin());
-  };
-  std::vector<std::vector<double>> corners(ng);
-  std::vector<std::vector<std::uint32_t>> kept(ng);  // tree triangle -> triangle of si
-  for (std::size_t t = 0; t < si.triangle_count(); ++t) {
-    const std::size_t g = group_of(material_of(approx, si.face_of[t]));
-    corners[g].insert(corners[g].end(), &si.corners[9 * t], &si.corners[9 * t + 9]);
-    kept[g].push_back(std::uint32_t(t));
-  }
-  std::vector<TriangleBvh> trees(ng);
-  for (std::size_t g = 0; g < ng; ++g) trees[g] = TriangleBvh(corners[g]);
+/// A tree to search and how its triangles map to those of `si` (nullptr: the same numbering).
+struct Search {
+  const TriangleBvh* tree = nullptr;
+  const std::vector<std::uint32_t>* to_si = nullptr;
+  std::uint32_t triangle(std::uint32_t t) const { return to_si ? (*to_si)[t] : t; }
+};
 
-  const std::size_t n = places.size();
-  std::vector<std::uint32_t> group(n);
-  for (std::size_t k = 0; k < n; ++k) group[k] = std::uint32_t(group_of(material_of(original, sn.face_of[places[k].triangle])));
-  const std::vector<std::uint32_t> order = core::morton_order(
-      n, [&](std::size_t i) { return Vec3(samples[3 * i], samples[3 * i + 1], samples[3 * i + 2]); });
-  core::for_chunks(n, kQueryChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
-    std::uint32_t hint = UINT32_MAX, last = UINT32_MAX;
-    for (std::size_t j = begin; j < end; ++j) {
-      const std::uint32_t k = order[j], g = group[k];
-      if (trees[g].empty()) continue;
-      if (g != last) hint = UINT32_MAX, last = g;  // a hint names a triangle of one tree
-      hits[k] = kept[g][trees[g].closest(&samples[3 * k], &hint).triangle];
-    }
-  });
+/// Trees over the faces of each material of `si`, the script's rule when both meshes have the same
+/// material set: a sample on the original's leather is compared with the approximation's leather,
+/// not with the metal that came closer.
+struct MaterialTrees {
+  std::vector<std::uint32_t> materials;  ///< sorted; tree g holds material materials[g]
+  std::vector<TriangleBvh> trees;
+  std::vector<std::vector<std::uint32_t>> to_si;
+  std::size_t group(std::uint32_t material) const {
+    return std::size_t(std::lower_bound(materials.begin(), materials.end(), material) - materials.begin());
+  }
+};
+
+MaterialTrees material_trees(MeshView approx, const Surface& si, std::vector<std::uint32_t> materials) {
+  MaterialTrees m;
+  m.materials = std::move(materials);
+  const std::size_t ng = m.materials.size();
+  std::vector<std::vector<double>> corners(ng);
+  m.to_si.resize(ng);
+  for (std::size_t t = 0; t < si.triangle_count(); ++t) {
+    const std::size_t g = m.group(material_of(approx, si.face_of[t]));
+    corners[g].insert(corners[g].end(), &si.corners[9 * t], &si.corners[9 * t + 9]);
+    m.to_si[g].push_back(std::uint32_t(t));
+  }
+  m.trees.resize(ng);
+  for (std::size_t g = 0; g < ng; ++g) m.trees[g] = TriangleBvh(corners[g]);
+  return m;
+}
+
+/// The face to read the approximation's attributes from, given `t`, the closest face to `p` that
+/// `search` found (lowest index of equally close faces). When the closest point is on an edge or a
+/// corner, the faces around it are all as close: on a convex hull of the original, whole wedges of
+/// samples land on edges, so the choice decides what a seam reads (u = 0 or u = 1). The lowest
+/// index is arbitrary; this takes the face the sample lies most squarely over, the largest
+/// |cos| between the face normal and the offset to its closest point, the side of the seam the
+/// sample is on. (The script's Embree queries, in float, pick that side nearly always: 3 of 199
+/// edge hits by the seam of the test's UV sphere went across, against ~half by lowest index.)
+std::uint32_t settle_tie(const Surface& si, const Search& search, const double* p, std::uint32_t t,
+                         std::vector<std::uint32_t>& scratch) {
+  auto corner = [&](std::uint32_t tri, int k) {
+    const double* c = &si.corners[9 * std::size_t(tri) + 3 * k];
+    return Vec3{c[0], c[1], c[2]};
+  };
+  const Vec3 q{p[0], p[1], p[2]};
+  const std::array<double, 3> w = closest_point_weights(q, corner(t, 0), corner(t, 1), corner(t, 2));
+  if (w[0] > 0 && w[1] > 0 && w[2] > 0) return t;  // inside the face: no other face is as close
+  const double d2 = squared_distance(q, closest_point_on_triangle(q, corner(t, 0), corner(t, 1), corner(t, 2)));
+  if (!(d2 > 0)) return t;  // on the surface: no direction to judge by
+  const double limit = d2 * (1 + 1e-9);  // the same edge point, reached through another face's rounding
+  scratch.clear();
+  search.tree->within(p, limit, scratch);
+  std::uint32_t best = t;
+  double best_cos = -1;
+  for (const std::uint32_t id : scratch) {
+    const std::uint32_t u = search.triangle(id);
+    const Vec3 a = corner(u, 0), b = corner(u, 1), c = corner(u, 2);
+    const Vec3 offset = q - closest_point_on_triangle(q, a, b, c);
+    const double e2 = dot(offset, offset);
+    if (e2 > limit) continue;
+    const Vec3 n = cross(b - a, c - a);
+    const double cosine = std::abs(dot(n, offset)) / std::sqrt(dot(n, n) * e2);
+    if (cosine > best_cos || (cosine == best_cos && u < best)) best_cos = cosine, best = u;
+  }
+  return best;
 }
 
 }  // namespace
@@ -126,17 +158,48 @@ bool has_comparable_attributes(MeshView original, MeshView approx) {
 }
 
 AttributeErrors attribute_errors(MeshView original, const Surface& sn, MeshView approx, const Surface& si,
-                                 const std::vector<double>& samples, const std::vector<SamplePlace>& places,
-                                 const std::vector<std::uint32_t>& hits_all, unsigned threads) {
+                                 const TriangleBvh& tree_i, const std::vector<double>& samples,
+                                 const std::vector<SamplePlace>& places, const std::vector<std::uint32_t>& hits_all,
+                                 unsigned threads) {
   AttributeErrors result;
-  const std::vector<std::uint32_t> materials = material_set(original);
-  std::vector<std::uint32_t> hits = hits_all;
+  const std::size_t n = places.size();
+  std::vector<std::uint32_t> materials = material_set(original);
+  MaterialTrees by_material;
   if (materials.size() > 1 && materials == material_set(approx)) {
     result.by_material = true;
-    restrict_to_materials(original, sn, approx, si, materials, samples, places, hits, threads);
+    by_material = material_trees(approx, si, std::move(materials));
   }
+  // Each sample's search: the whole approximation (whose answers the distance pass found), or the
+  // faces of its material; a material without a face of non-zero area there falls back to all
+  // faces, as the script does for a group without faces.
+  const Search everything{&tree_i, nullptr};
+  auto search_of = [&](std::size_t k) {
+    if (!result.by_material) return everything;
+    const std::size_t g = by_material.group(material_of(original, sn.face_of[places[k].triangle]));
+    if (by_material.trees[g].empty()) return everything;
+    return Search{&by_material.trees[g], &by_material.to_si[g]};
+  };
+  // Queries in Morton order within fixed chunks; no answer depends on the warm start or the chunk,
+  // so the faces, and the sums below, are the same for any thread count.
+  std::vector<std::uint32_t> hits(n);
+  const std::vector<std::uint32_t> order = core::morton_order(
+      n, [&](std::size_t i) { return Vec3(samples[3 * i], samples[3 * i + 1], samples[3 * i + 2]); });
+  core::for_chunks(n, kQueryChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
+    std::uint32_t hint = UINT32_MAX;
+    const TriangleBvh* last = nullptr;
+    std::vector<std::uint32_t> scratch;
+    for (std::size_t j = begin; j < end; ++j) {
+      const std::uint32_t k = order[j];
+      const Search search = search_of(k);
+      std::uint32_t t = hits_all[k];
+      if (search.tree != &tree_i) {
+        if (search.tree != last) hint = UINT32_MAX, last = search.tree;  // a hint names a triangle of one tree
+        t = search.triangle(search.tree->closest(&samples[3 * k], &hint).triangle);
+      }
+      hits[k] = settle_tie(si, search, &samples[3 * k], t, scratch);
+    }
+  });
 
-  const std::size_t n = places.size();
   std::optional<double>* out[3] = {&result.uv_rms, &result.normal_rms_deg, &result.color_rms};
   for (int c = 0; c < 3; ++c) {
     const Channel& ch = kChannels[c];

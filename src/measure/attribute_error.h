@@ -25,11 +25,12 @@ struct AttributeErrors {
 bool has_comparable_attributes(MeshView original, MeshView approx);
 
 /// The samples on the original are `samples` (xyz) at `places` on `sn`; `hits[k]` is the triangle
-/// of `si` closest to sample k over the whole approximation (already found by the distance pass,
-/// and used as is unless the search is restricted by material).
+/// of `si` closest to sample k in `tree_i` (over the whole approximation: found by the distance
+/// pass, and used unless the search is restricted by material).
 AttributeErrors attribute_errors(MeshView original, const Surface& sn, MeshView approx, const Surface& si,
-                                 const std::vector<double>& samples, const std::vector<SamplePlace>& places,
-                                 const std::vector<std::uint32_t>& hits, unsigned threads);
+                                 const TriangleBvh& tree_i, const std::vector<double>& samples,
+                                 const std::vector<SamplePlace>& places, const std::vector<std::uint32_t>& hits,
+                                 unsigned threads);
 
 /// Edges used by exactly one face once vertices of equal position are welded (-0 equals +0), over
 /// all faces, zero-area ones included: the script's `boundary_edges`.

@@ -34,6 +34,9 @@ class TriangleBvh {
   /// consecutive queries are near each other. `*hint` is set to the closest triangle found.
   Hit closest(const double p[3], std::uint32_t* hint) const;
 
+  /// Appends to `out` the (input) index of every triangle within sqrt(max_d2) of `p`, in no order.
+  void within(const double p[3], double max_d2, std::vector<std::uint32_t>& out) const;
+
   std::size_t triangle_count() const { return ids_.size(); }
   std::size_t node_count() const { return nodes_.size(); }
   bool empty() const { return ids_.empty(); }

@@ -127,7 +127,7 @@ MeasureResult measure(MeshView original, MeshView approx, const MeasureOptions& 
 
   if (attributes) {
     const measure_detail::AttributeErrors ae =
-        measure_detail::attribute_errors(original, sn, approx, si, xn, places, hits, threads);
+        measure_detail::attribute_errors(original, sn, approx, si, tree_i, xn, places, hits, threads);
     r.uv_rms = ae.uv_rms, r.normal_rms_deg = ae.normal_rms_deg, r.color_rms = ae.color_rms;
     r.attributes_by_material = ae.by_material;
   }
