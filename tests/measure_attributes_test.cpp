@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "measure/attribute_error.h"
+#include "qem/io.h"
 #include "qem/measure.h"
 #include "test_meshes.h"
 
@@ -50,7 +51,8 @@ Mesh plane(int nx, int ny, double x0, double x1, const std::function<void(double
     }
   for (int j = 0; j < ny; ++j)
     for (int i = 0; i < nx; ++i) {
-      const std::uint32_t a = std::uint32_t(j * (nx + 1) + i), b = a + 1, c = a + std::uint32_t(nx + 1), d = c + 1;
+      const std::uint32_t a = std::uint32_t(j * (nx + 1) + i), b = a + 1, c = a + std::uint32_t(nx + 1),
+                          d = c + 1;
       m.indices.insert(m.indices.end(), {a, b, d, a, d, c});
     }
   return m;
@@ -232,6 +234,32 @@ TEST(MeasureAttributes, CracksAlongASeam) {
   EXPECT_EQ(measure_detail::welded_boundary_edges(signed_zero), 16u);
 }
 
+TEST(MeasureAttributes, AnEdgeHitReadsTheSideTheSampleIsOn) {
+  // A roof (ridge along y at x = z = 0, slopes of 45 degrees) with u = 0 on the left slope and 1 on
+  // the right, split at the ridge; the original is a flat strip above it, |x| < 0.2 at z = 0.5,
+  // with the same split. Every sample's closest point is on the ridge, where both slopes are as
+  // close: reading the face the sample lies over gives no error (face index would give 0.7).
+  auto strip = [](double x0, double x1, double z0, double z1, double u) {
+    Mesh m;
+    add(m, AttributeKind::TexCoord, "TEXCOORD_0", 2);
+    Mesh g = plane(1, 4, x0, x1, [&](double, double y) {
+      m.attributes[0].values.insert(m.attributes[0].values.end(), {u, y});
+    });
+    for (std::size_t v = 0; v < g.vertex_count(); ++v) {
+      const double t = (g.positions[3 * v] - x0) / (x1 - x0);
+      g.positions[3 * v + 2] = z0 + t * (z1 - z0);
+    }
+    m.positions = std::move(g.positions);
+    m.indices = std::move(g.indices);
+    return m;
+  };
+  Mesh roof = strip(-1, 0, -1, 0, 0), flat = strip(-0.2, 0, 0.5, 0.5, 0);
+  append(roof, strip(0, 1, 0, -1, 1));
+  append(flat, strip(0, 0.2, 0.5, 0.5, 1));
+  const MeasureResult r = measure(flat, roof, options(20000));
+  EXPECT_LT(*r.uv_rms, 1e-12);
+}
+
 /// Two parallel planes of different materials, colours and UV; `swap` puts each material at the
 /// other's height, so each sample's nearest surface is the other material.
 Mesh two_materials(bool swap, std::uint32_t second = 1) {
@@ -244,7 +272,8 @@ Mesh two_materials(bool swap, std::uint32_t second = 1) {
     add(part, AttributeKind::TexCoord, "TEXCOORD_0", 2);
     const double z = swap ? (k == 0 ? 0.9 : 0.1) : k;
     Mesh g = plane(4, 4, 0, 1, [&](double x, double y) {
-      part.attributes[0].values.insert(part.attributes[0].values.end(), {k == 0 ? 1.0 : 0.0, 0, k == 0 ? 0.0 : 1.0});
+      part.attributes[0].values.insert(part.attributes[0].values.end(),
+                                       {k == 0 ? 1.0 : 0.0, 0, k == 0 ? 0.0 : 1.0});
       part.attributes[1].values.insert(part.attributes[1].values.end(), {x + k, y});
     });
     for (std::size_t v = 0; v < g.vertex_count(); ++v) g.positions[3 * v + 2] = z;
@@ -277,6 +306,28 @@ TEST(MeasureAttributes, SameBitsForAnyThreadCount) {
   }
 }
 
+TEST(MeasureAttributes, CliReportsNullsAndCracks) {
+  // The readers of this branch read no attributes: every attribute error is null, the cracks are
+  // counted all the same (the cube with one side's two triangles gone has a 4-edge hole).
+  const std::string dir = test::temp_dir();
+  const std::string a = dir + "/attr_cube.ply", b = dir + "/attr_open_cube.ply", out = dir + "/attr_out";
+  Mesh open = test::cube();
+  open.indices.resize(open.indices.size() - 6);
+  save_mesh(a, test::cube());
+  save_mesh(b, open);
+  const std::string cmd = std::string(QEM_CLI_PATH) + " measure " + a + " " + b + " --samples 2000";
+  ASSERT_EQ(std::system((cmd + " --json > " + out + ".json").c_str()), 0);
+  const std::string json = test::slurp(out + ".json");
+  for (const char* field :
+       {"\"uv_rms\":null", "\"normal_rms_deg\":null", "\"color_rms\":null", "\"attr_by_material\":false",
+        "\"cracks_in\":0", "\"cracks_out\":4", "\"seam_cracks\":4"})
+    EXPECT_NE(json.find(field), std::string::npos) << field << " in " << json;
+  ASSERT_EQ(std::system((cmd + " > " + out + ".txt").c_str()), 0);
+  const std::string text = test::slurp(out + ".txt");
+  EXPECT_NE(text.find("seam cracks"), std::string::npos) << text;
+  EXPECT_NE(text.find("UV RMS"), std::string::npos) << text;
+}
+
 // ---- Cross-check against attr_metric.py -------------------------------------------------------
 
 /// Writes `m` as an ASCII PLY the script reads: x y z, nx ny nz, s t, red green blue alpha (float,
@@ -299,8 +350,10 @@ void write_ply(const std::string& path, const Mesh& m) {
   };
   for (std::size_t v = 0; v < m.vertex_count(); ++v) {
     for (int k = 0; k < 3; ++k) put(m.positions[3 * v + k]);
-    if (n) for (int k = 0; k < 3; ++k) put(n->values[3 * v + k]);
-    if (uv) for (int k = 0; k < 2; ++k) put(uv->values[2 * v + k]);
+    if (n)
+      for (int k = 0; k < 3; ++k) put(n->values[3 * v + k]);
+    if (uv)
+      for (int k = 0; k < 2; ++k) put(uv->values[2 * v + k]);
     if (c)
       for (unsigned k = 0; k < 4; ++k) put(k < c->components ? c->values[c->components * v + k] : 1.0);
     f << "\n";
@@ -321,7 +374,8 @@ void write_obj(const std::string& path, const Mesh& m) {
     std::snprintf(buf, sizeof buf, "v %.17g %.17g %.17g\n", m.positions[3 * v], m.positions[3 * v + 1],
                   m.positions[3 * v + 2]);
     f << buf;
-    if (uv) std::snprintf(buf, sizeof buf, "vt %.17g %.17g\n", uv->values[2 * v], uv->values[2 * v + 1]), f << buf;
+    if (uv)
+      std::snprintf(buf, sizeof buf, "vt %.17g %.17g\n", uv->values[2 * v], uv->values[2 * v + 1]), f << buf;
     if (n)
       std::snprintf(buf, sizeof buf, "vn %.17g %.17g %.17g\n", n->values[3 * v], n->values[3 * v + 1],
                     n->values[3 * v + 2]),
@@ -360,7 +414,8 @@ std::string script_command() {
   return "";
 }
 
-nlohmann::json run_script(const std::string& script, const std::string& a, const std::string& b, std::size_t n) {
+nlohmann::json run_script(const std::string& script, const std::string& a, const std::string& b,
+                          std::size_t n) {
   const std::string cmd = script + " " + a + " " + b + " --samples " + std::to_string(n) + " 2>/dev/null";
   std::string out;
   if (FILE* p = popen(cmd.c_str(), "r")) {
@@ -397,7 +452,7 @@ Mesh uv_sphere(int rings, int segments, double gap = 0) {
     for (int j = 0; j < segments; ++j) {
       const std::uint32_t a = std::uint32_t(i * (segments + 1) + j), b = a + 1;
       const std::uint32_t c = a + std::uint32_t(segments + 1), d = c + 1;
-      if (i > 0) m.indices.insert(m.indices.end(), {a, c, b});            // no sliver at the north pole
+      if (i > 0) m.indices.insert(m.indices.end(), {a, c, b});          // no sliver at the north pole
       if (i < rings - 1) m.indices.insert(m.indices.end(), {b, c, d});  // nor at the south pole
     }
   return m;
@@ -422,7 +477,8 @@ Mesh shaded_cube(bool flat) {
       for (int d = 0; d < 3; ++d) c[k][d] = cube.positions[3 * cube.indices[3 * f + k] + d];
     const double e1[3] = {c[1][0] - c[0][0], c[1][1] - c[0][1], c[1][2] - c[0][2]};
     const double e2[3] = {c[2][0] - c[0][0], c[2][1] - c[0][1], c[2][2] - c[0][2]};
-    const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+    const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                         e1[0] * e2[1] - e1[1] * e2[0]};
     const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     for (int k = 0; k < 3; ++k) {
       m.indices.push_back(std::uint32_t(m.vertex_count()));
@@ -469,7 +525,8 @@ TEST(MeasureAttributes, AgreesWithAttrMetricScript) {
   const std::string dir = test::temp_dir();
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
-    const std::string a = dir + "/" + c.name + "_orig." + c.format, b = dir + "/" + c.name + "_approx." + c.format;
+    const std::string a = dir + "/" + c.name + "_orig." + c.format,
+                      b = dir + "/" + c.name + "_approx." + c.format;
     auto write = std::string(c.format) == "obj" ? write_obj : write_ply;
     write(a, c.original);
     write(b, c.approx);
@@ -485,14 +542,16 @@ TEST(MeasureAttributes, AgreesWithAttrMetricScript) {
       const double theirs = s[key].get<double>();
       std::printf("  %s qem %.6g script %.6g", key, *ours, theirs);
       const double ties = kTieSamples / double(r.samples_original) * seam_jump * seam_jump;
-      const double allowed = (2 * kTolerance + kTolerance * kTolerance) * theirs * theirs + ties + kFloor * kFloor;
+      const double allowed =
+          (2 * kTolerance + kTolerance * kTolerance) * theirs * theirs + ties + kFloor * kFloor;
       EXPECT_LE(std::abs(*ours * *ours - theirs * theirs), allowed) << key << ": mean squares";
     };
     compare("uv_rms", r.uv_rms, 1.0);
     compare("normal_rms_deg", r.normal_rms_deg, 0.0);
     compare("color_rms", r.color_rms, 0.0);
-    std::printf("  seam_cracks qem %zu (%zu/%zu) script %d (%d/%d)\n", r.seam_cracks, r.cracks_in, r.cracks_out,
-                s["seam_cracks"].get<int>(), s["cracks_in"].get<int>(), s["cracks_out"].get<int>());
+    std::printf("  seam_cracks qem %zu (%zu/%zu) script %d (%d/%d)\n", r.seam_cracks, r.cracks_in,
+                r.cracks_out, s["seam_cracks"].get<int>(), s["cracks_in"].get<int>(),
+                s["cracks_out"].get<int>());
     EXPECT_EQ(r.seam_cracks, s["seam_cracks"].get<std::size_t>());
     EXPECT_EQ(r.cracks_in, s["cracks_in"].get<std::size_t>());
     EXPECT_EQ(r.cracks_out, s["cracks_out"].get<std::size_t>());

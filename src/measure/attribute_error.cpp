@@ -129,8 +129,9 @@ std::uint32_t settle_tie(const Surface& si, const Search& search, const double* 
   const Vec3 q{p[0], p[1], p[2]};
   const std::array<double, 3> w = closest_point_weights(q, corner(t, 0), corner(t, 1), corner(t, 2));
   if (w[0] > 0 && w[1] > 0 && w[2] > 0) return t;  // inside the face: no other face is as close
-  const double d2 = squared_distance(q, closest_point_on_triangle(q, corner(t, 0), corner(t, 1), corner(t, 2)));
-  if (!(d2 > 0)) return t;  // on the surface: no direction to judge by
+  const double d2 =
+      squared_distance(q, closest_point_on_triangle(q, corner(t, 0), corner(t, 1), corner(t, 2)));
+  if (!(d2 > 0)) return t;               // on the surface: no direction to judge by
   const double limit = d2 * (1 + 1e-9);  // the same edge point, reached through another face's rounding
   scratch.clear();
   search.tree->within(p, limit, scratch);
@@ -159,8 +160,8 @@ bool has_comparable_attributes(MeshView original, MeshView approx) {
 
 AttributeErrors attribute_errors(MeshView original, const Surface& sn, MeshView approx, const Surface& si,
                                  const TriangleBvh& tree_i, const std::vector<double>& samples,
-                                 const std::vector<SamplePlace>& places, const std::vector<std::uint32_t>& hits_all,
-                                 unsigned threads) {
+                                 const std::vector<SamplePlace>& places,
+                                 const std::vector<std::uint32_t>& hits_all, unsigned threads) {
   AttributeErrors result;
   const std::size_t n = places.size();
   std::vector<std::uint32_t> materials = material_set(original);
@@ -193,7 +194,8 @@ AttributeErrors attribute_errors(MeshView original, const Surface& sn, MeshView 
       const Search search = search_of(k);
       std::uint32_t t = hits_all[k];
       if (search.tree != &tree_i) {
-        if (search.tree != last) hint = UINT32_MAX, last = search.tree;  // a hint names a triangle of one tree
+        if (search.tree != last)
+          hint = UINT32_MAX, last = search.tree;  // a hint names a triangle of one tree
         t = search.triangle(search.tree->closest(&samples[3 * k], &hint).triangle);
       }
       hits[k] = settle_tie(si, search, &samples[3 * k], t, scratch);
@@ -211,12 +213,13 @@ AttributeErrors attribute_errors(MeshView original, const Surface& sn, MeshView 
     core::for_chunks(n, kQueryChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
       for (std::size_t k = begin; k < end; ++k) {
         double x[4], y[4];
-        interpolate(*an, ch, &original.indices[3 * std::size_t(sn.face_of[places[k].triangle])], places[k].w, x);
+        interpolate(*an, ch, &original.indices[3 * std::size_t(sn.face_of[places[k].triangle])], places[k].w,
+                    x);
         const std::uint32_t t = hits[k];
         const double* tc = &si.corners[9 * std::size_t(t)];
-        const std::array<double, 3> w = closest_point_weights(
-            {samples[3 * k], samples[3 * k + 1], samples[3 * k + 2]}, {tc[0], tc[1], tc[2]}, {tc[3], tc[4], tc[5]},
-            {tc[6], tc[7], tc[8]});
+        const std::array<double, 3> w =
+            closest_point_weights({samples[3 * k], samples[3 * k + 1], samples[3 * k + 2]},
+                                  {tc[0], tc[1], tc[2]}, {tc[3], tc[4], tc[5]}, {tc[6], tc[7], tc[8]});
         interpolate(*ai, ch, &approx.indices[3 * std::size_t(si.face_of[t])], w.data(), y);
         e2[k] = squared_error(ch, x, y);
       }

@@ -29,8 +29,8 @@ bool has_comparable_attributes(MeshView original, MeshView approx);
 /// pass, and used unless the search is restricted by material).
 AttributeErrors attribute_errors(MeshView original, const Surface& sn, MeshView approx, const Surface& si,
                                  const TriangleBvh& tree_i, const std::vector<double>& samples,
-                                 const std::vector<SamplePlace>& places, const std::vector<std::uint32_t>& hits,
-                                 unsigned threads);
+                                 const std::vector<SamplePlace>& places,
+                                 const std::vector<std::uint32_t>& hits, unsigned threads);
 
 /// Edges used by exactly one face once vertices of equal position are welded (-0 equals +0), over
 /// all faces, zero-area ones included: the script's `boundary_edges`.

@@ -99,8 +99,8 @@ MeasureResult measure(MeshView original, MeshView approx, const MeasureOptions& 
       });
   static const std::vector<double> kNone;
   std::vector<std::uint32_t> hits;
-  const Distances o2a =
-      distances(tree_i, xn, options.include_vertices ? sn.vertices : kNone, threads, attributes ? &hits : nullptr);
+  const Distances o2a = distances(tree_i, xn, options.include_vertices ? sn.vertices : kNone, threads,
+                                  attributes ? &hits : nullptr);
   const Distances a2o = distances(tree_n, xi, options.include_vertices ? si.vertices : kNone, threads);
 
   MeasureResult r;

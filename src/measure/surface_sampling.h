@@ -12,10 +12,10 @@ namespace qem::measure_detail {
 
 /// The non-degenerate triangles of a mesh as flat corner coordinates, ready for sampling and the BVH.
 struct Surface {
-  std::vector<double> corners;   ///< 9 per kept triangle: a.xyz b.xyz c.xyz
-  std::vector<double> cum_area;  ///< prefix sums of the kept triangles' areas (the sampling CDF)
+  std::vector<double> corners;         ///< 9 per kept triangle: a.xyz b.xyz c.xyz
+  std::vector<double> cum_area;        ///< prefix sums of the kept triangles' areas (the sampling CDF)
   std::vector<std::uint32_t> face_of;  ///< the input face of each kept triangle (for its attributes)
-  std::vector<double> vertices;  ///< xyz of every vertex referenced by a face (Hausdorff candidates)
+  std::vector<double> vertices;        ///< xyz of every vertex referenced by a face (Hausdorff candidates)
   double area = 0;
   std::size_t faces = 0;       ///< input faces
   std::size_t degenerate = 0;  ///< zero-area faces: ignored for sampling and distance
