@@ -46,6 +46,28 @@ def cli_simplify_s(cli, path, faces, repeat, tmp):
     return statistics.median(times), qem.load(os.path.join(tmp, "cli.ply"))
 
 
+def overhead(args):
+    """Pairs of runs, CLI then Python, so that both see the same machine load."""
+    with tempfile.TemporaryDirectory() as tmp:
+        for path in args.meshes:
+            mesh = qem.load(path)
+            for ratio in [float(r) for r in args.ratios.split(",")]:
+                target = max(4, int(ratio * len(mesh.faces)))
+                wall, cpu = [], []
+                for _ in range(args.repeat):
+                    out = subprocess.run([args.cli, "simplify", path, os.path.join(tmp, "c.ply"), "--faces", str(target),
+                                          "--json", "--quiet", "--force"], check=True, capture_output=True,
+                                         text=True).stdout
+                    c = json.loads(out)
+                    t0, c0 = time.perf_counter(), time.process_time()
+                    qem.simplify(mesh.vertices, mesh.faces, target_faces=target)
+                    wall.append((time.perf_counter() - t0) / c["simplify_s"])
+                    cpu.append((time.process_time() - c0) / c["simplify_cpu_s"])
+                print(f"{os.path.basename(path)} {len(mesh.faces)} faces -> {target}: Python / C++ call, median of "
+                      f"{args.repeat} pairs: wall {statistics.median(wall):.3f} (pairs {min(wall):.2f}-{max(wall):.2f}), "
+                      f"CPU {statistics.median(cpu):.3f} (pairs {min(cpu):.2f}-{max(cpu):.2f})")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("meshes", nargs="+")
@@ -54,7 +76,12 @@ def main():
     ap.add_argument("--samples", type=int, default=1_000_000)
     ap.add_argument("--cli", default=os.path.join(os.path.dirname(__file__), "..", "build", "qem"))
     ap.add_argument("--no-open3d", action="store_true")
+    ap.add_argument("--overhead", action="store_true",
+                    help="only the Python call against the C++ call: CLI and Python runs alternate, and the "
+                         "median of the pairs' ratios (wall and CPU time) is printed")
     args = ap.parse_args()
+    if args.overhead:
+        return overhead(args)
     o3d = None
     if not args.no_open3d:
         import open3d as o3d  # noqa: F811  (Debian's python3-open3d)
