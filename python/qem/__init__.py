@@ -418,7 +418,8 @@ def save(path, mesh, *, binary: bool = True, double: Optional[bool] = None) -> N
 
     mesh: a qem.Mesh / SimplifyResult, anything with .vertices and .faces (or an Open3D
     TriangleMesh), or a (vertices, faces) pair. binary: PLY and STL binary (little endian) or ASCII.
-    double: PLY coordinates as double (default: as the mesh was loaded, else float).
+    double: PLY coordinates as double (default: as the loaded mesh was stored, else float; the
+    command line writes a double PLY's simplification with doubles: pass double=True for that).
     The result of qem.simplify saved with the defaults is the same bytes as `qem simplify`'s output.
     """
     vertices, faces, attributes = _mesh_arrays(mesh, "mesh")

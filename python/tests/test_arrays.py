@@ -132,3 +132,27 @@ def test_attributes_are_checked_and_passed(small_torus):
                                                          "TEXCOORD_0": v[:, :2].astype(np.float32),
                                                          "k1": v[:, 0]})
     assert isinstance(r.attributes, dict)  # empty until the simplifier carries attributes
+
+
+def test_bad_input_to_the_other_functions(small_torus):
+    v, f = small_torus
+    bad_f = f.copy()
+    bad_f[7, 1] = len(v)
+    for call in (lambda: qem.info(v, bad_f), lambda: qem.cluster(v, bad_f, grid=(4, 4, 4)),
+                 lambda: qem.lod(v, bad_f, ratios=[0.5]), lambda: qem.save("/tmp/x.ply", (v, bad_f))):
+        with pytest.raises(ValueError, match="faces"):
+            call()
+    with pytest.raises(ValueError, match="approx.faces"):
+        qem.measure((v, f), (v, bad_f))
+    with pytest.raises(ValueError, match="original"):
+        qem.measure(42, (v, f))
+    with pytest.raises(ValueError, match="grid"):
+        qem.cluster(v, f, grid=(4, 4))
+    with pytest.raises(ValueError, match="exactly one"):
+        qem.cluster(v, f)
+    with pytest.raises(ValueError, match="ratios"):
+        qem.lod(v, f, ratios=[1.5])
+    with pytest.raises(ValueError, match="samples"):
+        qem.measure((v, f), (v, f), samples=0)
+    with pytest.raises(qem.Error):
+        qem.Record.from_bytes(b"not a record")

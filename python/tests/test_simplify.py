@@ -149,6 +149,12 @@ def test_gil_is_released(large_torus):
     done.set()
     t.join()
     during = [x for x in ticks if t0 <= x <= t1]
-    # With the GIL held the other thread would get no tick in; released, it gets about one a ms.
+    # With the GIL held the other thread would get no tick in; released, about one a millisecond
+    # (fewer on a loaded machine: the bound is loose).
     assert t1 - t0 > 0.1
-    assert len(during) > 0.2 * (t1 - t0) / 0.001, (len(during), t1 - t0)
+    assert len(during) >= max(10, 0.05 * (t1 - t0) / 0.001), (len(during), t1 - t0)
+
+
+def test_help_is_the_manual():
+    for fn in (qem.simplify, qem.load, qem.save, qem.measure, qem.cluster, qem.info, qem.lod, qem.Record.replay):
+        assert fn.__doc__ and len(fn.__doc__) > 40, fn
