@@ -176,20 +176,8 @@ def option_names(option: str) -> list:
     return list(_OPTION_NAMES[option])
 
 
-_OPTION_NAMES = {}
-
-
-def _enum_names():
-    # The library's names (src/option_names.cpp), read from its error message: one list, written once.
-    for option in ("weighting", "placement", "scheme", "inversion"):
-        try:
-            setattr(_qem.SimplifyOptions(), option, "\x00")
-        except ValueError as e:
-            m = _re.search(r"\(one of (.*)\)", str(e))
-            _OPTION_NAMES[option] = tuple(m.group(1).split(", ")) if m else ()
-
-
-_enum_names()
+# The library's names (src/option_names.cpp): one list, written once.
+_OPTION_NAMES = {option: tuple(_qem.option_names(option)) for option in ("weighting", "placement", "scheme", "inversion")}
 
 # The command line's default refit (cli/algorithm_options.h): one round, about 2 input vertices
 # per output vertex, made only with optimal placement. "full" is `--refit`: 3 rounds, every vertex.

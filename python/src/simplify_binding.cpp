@@ -148,6 +148,14 @@ void bind_simplify(py::module_& m) {
       .def_readwrite("map_input_vertices", &SimplifyOptions::map_input_vertices)
       .def("check", [](const SimplifyOptions& o) { check_options(o); }, "Raises qem.Error for an option out of range");
 
+  m.def("option_names", [](const std::string& option) -> std::vector<std::string> {
+    if (option == "weighting") return option_names<Weighting>();
+    if (option == "placement") return option_names<Placement>();
+    if (option == "scheme") return option_names<Scheme>();
+    if (option == "inversion") return option_names<InversionPolicy>();
+    throw py::value_error("option: expected weighting, placement, scheme or inversion, got '" + option + "'");
+  });
+
   py::class_<Record>(m, "Record", "qem::Record: the base mesh and the contraction sequence of one run")
       .def("__len__", &Record::size)
       .def_property_readonly("final_faces", &Record::final_faces)

@@ -158,3 +158,10 @@ def test_gil_is_released(large_torus):
 def test_help_is_the_manual():
     for fn in (qem.simplify, qem.load, qem.save, qem.measure, qem.cluster, qem.info, qem.lod, qem.Record.replay):
         assert fn.__doc__ and len(fn.__doc__) > 40, fn
+
+
+def test_option_names_are_the_librarys():
+    assert qem.option_names("placement") == ["optimal", "segment", "midpoint", "endpoints"]
+    assert "passes" in qem.option_names("scheme") and "forbid" in qem.option_names("inversion")
+    with pytest.raises(ValueError, match="weighting"):
+        qem.simplify(np.eye(3), [[0, 1, 2]], target_faces=1, weighting="areal")
