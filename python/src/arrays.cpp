@@ -1,9 +1,9 @@
 #include "arrays.h"
 
+#include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <limits>
-#include <memory>
+#include <type_traits>
 
 namespace qem::python {
 namespace {

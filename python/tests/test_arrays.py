@@ -42,6 +42,8 @@ def test_outputs_own_their_memory(small_torus):
     for a in (r.vertices, r.faces):
         assert a.flags.c_contiguous
         a[0] = a[0]  # writable
+    # Handed over from the library's vectors (a capsule frees them), not copied.
+    assert type(r.vertices.base).__name__ == "PyCapsule" and type(r.faces.base).__name__ == "PyCapsule"
     v2 = r.vertices
     del r
     assert np.isfinite(v2).all()  # still valid after the result is gone
