@@ -339,9 +339,12 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
       attributes: {name: (n, k) array} of per-vertex data, or {name: (array, kind)}; the kind
         (normal, texcoord, color, joint_indices, joint_weights, tangent, scalar) follows glTF names
         (NORMAL, TEXCOORD_0, COLOR_0, ...) when not given. Returned in result.attributes by the
-        library as it carries them (today: checked and passed in; the simplifier does not carry
-        attributes yet, so result.attributes is empty; use return_mapping to carry your own).
-      attribute_weights, vertex_lock: not available yet (NotImplementedError when given).
+        simplified mesh: one vertex per wedge (a position may carry several attribute sets, split at
+        seams), seams kept closed and in place, normals unit, colours in [0, 1].
+      attribute_weights: {"normal": w, "uv": w, "color": w, "scalar": w}: what a unit of each
+        attribute costs against a unit of distance (1/w costs one bounding-box diagonal); the
+        library's defaults otherwise.
+      vertex_lock: not available yet (NotImplementedError when given).
       return_mapping: fill result.vertex_source, face_source and output_vertex_of_input.
       record: keep the contraction sequence in result.record (a qem.Record; no refit then).
     progress: called with the fraction done (0..1) every few thousand contractions; returning
@@ -352,9 +355,11 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
     stop_reason, stop_detail and, with return_mapping, the provenance maps.
     Raises ValueError naming a bad argument, qem.Error for what the library refuses.
     """
-    if attribute_weights is not None:
-        raise NotImplementedError("attribute_weights: the simplifier does not weight attributes yet; "
-                                  "leave attribute_weights=None")
+    if attribute_weights is not None and not isinstance(attribute_weights, dict):
+        raise ValueError("attribute_weights: expected a dict {kind: weight} with kinds normal, uv, color, scalar")
+    if record and attributes:
+        raise ValueError("record: a record keeps positions and faces only, and the attributes would be lost "
+                         "on replay; simplify without record=True, or carry them with return_mapping")
     if vertex_lock is not None:
         raise NotImplementedError("vertex_lock: locking chosen vertices is not in the library yet; "
                                   "leave vertex_lock=None (lock_border=True locks the border)")
@@ -367,6 +372,8 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
                        max_turn=max_turn, allow_non_manifold=allow_non_manifold, scheme=scheme, refit=refit,
                        threads=threads, record=record)
     options.map_input_vertices = bool(return_mapping)
+    if attribute_weights is not None:
+        options.attribute_weights = attribute_weights
     d = _qem.simplify(vertices, faces, options, _attribute_list(attributes), bool(record), progress)
     result = _mesh_from_dict(d, SimplifyResult)
     for key in SimplifyResult.__slots__:

@@ -137,7 +137,7 @@ def simplify(
     refit: _Refit = ...,
     threads: int = ...,
     attributes: Optional[Mapping[str, Union[np.ndarray, Tuple[np.ndarray, str]]]] = ...,
-    attribute_weights: None = ...,
+    attribute_weights: Optional[Mapping[str, float]] = ...,
     vertex_lock: None = ...,
     return_mapping: bool = ...,
     record: bool = ...,

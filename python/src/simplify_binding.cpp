@@ -2,6 +2,7 @@
 // and cancel a run with the GIL released, and the result handed to numpy without copies.
 #include <pybind11/stl.h>
 
+#include <cmath>
 #include <exception>
 #include <optional>
 #include <utility>
@@ -146,6 +147,28 @@ void bind_simplify(py::module_& m) {
       .def_readwrite("refit_rounds", &SimplifyOptions::refit_rounds)
       .def_readwrite("refit_points_per_vertex", &SimplifyOptions::refit_points_per_vertex)
       .def_readwrite("map_input_vertices", &SimplifyOptions::map_input_vertices)
+      .def_property(
+          "attribute_weights",
+          [](const SimplifyOptions& o) {
+            const AttributeWeights& w = o.attribute_weights;
+            return py::dict(py::arg("normal") = w.normal, py::arg("uv") = w.tex_coord, py::arg("color") = w.color,
+                            py::arg("scalar") = w.scalar);
+          },
+          [](SimplifyOptions& o, const py::dict& weights) {
+            for (auto [key, value] : weights) {
+              const std::string kind = py::str(key);
+              double* w = kind == "normal" ? &o.attribute_weights.normal
+                          : kind == "uv"   ? &o.attribute_weights.tex_coord
+                          : kind == "color" ? &o.attribute_weights.color
+                          : kind == "scalar" ? &o.attribute_weights.scalar
+                                             : nullptr;
+              if (!w) throw py::value_error("attribute_weights: unknown kind '" + kind + "' (normal, uv, color, scalar)");
+              const double x = value.cast<double>();
+              if (!(x >= 0) || !std::isfinite(x))
+                throw py::value_error("attribute_weights['" + kind + "']: expected a finite weight >= 0");
+              *w = x;
+            }
+          })
       .def("check", [](const SimplifyOptions& o) { check_options(o); }, "Raises qem.Error for an option out of range");
 
   m.def("option_names", [](const std::string& option) -> std::vector<std::string> {

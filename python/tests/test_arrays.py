@@ -111,8 +111,6 @@ def test_library_errors_are_qem_error(small_torus):
 
 
 def test_not_implemented_arguments_say_so(small_torus):
-    with pytest.raises(NotImplementedError, match="attribute_weights"):
-        qem.simplify(*small_torus, target_faces=10, attribute_weights={"NORMAL": 1.0})
     with pytest.raises(NotImplementedError, match="vertex_lock"):
         qem.simplify(*small_torus, target_faces=10, vertex_lock=np.zeros(3600, bool))
 
@@ -133,7 +131,21 @@ def test_attributes_are_checked_and_passed(small_torus):
     r = qem.simplify(v, f, target_faces=500, attributes={"NORMAL": v / np.linalg.norm(v, axis=1)[:, None],
                                                          "TEXCOORD_0": v[:, :2].astype(np.float32),
                                                          "k1": v[:, 0]})
-    assert isinstance(r.attributes, dict)  # empty until the simplifier carries attributes
+    assert set(r.attributes) == {"NORMAL", "TEXCOORD_0", "k1"}
+    n = r.attributes["NORMAL"]
+    assert n.shape == (len(r.vertices), 3)
+    assert np.allclose(np.linalg.norm(n, axis=1), 1.0)
+    assert r.attributes["TEXCOORD_0"].shape == (len(r.vertices), 2)
+    # The weights change the result; a bad kind is named.
+    heavy = qem.simplify(v, f, target_faces=500, attributes={"NORMAL": v / np.linalg.norm(v, axis=1)[:, None]},
+                         attribute_weights={"normal": 10.0})
+    light = qem.simplify(v, f, target_faces=500, attributes={"NORMAL": v / np.linalg.norm(v, axis=1)[:, None]},
+                         attribute_weights={"normal": 0.0})
+    assert not np.array_equal(heavy.vertices, light.vertices)
+    with pytest.raises(ValueError, match="gloss"):
+        qem.simplify(v, f, target_faces=500, attributes={"NORMAL": v}, attribute_weights={"gloss": 1.0})
+    with pytest.raises(ValueError, match="record"):
+        qem.simplify(v, f, target_faces=500, attributes={"NORMAL": v}, record=True)
 
 
 def test_bad_input_to_the_other_functions(small_torus):
