@@ -113,6 +113,10 @@ struct SimplifyOptions {
   /// Penalty weight of the boundary constraint planes (GH97 §6); 0 disables them.
   double boundary_weight = 1;
   bool lock_border = false;  ///< boundary vertices never move
+  /// Per input vertex (empty: none), nonzero = locked: it never moves and is never removed (the
+  /// other end of a contraction comes to it). With attributes, a position is locked when any of
+  /// its vertices is. The caller's buffer must outlive the call.
+  std::span<const std::uint8_t> vertex_lock;
   InversionPolicy inversion = InversionPolicy::Forbid;
   /// A face that turns by more than this (degrees) counts as an inversion; must be < 90.
   double max_normal_turn_degrees = 75;

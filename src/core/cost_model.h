@@ -39,9 +39,10 @@ inline bool place_pair(const Context& c, std::uint32_t p, Quadric& q, Placed& pl
   const WorkingMesh& m = c.mesh;
   q = c.quadric[a] + c.quadric[b];
   if (c.wedges) return place_with_wedges(c, a, b, q, placed);
-  if (c.settings.lock_border && (m.boundary[a] || m.boundary[b])) {
-    if (m.boundary[a] && m.boundary[b]) return false;
-    const Vec3& fixed = m.boundary[a] ? m.pos[a] : m.pos[b];
+  const bool held_a = m.held(a, c.settings.lock_border), held_b = m.held(b, c.settings.lock_border);
+  if (held_a || held_b) {
+    if (held_a && held_b) return false;
+    const Vec3& fixed = held_a ? m.pos[a] : m.pos[b];
     placed = {fixed, q.evaluate(fixed)};
     return true;
   }

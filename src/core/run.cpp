@@ -13,6 +13,7 @@
 #include "core/valid_pairs.h"
 #include "core/wedges.h"
 #include "core/working_mesh.h"
+#include "qem/error.h"
 
 namespace qem::core {
 
@@ -34,6 +35,20 @@ void finish(Context& c, std::optional<ContractionMap>& map, MeshView input, Simp
   }
 }
 
+// A working vertex is locked when any input vertex on it is.
+void lock_vertices(std::span<const std::uint8_t> lock, MeshView input, const Wedges* wedges, WorkingMesh& mesh) {
+  if (lock.size() != input.vertex_count())
+    throw Error("vertex_lock has " + std::to_string(lock.size()) + " entries for " +
+                std::to_string(input.vertex_count()) + " vertices");
+  mesh.locked.assign(mesh.vertex_count(), 0);
+  if (wedges) {
+    for (std::uint32_t w = 0; w < wedges->count(); ++w)
+      if (lock[wedges->source[w]]) mesh.locked[wedges->vertex[w]] = 1;
+  } else {
+    for (std::uint32_t v = 0; v < mesh.vertex_count(); ++v) mesh.locked[v] = lock[mesh.source_vertex[v]] != 0;
+  }
+}
+
 }  // namespace
 
 SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHooks& hooks) {
@@ -44,6 +59,7 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   std::optional<Wedges> wedges;  // with attributes, on the input's vertices (Hoppe 1999)
   if (!input.attributes.empty()) wedges.emplace(build_wedges(input, internal, mesh, options));
   std::vector<std::uint32_t>().swap(internal);
+  if (!options.vertex_lock.empty()) lock_vertices(options.vertex_lock, input, wedges ? &*wedges : nullptr, mesh);
   result.input_faces = mesh.faces_alive, result.input_vertices = mesh.vertices_alive;
   result.dropped_degenerate_faces = mesh.dropped_degenerate, result.dropped_duplicate_faces = mesh.dropped_duplicate;
   std::optional<ContractionMap> map;

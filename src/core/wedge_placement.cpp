@@ -9,7 +9,7 @@ bool place_with_wedges(const Context& c, std::uint32_t a, std::uint32_t b, const
   bool found = false;
   for (int direction = 0; direction < 2; ++direction) {
     const std::uint32_t survivor = direction == 0 ? a : b, removed = direction == 0 ? b : a;
-    if (c.settings.lock_border && m.boundary[removed]) continue;  // --lock-border: it must stay
+    if (m.held(removed, c.settings.lock_border)) continue;  // locked: it must stay
     if (!map_wedges(m, wg, survivor, removed, map)) continue;
     Quadric total = q;
     std::uint32_t w = wg.first[survivor];
@@ -20,7 +20,7 @@ bool place_with_wedges(const Context& c, std::uint32_t a, std::uint32_t b, const
       total += wg.reduced(w, partner);
       w = wg.next[w];
     } while (w != wg.first[survivor]);
-    const bool free = wg.single(a) && wg.single(b) && !(c.settings.lock_border && m.boundary[survivor]);
+    const bool free = wg.single(a) && wg.single(b) && !m.held(survivor, c.settings.lock_border);
     const Placed candidate =
         free ? place(total, m.pos[a], m.pos[b], c.settings.placement) : Placed{m.pos[survivor], total.evaluate(m.pos[survivor])};
     if (!found || candidate.error < placed.error) placed = candidate;

@@ -188,6 +188,7 @@ void WorkingMesh::squeeze_vertices(const std::vector<std::uint32_t>& vertex_to, 
   squeeze_by(vertex_to, count, moved);
   squeeze_by(vertex_to, count, aggregated);
   squeeze_by(vertex_to, count, source_vertex);
+  if (!locked.empty()) squeeze_by(vertex_to, count, locked);
 }
 
 Mesh build_output(const WorkingMesh& m, MeshView input, std::vector<std::uint32_t>* vertex_source,

@@ -32,6 +32,7 @@ struct WorkingMesh {
   /// Set on both ends of a contracted threshold pair and inherited through merges: an aggregation
   /// joint, non-manifold by design (GH97 §3.2), where the link condition does not apply.
   std::vector<std::uint8_t> aggregated;
+  std::vector<std::uint8_t> locked;  ///< SimplifyOptions::vertex_lock per working vertex (empty: none)
   VertexLists vertex_faces;  ///< each vertex's faces (exact in the greedy order; see order_passes)
 
   std::size_t faces_alive = 0, vertices_alive = 0;
@@ -49,6 +50,10 @@ struct WorkingMesh {
     const Vec3& p1 = t[1] == moved_vertex ? to : pos[t[1]];
     const Vec3& p2 = t[2] == moved_vertex ? to : pos[t[2]];
     return cross(p1 - p0, p2 - p0);
+  }
+  /// Whether v may not move: locked, or on a border under --lock-border.
+  bool held(std::uint32_t v, bool lock_border) const {
+    return (lock_border && boundary[v]) || (!locked.empty() && locked[v]);
   }
   /// A vertex's position in the input's frame: its exact input coordinates if it never moved.
   Vec3 output_position(std::uint32_t v, MeshView input) const {
