@@ -134,7 +134,8 @@ void print_report(const std::string& path, const LoadReport& r, const Mesh& mesh
     std::printf("  genus                  - (not a closed oriented manifold)\n");
   if (mesh.attributes.empty()) std::printf("  attributes             none\n");
   for (const VertexAttribute& a : mesh.attributes)
-    std::printf("  attribute              %s (%s, %u components)\n", a.name.c_str(), kind_name(a.kind), a.components);
+    std::printf("  attribute              %s (%s, %u components)\n", a.name.c_str(), kind_name(a.kind),
+                a.components);
   std::printf("  seam vertices          %zu (positions held by more than one vertex)\n", m.seam_vertices);
   std::printf("  materials              %zu", m.materials);
   if (!mesh.material_library.empty()) std::printf(" (library %s)", mesh.material_library.c_str());

@@ -125,8 +125,8 @@ inline std::string check_parse(std::string_view bytes, FileFormat format) {
     if (wedges) {
       // Vertices may be renumbered (duplicate v lines are welded); every vertex and corner stays.
       if (again.vertex_count() != mesh.vertex_count())
-        return "an OBJ round trip changed the vertex count from " + std::to_string(mesh.vertex_count()) + " to " +
-               std::to_string(again.vertex_count());
+        return "an OBJ round trip changed the vertex count from " + std::to_string(mesh.vertex_count()) +
+               " to " + std::to_string(again.vertex_count());
       if (corner_values(again) != corner_values(mesh)) return "an OBJ round trip changed a corner's values";
     } else if (o.double_precision || format == FileFormat::Obj || format == FileFormat::Off) {
       if (again.positions != mesh.positions) return "a lossless write/read round trip changed a coordinate";

@@ -107,12 +107,9 @@ void serialised_seeds(const fs::path& out) {
     const char* name;
     qem::Mesh mesh;
   };
-  const std::vector<Named> meshes = {{"tetrahedron", tetrahedron()},
-                                     {"cube", cube()},
-                                     {"grid", grid(3)},
-                                     {"odd", odd()},
-                                     {"attributed", attributed()},
-                                     {"empty", qem::Mesh{}}};
+  const std::vector<Named> meshes = {
+      {"tetrahedron", tetrahedron()}, {"cube", cube()},      {"grid", grid(3)}, {"odd", odd()},
+      {"attributed", attributed()},   {"empty", qem::Mesh{}}};
   struct Format {
     qem::FileFormat format;
     const char* dir;
@@ -187,19 +184,21 @@ void handwritten_seeds(const fs::path& out) {
              "end_header\n0 0 0 0 0 1\n1 0 0 0 0 1\n1 1 0 0 0 1\n0 1 0 0 0 1\n4 0 1 2 3\n");
   // Attribute properties in every spelling: float colours with alpha, texture_u/v, ushort and face
   // colours.
-  write_file(out / "ply" / "hand_attributes",
-             "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
-             "property float nx\nproperty float ny\nproperty float nz\nproperty float texture_u\n"
-             "property float texture_v\nproperty float red\nproperty float green\nproperty float blue\n"
-             "property float alpha\nproperty ushort quality\nelement face 2\n"
-             "property list uchar int vertex_indices\nproperty uchar red\nproperty uchar green\n"
-             "property uchar blue\nend_header\n0 0 0 0 0 1 0 0 1 0 0 1 7\n1 0 0 0 0 1 1 0 0 1 0 0.5 8\n"
-             "1 1 0 0 0 1 1 1 0 0 1 1 9\n0 1 0 0 0 1 0 1 0.2 0.2 0.2 0 10\n3 0 1 2 255 0 0\n3 0 2 3 0 0 255\n");
-  write_file(out / "ply" / "hand_uchar_colours",
-             "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-             "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty float s\nproperty float t\n"
-             "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
-             "0 0 0 255 0 0 0 0\n1 0 0 0 255 0 1 0\n0 1 0 0 0 255 0 1\n3 0 1 2\n");
+  write_file(
+      out / "ply" / "hand_attributes",
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+      "property float nx\nproperty float ny\nproperty float nz\nproperty float texture_u\n"
+      "property float texture_v\nproperty float red\nproperty float green\nproperty float blue\n"
+      "property float alpha\nproperty ushort quality\nelement face 2\n"
+      "property list uchar int vertex_indices\nproperty uchar red\nproperty uchar green\n"
+      "property uchar blue\nend_header\n0 0 0 0 0 1 0 0 1 0 0 1 7\n1 0 0 0 0 1 1 0 0 1 0 0.5 8\n"
+      "1 1 0 0 0 1 1 1 0 0 1 1 9\n0 1 0 0 0 1 0 1 0.2 0.2 0.2 0 10\n3 0 1 2 255 0 0\n3 0 2 3 0 0 255\n");
+  write_file(
+      out / "ply" / "hand_uchar_colours",
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty float s\nproperty float t\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0 255 0 0 0 0\n1 0 0 0 255 0 1 0\n0 1 0 0 0 255 0 1\n3 0 1 2\n");
   write_file(
       out / "stl" / "hand_ascii",
       "solid part\n  facet normal 0 0 1\n    outer loop\n      vertex 0 0 0\n      vertex 1 0 0\n"

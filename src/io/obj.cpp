@@ -40,7 +40,7 @@ struct IndexCheck {
       idx += n;  // relative: -1 is the last element read so far
       if (idx < 0)
         in.fail(std::string("relative ") + what + " index " + std::to_string(idx - n) +
-                " refers before the first one");
+                " refers before the first " + what);
       return static_cast<std::uint32_t>(idx);
     }
     if (idx == 0) in.fail(std::string(what) + " index 0 (OBJ indices start at 1)");
@@ -157,7 +157,8 @@ void build_wedges(Mesh& mesh, const CornerColumn& tex, const CornerColumn& nrm, 
 
 }  // namespace
 
-Mesh parse_obj(std::string_view bytes, const std::string& name, const LoadOptions& options, LoadReport& report) {
+Mesh parse_obj(std::string_view bytes, const std::string& name, const LoadOptions& options,
+               LoadReport& report) {
   const bool attributes = options.read_attributes;
   Mesh mesh;
   // Rough reservation from the file size (a vertex line is at least ~12 bytes); bounded by the data.
@@ -172,6 +173,7 @@ Mesh parse_obj(std::string_view bytes, const std::string& name, const LoadOption
   std::unordered_map<std::string, std::uint32_t> material_index;
   std::string material;  // the current `usemtl` name
   bool any_usemtl = false;
+  std::uint32_t current_material = kNone;  // its index, once a face has used it
 
   TextCursor in(bytes, name, '#', true);
   while (!in.at_end()) {
@@ -273,17 +275,22 @@ Mesh parse_obj(std::string_view bytes, const std::string& name, const LoadOption
       const std::size_t before = mesh.indices.size();
       sink.add(corners.data(), corners.size());
       if (attributes) {
-        // The same fan as PolygonSink: corners 0, k-1, k.
+        // The same fan as PolygonSink: triangle k - 2 has corners 0, k - 1, k.
+        std::size_t c = before;
         for (std::size_t k = 2; k < corners.size(); ++k)
           for (std::size_t j : {std::size_t{0}, k - 1, k}) {
-            const std::size_t c = before + 3 * (k - 2) + (j == 0 ? 0 : j == k - 1 ? 1 : 2);
             tex.push(corner_vt[j], c);
             nrm.push(corner_vn[j], c);
+            ++c;
           }
         if (any_usemtl) {
-          auto [it, added] = material_index.try_emplace(material, static_cast<std::uint32_t>(mesh.material_names.size()));
-          if (added) mesh.material_names.push_back(material);
-          mesh.face_materials.insert(mesh.face_materials.end(), corners.size() - 2, it->second);
+          if (current_material == kNone) {  // the first face since a usemtl: look its name up once
+            auto [it, added] =
+                material_index.try_emplace(material, static_cast<std::uint32_t>(mesh.material_names.size()));
+            if (added) mesh.material_names.push_back(material);
+            current_material = it->second;
+          }
+          mesh.face_materials.insert(mesh.face_materials.end(), corners.size() - 2, current_material);
         }
       }
     } else if (keyword == "usemtl" && attributes) {
@@ -297,13 +304,15 @@ Mesh parse_obj(std::string_view bytes, const std::string& name, const LoadOption
         }
       }
       material = std::string(in.rest_of_line());
+      current_material = kNone;
     } else if (keyword == "mtllib" && attributes) {
       std::string library(in.rest_of_line());
       if (mesh.material_library.empty())
         mesh.material_library = library;
       else if (library != mesh.material_library)
-        report.warnings.push_back(at_line(name, in.line(), "second mtllib '" + library.substr(0, 64) +
-                                                               "' ignored (one material library is kept)"));
+        report.warnings.push_back(
+            at_line(name, in.line(),
+                    "second mtllib '" + library.substr(0, 64) + "' ignored (one material library is kept)"));
     }
     in.next_line();
   }
@@ -421,10 +430,15 @@ std::string write_obj(const Mesh& mesh) {
         vline[v] = lines++;
         continue;
       }
-      std::array<std::uint64_t, 6> key{bits(mesh.positions[3 * v]), bits(mesh.positions[3 * v + 1]),
-                                       bits(mesh.positions[3 * v + 2]), 0, 0, 0};
+      std::array<std::uint64_t, 6> key{bits(mesh.positions[3 * v]),
+                                       bits(mesh.positions[3 * v + 1]),
+                                       bits(mesh.positions[3 * v + 2]),
+                                       0,
+                                       0,
+                                       0};
       if (col)
-        for (std::size_t k = 0; k < 3 && k < col->components; ++k) key[3 + k] = bits(col->values[col->components * v + k]);
+        for (std::size_t k = 0; k < 3 && k < col->components; ++k)
+          key[3 + k] = bits(col->values[col->components * v + k]);
       auto [it, added] = line_of.try_emplace(key, lines);
       std::uint32_t line = it->second;
       const std::uint64_t t = tex ? vt_id[v] : 0, n = nrm ? vn_id[v] : 0;
@@ -471,7 +485,8 @@ std::string write_obj(const Mesh& mesh) {
   };
   std::uint32_t current = materials ? mesh.face_materials[0] : 0;
   // Leading faces of the unnamed material are the faces before any usemtl: no statement needed.
-  if (materials && !(current < mesh.material_names.size() && mesh.material_names[current].empty())) usemtl(current);
+  if (materials && !(current < mesh.material_names.size() && mesh.material_names[current].empty()))
+    usemtl(current);
   for (std::size_t f = 0; f < nf; ++f) {
     if (materials && mesh.face_materials[f] != current) {
       current = mesh.face_materials[f];

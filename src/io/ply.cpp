@@ -426,11 +426,13 @@ constexpr std::string_view kTexCoordNames[][2] = {
 /// Finds normals (nx ny nz), texture coordinates and colours (red green blue [alpha]) among the
 /// vertex properties and adds their attributes to `mesh`. Colours must be uchar (0..255), ushort
 /// (0..65535) or floating point ([0, 1] as is): an integer of another type has no agreed scale.
-std::vector<AttributeSlot> find_attributes(const Element& e, Mesh& mesh, std::size_t n, const std::string& name) {
+std::vector<AttributeSlot> find_attributes(const Element& e, Mesh& mesh, std::size_t n,
+                                           const std::string& name) {
   std::vector<AttributeSlot> slots(e.props.size());
   auto find = [&](std::string_view prop) -> int {
     for (std::size_t k = 0; k < e.props.size(); ++k)
-      if (!e.props[k].is_list && e.props[k].name == prop && slots[k].attribute < 0) return static_cast<int>(k);
+      if (!e.props[k].is_list && e.props[k].name == prop && slots[k].attribute < 0)
+        return static_cast<int>(k);
     return -1;
   };
   auto add = [&](const char* attr, AttributeKind kind, const std::vector<int>& props) {
@@ -449,8 +451,9 @@ std::vector<AttributeSlot> find_attributes(const Element& e, Mesh& mesh, std::si
         s.scale = 1.0 / 65535;
       else if (is_integral(p.type))
         fail_line(name, p.line,
-                  "vertex colour property '" + p.name + "' has an integer type other than uchar or ushort "
-                  "(its scale is unknown; uchar, ushort, float or double expected)");
+                  "vertex colour property '" + p.name +
+                      "' has an integer type other than uchar or ushort "
+                      "(its scale is unknown; uchar, ushort, float or double expected)");
     }
   };
   const int nx = find("nx"), ny = find("ny"), nz = find("nz");
@@ -464,7 +467,8 @@ std::vector<AttributeSlot> find_attributes(const Element& e, Mesh& mesh, std::si
   }
   const int r = find("red"), g = find("green"), b = find("blue"), alpha = find("alpha");
   if (r >= 0 && g >= 0 && b >= 0)
-    add("COLOR_0", AttributeKind::Color, alpha >= 0 ? std::vector<int>{r, g, b, alpha} : std::vector<int>{r, g, b});
+    add("COLOR_0", AttributeKind::Color,
+        alpha >= 0 ? std::vector<int>{r, g, b, alpha} : std::vector<int>{r, g, b});
   return slots;
 }
 
@@ -503,8 +507,8 @@ void read_vertices(BodyReader& in, const Element& e, Mesh& mesh, const LoadOptio
     in.fail("header declares " + std::to_string(e.count) + " vertices but the file is too short for them");
   const std::size_t n = static_cast<std::size_t>(e.count);
   mesh.positions.resize(3 * n);
-  std::vector<AttributeSlot> attr_slot =
-      options.read_attributes ? find_attributes(e, mesh, n, in.name()) : std::vector<AttributeSlot>(e.props.size());
+  std::vector<AttributeSlot> attr_slot = options.read_attributes ? find_attributes(e, mesh, n, in.name())
+                                                                 : std::vector<AttributeSlot>(e.props.size());
   std::vector<int> prop_slot(e.props.size(), -1);  // index into mesh.vertex_properties
   if (options.keep_vertex_properties)
     for (std::size_t k = 0; k < e.props.size(); ++k) {
@@ -795,10 +799,10 @@ Mesh parse_ply(std::string_view bytes, const std::string& name, const LoadOption
       // material per distinct colour would be a guess at the writer's intent): skipped, and said.
       if (options.read_attributes &&
           std::any_of(e.props.begin(), e.props.end(), [](const Property& p) { return p.name == "red"; }))
-        report.warnings.push_back(at_line(name, e.header_line, "face colours skipped (vertex colours are read)"));
+        report.warnings.push_back(
+            at_line(name, e.header_line, "face colours skipped (vertex colours are read)"));
       read_faces(in, e, nv, false, sink);
-    }
-    else if (e.name == "tristrips")
+    } else if (e.name == "tristrips")
       read_faces(in, e, nv, true, sink);
     else
       skip_element(in, e);
@@ -877,7 +881,8 @@ std::string write_ply(const Mesh& mesh, bool binary, bool double_precision) {
         for (std::size_t i = 0; i < a->values.size(); ++i)
           if (std::fabs(a->values[i]) > std::numeric_limits<float>::max())
             throw Error("cannot write PLY with float values: vertex " + std::to_string(i / a->components) +
-                        " has attribute '" + a->name + "' beyond single precision; write a PLY with double values (qem --double)");
+                        " has attribute '" + a->name +
+                        "' beyond single precision; write a PLY with double values (qem --double)");
   }
   const char* type = double_precision ? "double" : "float";
   std::string out;
@@ -892,7 +897,8 @@ std::string write_ply(const Mesh& mesh, bool binary, bool double_precision) {
   if (attrs.texcoord)
     for (const char* c : {"s", "t"}) out += std::string("property ") + type + " " + c + "\n";
   const char* channels[] = {"red", "green", "blue", "alpha"};
-  for (std::uint32_t k = 0; k < attrs.colour_channels(); ++k) out += std::string("property uchar ") + channels[k] + "\n";
+  for (std::uint32_t k = 0; k < attrs.colour_channels(); ++k)
+    out += std::string("property uchar ") + channels[k] + "\n";
   for (const VertexProperty* p : props) out += std::string("property ") + type + " " + p->name + "\n";
   out += "element face ";
   append_uint(out, nf);
