@@ -227,6 +227,17 @@ TEST(IoAttributesObj, WriterSharesPositionsButKeepsEveryVertex) {
   EXPECT_EQ(corners(r), corners(m));
 }
 
+TEST(IoAttributesObj, WeldingKeepsTheWedgesOfASeam) {
+  LoadOptions o;
+  o.weld = qem::Weld::On;
+  // Two v lines at the same place: the corners with the same vt merge, the seam stays.
+  Mesh m = read_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 0\nvt 0 0\nvt 1 1\nf 1/1 2/1 3/1\nf 4/1 3/1 2/2\n", o);
+  EXPECT_EQ(m.vertex_count(), 4u);  // (0,0,0)/vt1 once, (1,0,0) twice (vt1, vt2), (0,1,0)
+  EXPECT_EQ(m.attributes[0].values.size(), 8u);
+  EXPECT_EQ(corners(m),
+            corners(read_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 1\nf 1/1 2/1 3/1\nf 1/1 3/1 2/2\n")));
+}
+
 TEST(IoAttributesObj, Errors) {
   const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
   EXPECT_EQ(expect_error(tri + "vt nan 0\nf 1/1 2/1 3/1\n", FileFormat::Obj),
