@@ -3,11 +3,15 @@
 // and colours (uchar and float, with alpha), binary and ASCII; errors with file and line; every
 // shared OBJ with vt/vn.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 #include <string>
@@ -254,6 +258,27 @@ TEST(IoAttributesObj, Errors) {
             "bad, line 4: expected a texture coordinate index, found 'x 2 3'");
   EXPECT_EQ(expect_error("v 0 0 0 1 nan 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", FileFormat::Obj),
             "bad, line 1: vertex colour is not finite");
+}
+
+TEST(IoAttributesInfo, JsonListsAttributesSeamsAndMaterials) {
+  const std::string path = qem::test::temp_dir() + "/cube.obj";
+  std::ofstream(path) << "mtllib c.mtl\nusemtl wood\n" << unwrapped_cube(true);
+  std::string out;
+  FILE* pipe = popen((std::string(QEM_CLI_PATH) + " info --json " + path).c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::array<char, 4096> buf;
+  while (std::size_t n = std::fread(buf.data(), 1, buf.size(), pipe)) out.append(buf.data(), n);
+  ASSERT_EQ(pclose(pipe), 0) << out;
+  const nlohmann::json j = nlohmann::json::parse(out);  // throws on invalid JSON
+  EXPECT_EQ(j["vertices"], 24);
+  EXPECT_EQ(j["seam_vertices"], 8);
+  EXPECT_EQ(j["materials"], 1);
+  EXPECT_EQ(j["material_names"], nlohmann::json::array({"wood"}));
+  EXPECT_EQ(j["material_library"], "c.mtl");
+  ASSERT_EQ(j["attributes"].size(), 2u);
+  EXPECT_EQ(j["attributes"][0]["name"], "TEXCOORD_0");
+  EXPECT_EQ(j["attributes"][0]["kind"], "texcoord");
+  EXPECT_EQ(j["attributes"][1]["components"], 3);
 }
 
 // --- PLY -----------------------------------------------------------------------------------------
