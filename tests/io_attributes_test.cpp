@@ -377,16 +377,28 @@ TEST(IoAttributesPly, UcharColoursWithoutAlphaAndUvNames) {
   EXPECT_TRUE(qem::parse_mesh(text, FileFormat::Ply, "t.ply", plain).attributes.empty());
 }
 
-TEST(IoAttributesPly, FaceColoursAreSkippedWithAWarning) {
+TEST(IoAttributesPly, FaceColoursBecomeMaterialsAndAreWrittenBack) {
   const std::string text =
-      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-      "element face 1\nproperty list uchar int vertex_indices\nproperty uchar red\nproperty uchar green\n"
-      "property uchar blue\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2 255 0 0\n";
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 3\nproperty list uchar int vertex_indices\nproperty uchar red\nproperty uchar green\n"
+      "property uchar blue\nend_header\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2 255 0 0\n4 1 3 2 0 0 0 0\n"
+      "3 0 2 1 255 0 0\n";
   qem::LoadReport report;
   Mesh m = qem::parse_mesh(text, FileFormat::Ply, "t.ply", {}, &report);
-  EXPECT_EQ(m.face_count(), 1u);
-  ASSERT_EQ(report.warnings.size(), 1u);
-  EXPECT_EQ(report.warnings[0], "t.ply, line 7: face colours skipped (vertex colours are read)");
+  EXPECT_TRUE(report.warnings.empty());
+  EXPECT_EQ(m.material_names, (std::vector<std::string>{"rgb(255,0,0)", "rgb(0,0,0)"}));
+  EXPECT_EQ(m.face_materials, (std::vector<std::uint32_t>{0, 1, 1, 0}));  // the quad is two triangles
+  for (bool binary : {true, false}) {
+    const std::string bytes = qem::serialize_mesh(m, FileFormat::Ply, binary);
+    EXPECT_NE(bytes.find("property uchar blue\nend_header"), std::string::npos);
+    Mesh r = qem::parse_mesh(bytes, FileFormat::Ply, "t.ply");
+    EXPECT_EQ(r.material_names, m.material_names);
+    EXPECT_EQ(r.face_materials, m.face_materials);
+  }
+  // Named materials (OBJ usemtl) have no PLY form: not written.
+  Mesh named = m;
+  named.material_names = {"wood", "steel"};
+  EXPECT_EQ(qem::serialize_mesh(named, FileFormat::Ply, false).find("red"), std::string::npos);
 }
 
 TEST(IoAttributesPly, Errors) {
@@ -398,6 +410,13 @@ TEST(IoAttributesPly, Errors) {
                          FileFormat::Ply),
             "bad, line 7: vertex colour property 'red' has an integer type other than uchar or ushort (its "
             "scale is unknown; uchar, ushort, float or double expected)");
+  EXPECT_EQ(
+      expect_error(head + "element face 1\nproperty list uchar int vertex_indices\nproperty short red\n"
+                          "property short green\nproperty short blue\nend_header\n0 0 0\n1 0 0\n0 1 0\n"
+                          "3 0 1 2 1 1 1\n",
+                   FileFormat::Ply),
+      "bad, line 9: face colour property 'red' has an integer type other than uchar (uchar, float or double "
+      "expected)");
   EXPECT_EQ(expect_error(head + "property float nx\nproperty float ny\nproperty float nz\n" + tail +
                              "0 0 0 0 0 1\n1 0 0 0 nan 1\n0 1 0 0 0 1\n3 0 1 2\n",
                          FileFormat::Ply),

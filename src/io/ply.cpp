@@ -8,8 +8,10 @@
 // binary layouts (fixed-size vertex rows, faces "uchar count + int indices") run through tight
 // memcpy loops.
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <string>
@@ -687,7 +689,54 @@ bool read_faces_fast(BodyReader& in, const Element& e, std::size_t list_prop, st
 }
 
 /// Reads a face element (vertex_indices list) or a tristrips element.
-void read_faces(BodyReader& in, const Element& e, std::uint64_t nv, bool strips, PolygonSink& sink) {
+/// Face colours read as materials: each distinct colour is one material named "rgb(R,G,B)" (bytes),
+/// in order of first use; the writer turns such materials back into face colours.
+struct FaceColours {
+  int channel[3] = {-1, -1, -1};  ///< the red, green, blue properties of the face element
+  std::vector<std::uint32_t>* face_materials = nullptr;
+  std::vector<std::string>* names = nullptr;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> index;  ///< (packed rgb, material), unsorted: few
+
+  /// Finds red, green and blue among `e`'s scalar properties; false when any is missing.
+  bool find(const Element& e, const std::string& name) {
+    const char* names_rgb[3] = {"red", "green", "blue"};
+    for (int c = 0; c < 3; ++c)
+      for (std::size_t k = 0; k < e.props.size() && channel[c] < 0; ++k)
+        if (!e.props[k].is_list && e.props[k].name == names_rgb[c]) channel[c] = static_cast<int>(k);
+    if (channel[0] < 0 || channel[1] < 0 || channel[2] < 0) return false;
+    for (int c : channel) {
+      const Property& p = e.props[static_cast<std::size_t>(c)];
+      if (p.type != Type::U8 && is_integral(p.type))
+        fail_line(name, p.line,
+                  "face colour property '" + p.name +
+                      "' has an integer type other than uchar (uchar, float or "
+                      "double expected)");
+    }
+    return true;
+  }
+  /// The material of a face whose colour is `rgb` (bytes), added if new.
+  std::uint32_t material(const std::uint8_t rgb[3]) {
+    const std::uint32_t key = std::uint32_t{rgb[0]} << 16 | std::uint32_t{rgb[1]} << 8 | rgb[2];
+    for (const auto& [k, m] : index)
+      if (k == key) return m;
+    const auto m = static_cast<std::uint32_t>(names->size());
+    names->push_back("rgb(" + std::to_string(rgb[0]) + "," + std::to_string(rgb[1]) + "," +
+                     std::to_string(rgb[2]) + ")");
+    index.emplace_back(key, m);
+    return m;
+  }
+};
+
+/// A colour channel as a byte: uchar as is, a real in [0, 1] scaled; clamped and rounded (an
+/// ASCII file may hold 300 in a uchar).
+std::uint8_t channel_byte(double v, Type t) {
+  double x = t == Type::U8 ? v / 255 : v;
+  x = x > 0 ? (x < 1 ? x : 1) : 0;
+  return static_cast<std::uint8_t>(x * 255 + 0.5);
+}
+
+void read_faces(BodyReader& in, const Element& e, std::uint64_t nv, bool strips, PolygonSink& sink,
+                FaceColours* colours = nullptr) {
   std::size_t list_prop = e.props.size();
   for (std::size_t k = 0; k < e.props.size(); ++k)
     if (is_index_list(e.props[k])) {
@@ -702,15 +751,25 @@ void read_faces(BodyReader& in, const Element& e, std::uint64_t nv, bool strips,
   if (!fits(e.count, min_row, in.remaining() + 1))
     in.fail("header declares " + std::to_string(e.count) + " " + e.name +
             " elements but the file is too short for them");
-  if (!strips && read_faces_fast(in, e, list_prop, nv, sink)) return;
+  if (!strips && !colours && read_faces_fast(in, e, list_prop, nv, sink)) return;
 
   std::vector<std::uint32_t> corners;
   const Property& lp = e.props[list_prop];
   for (std::uint64_t i = 0; i < e.count; ++i) {
     in.set_context(&e, i);
+    const std::size_t before = sink.indices->size();
+    std::uint8_t rgb[3] = {0, 0, 0};
     for (std::size_t k = 0; k < e.props.size(); ++k) {
       if (k != list_prop) {
-        in.skip_property(e.props[k]);
+        int c = 0;
+        while (colours && c < 3 && colours->channel[c] != static_cast<int>(k)) ++c;
+        if (colours && c < 3) {
+          const double v = in.real(e.props[k].type);
+          if (!std::isfinite(v)) in.fail("face colour is not finite");
+          rgb[c] = channel_byte(v, e.props[k].type);
+        } else {
+          in.skip_property(e.props[k]);
+        }
         continue;
       }
       std::size_t c = in.list_count(lp);
@@ -746,6 +805,9 @@ void read_faces(BodyReader& in, const Element& e, std::uint64_t nv, bool strips,
         start = j + 1;
       }
     }
+    if (colours)
+      colours->face_materials->insert(colours->face_materials->end(), (sink.indices->size() - before) / 3,
+                                      colours->material(rgb));
   }
 }
 
@@ -765,6 +827,21 @@ void skip_element(BodyReader& in, const Element& e) {
     in.set_context(&e, i);
     for (const Property& p : e.props) in.skip_property(p);
   }
+}
+
+}  // namespace
+
+namespace {
+
+/// Gives the triangles of a face element without colours, read after a coloured one, the material
+/// "rgb(0,0,0)", so face_materials stays one per face.
+void pad_materials(Mesh& mesh) {
+  if (mesh.face_materials.empty() || mesh.face_materials.size() == mesh.face_count()) return;
+  const std::string black = "rgb(0,0,0)";
+  auto it = std::find(mesh.material_names.begin(), mesh.material_names.end(), black);
+  const auto m = static_cast<std::uint32_t>(it - mesh.material_names.begin());
+  if (it == mesh.material_names.end()) mesh.material_names.push_back(black);
+  mesh.face_materials.resize(mesh.face_count(), m);
 }
 
 }  // namespace
@@ -795,16 +872,24 @@ Mesh parse_ply(std::string_view bytes, const std::string& name, const LoadOption
     if (&e == vertex)
       read_vertices(in, e, mesh, options, report);
     else if (e.name == "face") {
-      // Face colours would need per-face attributes, which qem's wedge model does not have (a
-      // material per distinct colour would be a guess at the writer's intent): skipped, and said.
-      if (options.read_attributes &&
-          std::any_of(e.props.begin(), e.props.end(), [](const Property& p) { return p.name == "red"; }))
-        report.warnings.push_back(
-            at_line(name, e.header_line, "face colours skipped (vertex colours are read)"));
-      read_faces(in, e, nv, false, sink);
-    } else if (e.name == "tristrips")
+      // Face colours become materials (one per distinct colour): the faces keep their colour
+      // through a write, and a colour boundary is a seam to the simplifier, as a material's is.
+      FaceColours colours;
+      colours.face_materials = &mesh.face_materials;
+      colours.names = &mesh.material_names;
+      const bool coloured = options.read_attributes && mesh.face_materials.empty() && colours.find(e, name);
+      const std::size_t before = mesh.face_count();
+      read_faces(in, e, nv, false, sink, coloured ? &colours : nullptr);
+      if (coloured && before > 0) {
+        // The triangles of earlier face elements had no colour: black, the colour of none.
+        const std::uint8_t black[3] = {0, 0, 0};
+        mesh.face_materials.insert(mesh.face_materials.begin(), before, colours.material(black));
+      }
+      pad_materials(mesh);
+    } else if (e.name == "tristrips") {
       read_faces(in, e, nv, true, sink);
-    else
+      pad_materials(mesh);
+    } else
       skip_element(in, e);
   }
   if (mesh.indices.empty()) fail(name, "no faces");
@@ -851,6 +936,24 @@ struct PlyAttributes {
     return colour && (p == "red" || p == "green" || p == "blue" || (colour_channels() == 4 && p == "alpha"));
   }
 };
+
+/// The byte colour of each material when every material is named "rgb(R,G,B)" (as the reader
+/// names face colours), else empty: other materials (OBJ's named ones) have no PLY form.
+std::vector<std::array<std::uint8_t, 3>> face_colours(const Mesh& m) {
+  std::vector<std::array<std::uint8_t, 3>> colours;
+  if (m.face_materials.empty()) return colours;
+  for (const std::string& n : m.material_names) {
+    unsigned rgb[3];
+    int used = 0;
+    if (std::sscanf(n.c_str(), "rgb(%u,%u,%u)%n", &rgb[0], &rgb[1], &rgb[2], &used) != 3 ||
+        static_cast<std::size_t>(used) != n.size() || rgb[0] > 255 || rgb[1] > 255 || rgb[2] > 255)
+      return {};
+    colours.push_back({std::uint8_t(rgb[0]), std::uint8_t(rgb[1]), std::uint8_t(rgb[2])});
+  }
+  for (std::uint32_t f : m.face_materials)
+    if (f >= colours.size()) return {};
+  return colours;
+}
 
 /// A [0, 1] colour value as a byte, clamped and rounded.
 std::uint8_t colour_byte(double v) {
@@ -902,7 +1005,10 @@ std::string write_ply(const Mesh& mesh, bool binary, bool double_precision) {
   for (const VertexProperty* p : props) out += std::string("property ") + type + " " + p->name + "\n";
   out += "element face ";
   append_uint(out, nf);
-  out += "\nproperty list uchar int vertex_indices\nend_header\n";
+  out += "\nproperty list uchar int vertex_indices\n";
+  const std::vector<std::array<std::uint8_t, 3>> fcol = face_colours(mesh);
+  if (!fcol.empty()) out += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+  out += "end_header\n";
 
   // One row of real values per vertex, in header order; colours are bytes.
   std::vector<double> row;
@@ -941,6 +1047,8 @@ std::string write_ply(const Mesh& mesh, bool binary, bool double_precision) {
     for (std::size_t f = 0; f < nf; ++f) {
       out += '\3';
       for (int k = 0; k < 3; ++k) put(out, static_cast<std::int32_t>(mesh.indices[3 * f + k]));
+      if (!fcol.empty())
+        for (std::uint8_t c : fcol[mesh.face_materials[f]]) out += static_cast<char>(c);
     }
     return out;
   }
@@ -973,6 +1081,11 @@ std::string write_ply(const Mesh& mesh, bool binary, bool double_precision) {
     append_uint(out, mesh.indices[3 * f + 1]);
     out += ' ';
     append_uint(out, mesh.indices[3 * f + 2]);
+    if (!fcol.empty())
+      for (std::uint8_t c : fcol[mesh.face_materials[f]]) {
+        out += ' ';
+        append_uint(out, c);
+      }
     out += '\n';
   }
   return out;
