@@ -60,7 +60,8 @@ std::string number(double x) {
   return buf;
 }
 
-void print_json(const std::string& path, const LoadReport& r, const Mesh& mesh, const MeshInfo& m) {
+void print_json(const std::string& path, const LoadReport& r, const Mesh& mesh, const MeshInfo& m,
+                std::size_t wedges) {
   auto z = [](std::size_t v) { return std::to_string(v); };
   std::string s = "{\"file\":" + json_string(path);
   s += ",\"format\":\"" + std::string(format_name(r.format)) + "\"";
@@ -91,7 +92,7 @@ void print_json(const std::string& path, const LoadReport& r, const Mesh& mesh, 
     s += std::string(i ? "," : "") + "{\"name\":" + json_string(a.name) + ",\"kind\":\"" + kind_name(a.kind) +
          "\",\"components\":" + std::to_string(a.components) + "}";
   }
-  s += "],\"seam_vertices\":" + z(m.seam_vertices);
+  s += "],\"wedges\":" + z(wedges) + ",\"seam_vertices\":" + z(m.seam_vertices);
   s += ",\"materials\":" + z(m.materials) + ",\"material_names\":[";
   for (std::size_t i = 0; i < mesh.material_names.size(); ++i)
     s += (i ? "," : "") + json_string(mesh.material_names[i]);
@@ -102,7 +103,8 @@ void print_json(const std::string& path, const LoadReport& r, const Mesh& mesh, 
   std::printf("%s\n", s.c_str());
 }
 
-void print_report(const std::string& path, const LoadReport& r, const Mesh& mesh, const MeshInfo& m) {
+void print_report(const std::string& path, const LoadReport& r, const Mesh& mesh, const MeshInfo& m,
+                  std::size_t wedges) {
   auto yes = [](bool b) { return b ? "yes" : "no"; };
   std::printf("%s\n", path.c_str());
   std::printf("  loaded as              %s%s\n", format_name(r.format),
@@ -136,6 +138,10 @@ void print_report(const std::string& path, const LoadReport& r, const Mesh& mesh
   for (const VertexAttribute& a : mesh.attributes)
     std::printf("  attribute              %s (%s, %u components)\n", a.name.c_str(), kind_name(a.kind),
                 a.components);
+  if (wedges != m.vertices)
+    std::printf(
+        "  wedges                 %zu (vertices with their attributes; the counts above are of positions)\n",
+        wedges);
   std::printf("  seam vertices          %zu (positions held by more than one vertex)\n", m.seam_vertices);
   std::printf("  materials              %zu", m.materials);
   if (!mesh.material_library.empty()) std::printf(" (library %s)", mesh.material_library.c_str());
@@ -166,10 +172,21 @@ struct InfoArgs {
     LoadReport report;
     Mesh mesh = load_mesh(args->path, options, &report);
     MeshInfo info = mesh_info(mesh);
+    const std::size_t wedges = mesh.vertex_count();
+    if (report.format == FileFormat::Obj && info.seam_vertices > 0 && !mesh.attributes.empty()) {
+      // The topology of an OBJ is that of its `v` lines: the wedges its vt/vn corners split a
+      // position into would count every UV seam as a border (the catalogue counts `v` lines too).
+      LoadOptions positions_only = options;
+      positions_only.read_attributes = false;
+      MeshInfo topology = mesh_info(load_mesh(args->path, positions_only));
+      topology.seam_vertices = info.seam_vertices;
+      topology.materials = info.materials;
+      info = topology;
+    }
     if (args->json)
-      print_json(args->path, report, mesh, info);
+      print_json(args->path, report, mesh, info, wedges);
     else
-      print_report(args->path, report, mesh, info);
+      print_report(args->path, report, mesh, info, wedges);
     return 0;
   };
 });

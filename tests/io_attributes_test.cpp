@@ -260,7 +260,7 @@ TEST(IoAttributesObj, Errors) {
             "bad, line 1: vertex colour is not finite");
 }
 
-TEST(IoAttributesInfo, JsonListsAttributesSeamsAndMaterials) {
+TEST(IoAttributesInfo, JsonListsAttributesSeamsAndMaterialsAndTheTopologyOfPositions) {
   const std::string path = qem::test::temp_dir() + "/cube.obj";
   std::ofstream(path) << "mtllib c.mtl\nusemtl wood\n" << unwrapped_cube(true);
   std::string out;
@@ -270,7 +270,11 @@ TEST(IoAttributesInfo, JsonListsAttributesSeamsAndMaterials) {
   while (std::size_t n = std::fread(buf.data(), 1, buf.size(), pipe)) out.append(buf.data(), n);
   ASSERT_EQ(pclose(pipe), 0) << out;
   const nlohmann::json j = nlohmann::json::parse(out);  // throws on invalid JSON
-  EXPECT_EQ(j["vertices"], 24);
+  // The topology is of the 8 positions (a closed cube), the wedges are listed apart.
+  EXPECT_EQ(j["vertices"], 8);
+  EXPECT_EQ(j["boundary_edges"], 0);
+  EXPECT_EQ(j["genus"], 0);
+  EXPECT_EQ(j["wedges"], 24);
   EXPECT_EQ(j["seam_vertices"], 8);
   EXPECT_EQ(j["materials"], 1);
   EXPECT_EQ(j["material_names"], nlohmann::json::array({"wood"}));
