@@ -135,10 +135,6 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
 
 LoadOptions to_load_options(const AlgorithmArgs& a) {
   LoadOptions load;
-  // Positions only until the simplifier carries attributes (issue 18): the wedges a UV seam splits
-  // into would be simplified as separate borders and the output would open cracks along the seams,
-  // while the written output has no attributes anyway.
-  load.read_attributes = false;
   if (a.weld) load.weld = Weld::On;
   if (a.no_weld) load.weld = Weld::Off;
   return load;
