@@ -344,7 +344,7 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
       attribute_weights: {"normal": w, "uv": w, "color": w, "scalar": w}: what a unit of each
         attribute costs against a unit of distance (1/w costs one bounding-box diagonal); the
         library's defaults otherwise.
-      vertex_lock: not available yet (NotImplementedError when given).
+      vertex_lock: (n,) truth values: a locked vertex never moves and is never removed.
       return_mapping: fill result.vertex_source, face_source and output_vertex_of_input.
       record: keep the contraction sequence in result.record (a qem.Record; no refit then).
     progress: called with the fraction done (0..1) every few thousand contractions; returning
@@ -360,9 +360,6 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
     if record and attributes:
         raise ValueError("record: a record keeps positions and faces only, and the attributes would be lost "
                          "on replay; simplify without record=True, or carry them with return_mapping")
-    if vertex_lock is not None:
-        raise NotImplementedError("vertex_lock: locking chosen vertices is not in the library yet; "
-                                  "leave vertex_lock=None (lock_border=True locks the border)")
     if progress is not None and not callable(progress):
         raise ValueError(f"progress: expected a callable taking the fraction done, got {progress!r}")
     options = _options(target_faces=target_faces, target_ratio=target_ratio, target_vertices=target_vertices,
@@ -374,7 +371,7 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
     options.map_input_vertices = bool(return_mapping)
     if attribute_weights is not None:
         options.attribute_weights = attribute_weights
-    d = _qem.simplify(vertices, faces, options, _attribute_list(attributes), bool(record), progress)
+    d = _qem.simplify(vertices, faces, options, _attribute_list(attributes), bool(record), progress, vertex_lock)
     result = _mesh_from_dict(d, SimplifyResult)
     for key in SimplifyResult.__slots__:
         if key in ("record",):

@@ -138,7 +138,7 @@ def simplify(
     threads: int = ...,
     attributes: Optional[Mapping[str, Union[np.ndarray, Tuple[np.ndarray, str]]]] = ...,
     attribute_weights: Optional[Mapping[str, float]] = ...,
-    vertex_lock: None = ...,
+    vertex_lock: Optional[npt.ArrayLike] = ...,
     return_mapping: bool = ...,
     record: bool = ...,
     progress: Optional[Callable[[float], Optional[bool]]] = ...,

@@ -1,5 +1,6 @@
 // qem._qem.simplify and the progressive record: the options, the observer that lets Python watch
 // and cancel a run with the GIL released, and the result handed to numpy without copies.
+#include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
 #include <cmath>
@@ -201,11 +202,21 @@ void bind_simplify(py::module_& m) {
 
   m.def(
       "simplify",
-      [](py::handle vertices, py::handle faces, const SimplifyOptions& options, const py::list& attributes,
-         bool record, py::object progress) {
+      [](py::handle vertices, py::handle faces, SimplifyOptions options, const py::list& attributes,
+         bool record, py::object progress, py::object vertex_lock) {
         check_options(options);  // before any work on the arrays: a slip in the options is said at once
         Positions p = positions_from(vertices, "vertices");
         Indices f = indices_from(faces, "faces", p.data.size() / 3);
+        // vertex_lock: any array of n truth values (bool or integers), held here for the call.
+        std::vector<std::uint8_t> lock;
+        if (!vertex_lock.is_none()) {
+          const auto values = py::array_t<std::uint8_t, py::array::forcecast>::ensure(vertex_lock);
+          if (!values || values.ndim() != 1 || std::size_t(values.shape(0)) != p.data.size() / 3)
+            throw py::value_error("vertex_lock: expected " + std::to_string(p.data.size() / 3) +
+                                  " truth values, one per vertex");
+          lock.assign(values.data(), values.data() + values.shape(0));
+          options.vertex_lock = lock;
+        }
         std::vector<VertexAttribute> attrs = attributes_from_python(attributes, p.data.size() / 3);
         PythonObserver observer(record, std::move(progress));
         SimplifyResult r;
@@ -252,7 +263,7 @@ void bind_simplify(py::module_& m) {
         return out;
       },
       py::arg("vertices"), py::arg("faces"), py::arg("options"), py::arg("attributes"), py::arg("record"),
-      py::arg("progress"));
+      py::arg("progress"), py::arg("vertex_lock") = py::none());
 }
 
 }  // namespace qem::python

@@ -110,9 +110,16 @@ def test_library_errors_are_qem_error(small_torus):
         qem.load("/nonexistent/mesh.ply")
 
 
-def test_not_implemented_arguments_say_so(small_torus):
-    with pytest.raises(NotImplementedError, match="vertex_lock"):
-        qem.simplify(*small_torus, target_faces=10, vertex_lock=np.zeros(3600, bool))
+def test_vertex_lock_keeps_the_locked_vertices(small_torus):
+    v, f = small_torus
+    lock = np.zeros(len(v), bool)
+    lock[::37] = True
+    r = qem.simplify(v, f, target_faces=300, vertex_lock=lock, return_mapping=True)
+    out = r.output_vertex_of_input[lock]
+    assert (out >= 0).all()
+    assert np.array_equal(r.vertices[out], v[lock])
+    with pytest.raises(ValueError, match="vertex_lock"):
+        qem.simplify(v, f, target_faces=10, vertex_lock=np.zeros(5, bool))
 
 
 def test_empty_and_tiny_meshes_do_not_crash():
