@@ -439,7 +439,10 @@ class Measure:
     """What `measure` returns (GH97 §6.1): distances in model units, *_rel over the original's diagonal.
 
     E: mean squared distance over both sample sets; rms = sqrt(E); mean; hausdorff (symmetric) and
-    its one-sided parts h_original_to_approx, h_approx_to_original; bbox_diag, areas, sample counts.
+    its one-sided parts h_original_to_approx, h_approx_to_original; bbox_diag, areas, sample counts;
+    with attributes, uv_rms (UV units), normal_rms_deg, color_rms (None where either mesh lacks the
+    attribute), and seam_cracks (open edges of the approximation, welded by position, beyond the
+    original's: cracks_out - cracks_in).
     """
 
     def __init__(self, d):
@@ -458,13 +461,9 @@ def measure(original, approx, *, samples: int = 1_000_000, seed: int = 1, thread
     """
     if samples <= 0:
         raise ValueError(f"samples: must be positive, got {samples}")
-    return Measure(_qem.measure(_as_pair(original, "original"), _as_pair(approx, "approx"), int(samples), int(seed),
-                                int(threads)))
-
-
-def _as_pair(mesh, name):
-    vertices, faces, _ = _mesh_arrays(mesh, name)
-    return (vertices, faces)
+    original_arrays, approx_arrays = _mesh_arrays(original, "original"), _mesh_arrays(approx, "approx")
+    return Measure(_qem.measure(original_arrays[:2], approx_arrays[:2], int(samples), int(seed), int(threads),
+                                _attribute_list(original_arrays[2]), _attribute_list(approx_arrays[2])))
 
 
 def cluster(vertices, faces, *, grid=None, cell: Optional[float] = None, cell_relative: Optional[float] = None,

@@ -50,8 +50,13 @@ void save(const std::string& path, py::handle vertices, py::handle faces, const 
   save_mesh(path, mesh, options);
 }
 
-py::dict measure(py::handle original, py::handle approx, std::size_t samples, std::uint64_t seed, unsigned threads) {
+py::dict measure(py::handle original, py::handle approx, std::size_t samples, std::uint64_t seed, unsigned threads,
+                 const py::list& original_attributes, const py::list& approx_attributes) {
   MeshArrays a = mesh_from(original, "original"), b = mesh_from(approx, "approx");
+  const std::vector<VertexAttribute> attributes_a = attributes_from_python(original_attributes, a.view().vertex_count());
+  const std::vector<VertexAttribute> attributes_b = attributes_from_python(approx_attributes, b.view().vertex_count());
+  MeshView view_a = a.view(), view_b = b.view();
+  view_a.attributes = attributes_a, view_b.attributes = attributes_b;
   MeasureOptions options;
   options.samples = samples;
   options.seed = seed;
@@ -59,7 +64,7 @@ py::dict measure(py::handle original, py::handle approx, std::size_t samples, st
   MeasureResult r;
   {
     py::gil_scoped_release nogil;
-    r = qem::measure(a.view(), b.view(), options);
+    r = qem::measure(view_a, view_b, options);
   }
   py::dict out;
   out["E"] = r.E, out["E_rel"] = r.E_rel;
@@ -70,6 +75,11 @@ py::dict measure(py::handle original, py::handle approx, std::size_t samples, st
   out["bbox_diag"] = r.bbox_diag;
   out["area_original"] = r.area_original, out["area_approx"] = r.area_approx;
   out["samples_original"] = r.samples_original, out["samples_approx"] = r.samples_approx;
+  // The attribute error (None where either mesh lacks the attribute) and the seam cracks.
+  const auto optional = [](const std::optional<double>& x) { return x ? py::object(py::float_(*x)) : py::object(py::none()); };
+  out["uv_rms"] = optional(r.uv_rms), out["normal_rms_deg"] = optional(r.normal_rms_deg);
+  out["color_rms"] = optional(r.color_rms);
+  out["seam_cracks"] = r.seam_cracks, out["cracks_in"] = r.cracks_in, out["cracks_out"] = r.cracks_out;
   return out;
 }
 
@@ -176,7 +186,7 @@ void bind_tools(py::module_& m) {
   m.def("save", &save, py::arg("path"), py::arg("vertices"), py::arg("faces"), py::arg("attributes"),
         py::arg("binary"), py::arg("double_precision"));
   m.def("measure", &measure, py::arg("original"), py::arg("approx"), py::arg("samples"), py::arg("seed"),
-        py::arg("threads"));
+        py::arg("threads"), py::arg("original_attributes"), py::arg("approx_attributes"));
   m.def("cluster", &cluster, py::arg("vertices"), py::arg("faces"), py::arg("grid"), py::arg("cell"),
         py::arg("cell_relative"), py::arg("placement"));
   m.def("info", &info, py::arg("vertices"), py::arg("faces"));

@@ -177,3 +177,15 @@ def test_bad_input_to_the_other_functions(small_torus):
         qem.measure((v, f), (v, f), samples=0)
     with pytest.raises(qem.Error):
         qem.Record.from_bytes(b"not a record")
+
+
+def test_measure_reports_the_attribute_error(small_torus):
+    v, f = small_torus
+    normals = v / np.linalg.norm(v, axis=1)[:, None]
+    original = qem.Mesh(v, f, {"NORMAL": normals})
+    r = qem.simplify(v, f, target_faces=500, attributes={"NORMAL": normals})
+    m = qem.measure(original, r, samples=20000)
+    assert m.normal_rms_deg is not None and 0 < m.normal_rms_deg < 30
+    assert m.uv_rms is None and m.color_rms is None
+    assert m.seam_cracks == 0
+    assert qem.measure(original, original, samples=20000).normal_rms_deg < 1e-3
