@@ -24,6 +24,8 @@ const char* format_name(FileFormat f) {
       return "stl";
     case FileFormat::Off:
       return "off";
+    case FileFormat::Gltf:
+      return "gltf";
     case FileFormat::Auto:
       break;
   }
@@ -75,8 +77,8 @@ void print_report(const std::string& path, const LoadReport& r, const MeshInfo& 
   auto yes = [](bool b) { return b ? "yes" : "no"; };
   std::printf("%s\n", path.c_str());
   std::printf("  loaded as              %s%s\n", format_name(r.format),
-              r.format == FileFormat::Ply || r.format == FileFormat::Stl
-                  ? (r.binary ? " (binary)" : " (ascii)")
+              r.format == FileFormat::Gltf  ? (r.binary ? " (binary .glb)" : " (JSON .gltf)")
+              : r.format == FileFormat::Ply || r.format == FileFormat::Stl ? (r.binary ? " (binary)" : " (ascii)")
                   : "");
   std::printf("  polygons triangulated  %zu\n", r.polygons_triangulated);
   std::printf("  vertices welded        %zu\n", r.vertices_welded);
