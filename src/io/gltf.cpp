@@ -613,6 +613,31 @@ void GltfDocument::save(const std::string& path) const {
   io::write_file_atomic(path, bytes);
 }
 
+namespace {
+
+/// Appends a part's faces on its vertices at `base`, with their material (no material: the one
+/// after the document's).
+void add_faces(Mesh& out, const Mesh& part, std::uint32_t base, const Mat4& world, int material,
+               std::size_t materials, bool& uses_default) {
+  // A mirroring transform (negative determinant) reverses the winding (glTF 2.0 §3.7.4).
+  const double det = world[0] * (world[5] * world[10] - world[6] * world[9]) -
+                     world[4] * (world[1] * world[10] - world[2] * world[9]) +
+                     world[8] * (world[1] * world[6] - world[2] * world[5]);
+  for (std::size_t f = 0; f < part.face_count(); ++f) {
+    std::uint32_t a = part.indices[3 * f], b = part.indices[3 * f + 1], c = part.indices[3 * f + 2];
+    if (det < 0) std::swap(b, c);
+    out.indices.insert(out.indices.end(), {base + a, base + b, base + c});
+  }
+  if (material < 0 || static_cast<std::size_t>(material) >= materials) {
+    uses_default = true;
+    material = static_cast<int>(materials);
+  }
+  out.face_materials.insert(out.face_materials.end(), part.face_count(),
+                            static_cast<std::uint32_t>(material));
+}
+
+}  // namespace
+
 Mesh GltfDocument::scene_mesh() const {
   const Impl& d = *impl_;
   const tinygltf::Model& m = d.model;
@@ -620,14 +645,21 @@ Mesh GltfDocument::scene_mesh() const {
   for (std::size_t i = 0; i < d.primitives.size(); ++i)
     index_of[{d.primitives[i].mesh, d.primitives[i].primitive}] = i;
 
-  // (primitive, world matrix) for every triangle primitive the scene instances.
-  std::vector<std::pair<std::size_t, Mat4>> parts;
+  // (primitive, world matrix, node instance) for every triangle primitive the scene instances.
+  struct Part {
+    std::size_t primitive;
+    Mat4 world;
+    std::size_t instance;
+  };
+  std::vector<Part> parts;
+  std::size_t instances = 0;
   auto add_mesh = [&](int mesh, const Mat4& world) {
+    ++instances;
     if (mesh < 0 || static_cast<std::size_t>(mesh) >= m.meshes.size()) return;
     for (std::size_t k = 0; k < m.meshes[static_cast<std::size_t>(mesh)].primitives.size(); ++k) {
       std::size_t i = index_of.at({static_cast<std::size_t>(mesh), k});
       if (d.primitives[i].mode == TINYGLTF_MODE_TRIANGLES && d.primitives[i].vertex_count > 0)
-        parts.push_back({i, world});
+        parts.push_back({i, world, instances});
     }
   };
   std::vector<int> roots;
@@ -668,7 +700,12 @@ Mesh GltfDocument::scene_mesh() const {
     out.material_names.push_back(m.materials[mi].name.empty() ? "material_" + std::to_string(mi)
                                                               : m.materials[mi].name);
   bool uses_default = false, first = true;
-  for (const auto& [i, world] : parts) {
+  // Primitives of one node instance that share their vertex accessors (one primitive per
+  // material over the same vertices, as save_mesh writes) share their vertices here too.
+  std::map<std::pair<std::size_t, std::map<std::string, int>>, std::uint32_t> shared_base;
+  for (const Part& part_ref : parts) {
+    const std::size_t i = part_ref.primitive;
+    const Mat4& world = part_ref.world;
     const Mesh part = d.replaced.count(i) ? d.replaced.at(i) : d.read(i);
     if (first) {
       for (const VertexAttribute& a : part.attributes)
@@ -684,6 +721,14 @@ Mesh GltfDocument::scene_mesh() const {
     if (out.positions.size() / 3 + part.vertex_count() > 0xffffffffu)
       throw Error(d.name + ": the scene has more than 2^32 vertices");
     const auto base = static_cast<std::uint32_t>(out.vertex_count());
+    const auto key = std::make_pair(part_ref.instance, d.primitive(i).attributes);
+    if (!d.replaced.count(i)) {
+      if (auto it = shared_base.find(key); it != shared_base.end()) {
+        add_faces(out, part, it->second, world, d.primitives[i].material, m.materials.size(), uses_default);
+        continue;
+      }
+      shared_base[key] = base;
+    }
     for (std::size_t v = 0; v < part.vertex_count(); ++v) {
       const double* p = &part.positions[3 * v];
       for (int r = 0; r < 3; ++r)
@@ -708,22 +753,7 @@ Mesh GltfDocument::scene_mesh() const {
           for (std::size_t r = 0; r < 3; ++r) a.values[v + r] = t[r] / len;
       }
     }
-    // A mirroring transform (negative determinant) reverses the winding (glTF 2.0 §3.7.4).
-    const double det = world[0] * (world[5] * world[10] - world[6] * world[9]) -
-                       world[4] * (world[1] * world[10] - world[2] * world[9]) +
-                       world[8] * (world[1] * world[6] - world[2] * world[5]);
-    for (std::size_t f = 0; f < part.face_count(); ++f) {
-      std::uint32_t a = part.indices[3 * f], b = part.indices[3 * f + 1], c = part.indices[3 * f + 2];
-      if (det < 0) std::swap(b, c);
-      out.indices.insert(out.indices.end(), {base + a, base + b, base + c});
-    }
-    int material = d.primitives[i].material;
-    if (material < 0 || static_cast<std::size_t>(material) >= m.materials.size()) {
-      uses_default = true;
-      material = static_cast<int>(m.materials.size());
-    }
-    out.face_materials.insert(out.face_materials.end(), part.face_count(),
-                              static_cast<std::uint32_t>(material));
+    add_faces(out, part, base, world, d.primitives[i].material, m.materials.size(), uses_default);
   }
   if (uses_default) out.material_names.push_back("(default)");
   return out;
