@@ -356,6 +356,25 @@ TEST(GltfErrors, AccessorBeyondItsBufferView) {
   EXPECT_NE(e.find("buffer view 1"), std::string::npos) << e;
 }
 
+TEST(GltfErrors, BufferViewBeyondItsBuffer) {
+  Tiny t;
+  t.doc["bufferViews"][2]["byteLength"] = 4000;
+  std::string e = error_of(t.text());
+  EXPECT_NE(e.find("tiny.gltf: buffer view 2 (bytes 96, 4000 long) lies outside its buffer of 156 bytes"),
+            std::string::npos)
+      << e;
+}
+
+TEST(GltfErrors, NodeTransformBeyondTheDoubleRange) {
+  Tiny t;
+  t.doc["nodes"][0]["scale"] = {1e308, 1e308, 1e308};
+  t.doc["nodes"][0]["translation"] = {1e308, 0, 0};
+  EXPECT_THROW(qem::parse_mesh(t.text(), qem::FileFormat::Gltf, "tiny.gltf"), qem::Error);
+  qem::Mesh m = qem::test::cube();
+  m.positions[0] = 1e300;  // beyond float: glTF cannot store it
+  EXPECT_THROW(qem::serialize_mesh(m, qem::FileFormat::Gltf, true), qem::Error);
+}
+
 TEST(GltfErrors, IndexBeyondTheVertexCount) {
   Tiny t;
   t.bin[144 + 10] = 9;  // the last index: 3 -> 9

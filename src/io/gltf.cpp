@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
@@ -133,6 +134,22 @@ std::array<double, 9> normal_matrix(const Mat4& m) {
   return {A / det, D / det, G / det, B / det, E / det, H / det, C / det, F / det, I / det};
 }
 
+/// Throws unless every coordinate and attribute value fits in single precision, which glTF
+/// stores (converting a double beyond the float range is undefined behaviour, and a file with
+/// infinities is one no reader takes).
+void check_fits_in_float(const Mesh& mesh, const std::string& where) {
+  const double limit = std::numeric_limits<float>::max();
+  for (std::size_t i = 0; i < mesh.positions.size(); ++i)
+    if (!(std::fabs(mesh.positions[i]) <= limit))
+      throw Error(where + ": vertex " + std::to_string(i / 3) + " has a coordinate beyond single precision");
+  for (const VertexAttribute& a : mesh.attributes)
+    for (std::size_t i = 0; i < a.values.size(); ++i)
+      if (!(std::fabs(a.values[i]) <= limit))
+        throw Error(where + ": " + a.name + " of vertex " +
+                    std::to_string(i / std::max<std::uint32_t>(a.components, 1)) +
+                    " is not finite or beyond single precision");
+}
+
 }  // namespace
 
 struct GltfDocument::Impl {
@@ -174,6 +191,18 @@ void refuse_compression(const tinygltf::Model& model, const std::string& name) {
 
 void GltfDocument::Impl::check_and_list() {
   refuse_compression(model, name);
+  // Every buffer view inside its buffer, so that saving (which copies them all) cannot fail.
+  for (std::size_t v = 0; v < model.bufferViews.size(); ++v) {
+    const tinygltf::BufferView& view = model.bufferViews[v];
+    if (view.buffer < 0 || static_cast<std::size_t>(view.buffer) >= model.buffers.size())
+      throw Error(name + ": buffer view " + std::to_string(v) + " names buffer " +
+                  std::to_string(view.buffer) + ", which does not exist");
+    const std::size_t size = model.buffers[static_cast<std::size_t>(view.buffer)].data.size();
+    if (view.byteOffset > size || view.byteLength > size - view.byteOffset)
+      throw Error(name + ": buffer view " + std::to_string(v) + " (bytes " + std::to_string(view.byteOffset) +
+                  ", " + std::to_string(view.byteLength) + " long) lies outside its buffer of " +
+                  std::to_string(size) + " bytes");
+  }
   for (std::size_t m = 0; m < model.meshes.size(); ++m)
     for (std::size_t k = 0; k < model.meshes[m].primitives.size(); ++k) {
       const tinygltf::Primitive& p = model.meshes[m].primitives[k];
@@ -383,6 +412,7 @@ void GltfDocument::replace(std::size_t i, Mesh mesh) {
     for (double v : b.values)
       if (!std::isfinite(v)) throw Error(at + ": the new mesh's " + b.name + " has a non-finite value");
   }
+  check_fits_in_float(mesh, at + ": the new mesh");
   mesh.face_materials.clear();
   mesh.material_names.clear();
   mesh.vertex_properties.clear();
@@ -756,10 +786,18 @@ Mesh GltfDocument::scene_mesh() const {
     add_faces(out, part, base, world, d.primitives[i].material, m.materials.size(), uses_default);
   }
   if (uses_default) out.material_names.push_back("(default)");
+  // Node matrices are unchecked numbers: a huge scale can push a coordinate to infinity.
+  for (double v : out.positions)
+    if (!std::isfinite(v)) throw Error(d.name + ": a node transform makes a coordinate non-finite");
+  for (const VertexAttribute& a : out.attributes)
+    for (double v : a.values)
+      if (!std::isfinite(v))
+        throw Error(d.name + ": a node transform makes a " + a.name + " value non-finite");
   return out;
 }
 
 std::string serialize_gltf(const Mesh& mesh, bool binary) {
+  check_fits_in_float(mesh, "cannot write glTF");
   tinygltf::Model m;
   m.asset.version = "2.0";
   m.asset.generator = "qem";
@@ -786,11 +824,8 @@ std::string serialize_gltf(const Mesh& mesh, bool binary) {
           if (a.components >= 3) semantic = "COLOR_" + std::to_string(colors++);
           break;
         case AttributeKind::JointIndices:
-          if (a.components == 4) semantic = "JOINTS_0";
-          break;
         case AttributeKind::JointWeights:
-          if (a.components == 4) semantic = "WEIGHTS_0";
-          break;
+          continue;  // joints without a skin mean nothing (GltfDocument keeps skins)
         case AttributeKind::Tangent:
           if (a.components == 4) semantic = "TANGENT";
           break;
@@ -801,10 +836,8 @@ std::string serialize_gltf(const Mesh& mesh, bool binary) {
       if (shared.attributes.count(semantic) || a.components < 1 || a.components > 4 ||
           a.values.size() != a.components * mesh.vertex_count())
         continue;
-      const int type = a.kind == AttributeKind::JointIndices ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT
-                                                             : TINYGLTF_COMPONENT_TYPE_FLOAT;
-      m.accessors.push_back(
-          append_accessor(m, bin, a.values, a.components, type, false, false, TINYGLTF_TARGET_ARRAY_BUFFER));
+      m.accessors.push_back(append_accessor(m, bin, a.values, a.components, TINYGLTF_COMPONENT_TYPE_FLOAT,
+                                            false, false, TINYGLTF_TARGET_ARRAY_BUFFER));
       shared.attributes[semantic] = static_cast<int>(m.accessors.size() - 1);
     }
     // One primitive per material, all on the same vertex accessors.
