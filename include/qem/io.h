@@ -17,7 +17,8 @@ namespace qem {
 
 /// Gltf: .gltf or .glb. load_mesh merges every triangle primitive of the default scene into one
 /// Mesh in world space (GltfDocument::scene_mesh); save_mesh writes a minimal glTF, .glb or .gltf
-/// by extension (serialize_gltf). Keeping the rest of a glTF file needs qem/gltf.h.
+/// by extension (serialize_gltf; `binary` chooses for serialize_mesh). Keeping the rest of a glTF
+/// file needs qem/gltf.h.
 enum class FileFormat { Auto, Obj, Ply, Stl, Off, Gltf };
 
 /// The format named by a path's extension (case-insensitive), or Auto if unknown.
@@ -54,8 +55,7 @@ Mesh parse_mesh(std::string_view bytes, FileFormat format, const std::string& na
 
 struct SaveOptions {
   FileFormat format = FileFormat::Auto;  ///< Auto: by extension
-  bool binary = true;  ///< PLY and STL: binary (little endian) or ASCII; glTF: .glb or .gltf (save_mesh
-                       ///< decides by the extension)
+  bool binary = true;                    ///< PLY, STL: binary (little endian) or ASCII; glTF: .glb
   bool double_precision = false;         ///< PLY: write double coordinates/properties instead of float
 };
 

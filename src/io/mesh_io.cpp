@@ -179,7 +179,9 @@ void save_mesh(const std::string& path, const Mesh& mesh, const SaveOptions& opt
   SaveOptions o = options;
   if (o.format == FileFormat::Auto) o.format = format_from_extension(path);
   if (o.format == FileFormat::Auto)
-    throw Error(path + ": cannot tell the output format from the extension (use .obj, .ply, .stl, .off, .glb or .gltf)");
+    throw Error(
+        path +
+        ": cannot tell the output format from the extension (use .obj, .ply, .stl, .off, .glb or .gltf)");
   if (o.format == FileFormat::Gltf) o.binary = extension_of(path) != "gltf";
   std::string bytes;
   try {
