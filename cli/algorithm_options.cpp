@@ -1,6 +1,10 @@
 #include "algorithm_options.h"
 
+#include <cmath>
+#include <cstdlib>
 #include <string>
+
+#include "cli_util.h"
 
 #include "qem/error.h"
 #include "qem/refit.h"
@@ -34,6 +38,13 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
                   "0 = off")
       ->capture_default_str();
   sub->add_flag("--lock-border", a.lock_border, "Boundary vertices never move");
+  sub->add_option("--attribute-weight", a.attribute_weights,
+                  "Weight of an attribute's error against distance, as KIND=W (normal, uv, color, scalar; "
+                  "repeat or separate by commas): a difference of 1/W costs as much as one bounding-box "
+                  "diagonal (defaults: normal=" + json_number(AttributeWeights{}.normal) + ", uv=" +
+                      json_number(AttributeWeights{}.tex_coord) + ", color=" + json_number(AttributeWeights{}.color) +
+                      ", scalar=" + json_number(AttributeWeights{}.scalar) + ")")
+      ->delimiter(',');
   sub->add_option("--inversion", a.inversion, "Contractions that flip a face: forbid, penalize, or off (GH97 6)")
       ->check(CLI::IsMember(option_names<InversionPolicy>()))
       ->capture_default_str();
@@ -95,6 +106,21 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
   opt.max_normal_turn_degrees = a.max_turn;
   opt.lock_border = a.lock_border;
   opt.preserve_topology = !a.allow_non_manifold;
+  for (const std::string& item : a.attribute_weights) {
+    const std::size_t eq = item.find('=');
+    const std::string kind = item.substr(0, eq);
+    double* weight = kind == "normal" ? &opt.attribute_weights.normal
+                     : kind == "uv"   ? &opt.attribute_weights.tex_coord
+                     : kind == "color" ? &opt.attribute_weights.color
+                     : kind == "scalar" ? &opt.attribute_weights.scalar
+                                        : nullptr;
+    char* end = nullptr;
+    const double w = eq == std::string::npos ? -1 : std::strtod(item.c_str() + eq + 1, &end);
+    if (!weight || eq == std::string::npos || !end || *end != 0 || !(w >= 0) || !std::isfinite(w))
+      throw Error("--attribute-weight: expected KIND=W with KIND normal, uv, color or scalar and W >= 0, got '" +
+                  item + "'");
+    *weight = w;
+  }
   if (a.refit_asked() && a.no_refit)
     throw Error("--no-refit cannot be combined with --refit, --refit-rounds or --refit-sample");
   if (a.refit_asked()) {

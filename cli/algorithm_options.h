@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 #include <string>
+#include <vector>
 
 #include "qem/io.h"
 #include "qem/simplify.h"
@@ -27,6 +28,7 @@ struct AlgorithmArgs {
   unsigned refit_rounds = 0;  // --refit-rounds (implies --refit); 0 = RefitOptions' default
   double refit_sample = 0;    // --refit-sample (implies --refit); 0 = every input vertex
   bool no_refit = false;      // --no-refit: not even the light refit of the default
+  std::vector<std::string> attribute_weights;  // --attribute-weight KIND=W, ...
   /// --refit, --refit-rounds or --refit-sample given (rather than the default's light refit).
   bool refit_asked() const { return refit || refit_rounds > 0 || refit_sample > 0; }
 };

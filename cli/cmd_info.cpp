@@ -32,6 +32,26 @@ const char* format_name(FileFormat f) {
   return "unknown";
 }
 
+const char* kind_name(AttributeKind k) {
+  switch (k) {
+    case AttributeKind::Normal:
+      return "normal";
+    case AttributeKind::TexCoord:
+      return "texcoord";
+    case AttributeKind::Color:
+      return "color";
+    case AttributeKind::JointIndices:
+      return "joint_indices";
+    case AttributeKind::JointWeights:
+      return "joint_weights";
+    case AttributeKind::Tangent:
+      return "tangent";
+    case AttributeKind::Scalar:
+      break;
+  }
+  return "scalar";
+}
+
 /// Shortest text that reads back to the same double (%.17g is exact but noisy).
 std::string number(double x) {
   char buf[32];
@@ -42,7 +62,8 @@ std::string number(double x) {
   return buf;
 }
 
-void print_json(const std::string& path, const LoadReport& r, const MeshInfo& m) {
+void print_json(const std::string& path, const LoadReport& r, const Mesh& mesh, const MeshInfo& m,
+                std::size_t wedges) {
   auto z = [](std::size_t v) { return std::to_string(v); };
   std::string s = "{\"file\":" + json_string(path);
   s += ",\"format\":\"" + std::string(format_name(r.format)) + "\"";
@@ -67,13 +88,25 @@ void print_json(const std::string& path, const LoadReport& r, const MeshInfo& m)
   s += ",\"manifold\":" + std::string(m.manifold() ? "true" : "false");
   s += ",\"euler\":" + std::to_string(m.euler);
   s += ",\"genus\":" + (m.genus < 0 ? std::string("null") : std::to_string(m.genus));
+  s += ",\"attributes\":[";
+  for (std::size_t i = 0; i < mesh.attributes.size(); ++i) {
+    const VertexAttribute& a = mesh.attributes[i];
+    s += std::string(i ? "," : "") + "{\"name\":" + json_string(a.name) + ",\"kind\":\"" + kind_name(a.kind) +
+         "\",\"components\":" + std::to_string(a.components) + "}";
+  }
+  s += "],\"wedges\":" + z(wedges) + ",\"seam_vertices\":" + z(m.seam_vertices);
+  s += ",\"materials\":" + z(m.materials) + ",\"material_names\":[";
+  for (std::size_t i = 0; i < mesh.material_names.size(); ++i)
+    s += (i ? "," : "") + json_string(mesh.material_names[i]);
+  s += "],\"material_library\":" + json_string(mesh.material_library);
   s += ",\"bbox\":[";
   for (int k = 0; k < 6; ++k) s += (k ? "," : "") + number(k < 3 ? m.box.lo[k] : m.box.hi[k - 3]);
   s += "],\"bbox_diagonal\":" + number(m.box.diagonal()) + "}";
   std::printf("%s\n", s.c_str());
 }
 
-void print_report(const std::string& path, const LoadReport& r, const MeshInfo& m) {
+void print_report(const std::string& path, const LoadReport& r, const Mesh& mesh, const MeshInfo& m,
+                  std::size_t wedges) {
   auto yes = [](bool b) { return b ? "yes" : "no"; };
   std::printf("%s\n", path.c_str());
   std::printf("  loaded as              %s%s\n", format_name(r.format),
@@ -104,6 +137,18 @@ void print_report(const std::string& path, const LoadReport& r, const MeshInfo& 
     std::printf("  genus                  %lld\n", m.genus);
   else
     std::printf("  genus                  - (not a closed oriented manifold)\n");
+  if (mesh.attributes.empty()) std::printf("  attributes             none\n");
+  for (const VertexAttribute& a : mesh.attributes)
+    std::printf("  attribute              %s (%s, %u components)\n", a.name.c_str(), kind_name(a.kind),
+                a.components);
+  if (wedges != m.vertices)
+    std::printf(
+        "  wedges                 %zu (vertices with their attributes; the counts above are of positions)\n",
+        wedges);
+  std::printf("  seam vertices          %zu (positions held by more than one vertex)\n", m.seam_vertices);
+  std::printf("  materials              %zu", m.materials);
+  if (!mesh.material_library.empty()) std::printf(" (library %s)", mesh.material_library.c_str());
+  std::printf("\n");
   std::printf("  bounding box           [%s, %s, %s] - [%s, %s, %s]\n", number(m.box.lo[0]).c_str(),
               number(m.box.lo[1]).c_str(), number(m.box.lo[2]).c_str(), number(m.box.hi[0]).c_str(),
               number(m.box.hi[1]).c_str(), number(m.box.hi[2]).c_str());
@@ -131,10 +176,21 @@ struct InfoArgs {
     LoadReport report;
     Mesh mesh = load_mesh(args->path, options, &report);
     MeshInfo info = mesh_info(mesh);
+    const std::size_t wedges = mesh.vertex_count();
+    if (report.format == FileFormat::Obj && info.seam_vertices > 0 && !mesh.attributes.empty()) {
+      // The topology of an OBJ is that of its `v` lines: the wedges its vt/vn corners split a
+      // position into would count every UV seam as a border (the catalogue counts `v` lines too).
+      LoadOptions positions_only = options;
+      positions_only.read_attributes = false;
+      MeshInfo topology = mesh_info(load_mesh(args->path, positions_only));
+      topology.seam_vertices = info.seam_vertices;
+      topology.materials = info.materials;
+      info = topology;
+    }
     if (args->json)
-      print_json(args->path, report, info);
+      print_json(args->path, report, mesh, info, wedges);
     else
-      print_report(args->path, report, info);
+      print_report(args->path, report, mesh, info, wedges);
     return 0;
   };
 });

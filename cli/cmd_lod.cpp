@@ -60,17 +60,30 @@ int run_lod(const LodArgs& a) {
     opt.target_faces = *std::min_element(a.faces.begin(), a.faces.end());
   else
     opt.target_ratio = *std::min_element(a.ratios.begin(), a.ratios.end());
+  // A record replays positions and faces only: with attributes (UVs, normals, colours) each level
+  // is a run of its own, which carries them.
+  const bool attributes = !mesh.attributes.empty();
   const double cpu_simplify0 = process_cpu_seconds();
-  const SimplifyResult result = simplify(mesh, opt, &recorder);
+  const SimplifyResult result = simplify(mesh, opt, attributes ? nullptr : &recorder);
   const double simplify_cpu = process_cpu_seconds() - cpu_simplify0;
   const double cpu_replay0 = process_cpu_seconds();
-  const Record record = make_record(mesh, recorder.log);
+  const Record record = attributes ? Record{} : make_record(mesh, recorder.log);
+  const std::size_t base_faces = attributes ? result.input_faces : record.base.face_count();
+  const std::size_t base_vertices = attributes ? result.input_vertices : record.base.vertex_count();
   std::vector<std::size_t> targets = a.faces;
-  for (double r : a.ratios) targets.push_back(std::size_t(std::floor(r * double(record.base.face_count()))));
+  for (double r : a.ratios) targets.push_back(std::size_t(std::floor(r * double(base_faces))));
   std::sort(targets.begin(), targets.end(), std::greater<>());  // finest first, as the manifest lists them
   targets.erase(std::unique(targets.begin(), targets.end()), targets.end());
-  std::vector<ReplayLevel> levels = replay_levels(record, targets);
-  if (refit.rounds > 0) {
+  std::vector<ReplayLevel> levels;
+  if (!attributes) levels = replay_levels(record, targets);
+  for (std::size_t target : attributes ? targets : std::vector<std::size_t>{}) {
+    SimplifyOptions level = opt;
+    level.target_ratio = 0, level.target_faces = target;
+    SimplifyResult r = simplify(mesh, level);
+    r.mesh.material_names = mesh.material_names, r.mesh.material_library = mesh.material_library;
+    levels.push_back({std::move(r.mesh), target, r.contractions, r.max_error});
+  }
+  if (refit.rounds > 0 && !attributes) {
     std::vector<Mesh*> meshes;
     for (ReplayLevel& l : levels) meshes.push_back(&l.mesh);
     qem::refit(mesh, meshes, refit);
@@ -89,8 +102,8 @@ int run_lod(const LodArgs& a) {
   const double cpu_write0 = process_cpu_seconds();
   std::string manifest = "{\n  \"generator\": \"qem lod\",\n  \"source\": " +
                          json_string(fs::path(a.input).filename().string()) +
-                         ",\n  \"input_faces\": " + std::to_string(record.base.face_count()) +
-                         ",\n  \"input_vertices\": " + std::to_string(record.base.vertex_count()) +
+                         ",\n  \"input_faces\": " + std::to_string(base_faces) +
+                         ",\n  \"input_vertices\": " + std::to_string(base_vertices) +
                          ",\n  \"levels\": [\n";
   for (std::size_t i = 0; i < levels.size(); ++i) {
     const ReplayLevel& l = levels[i];
@@ -111,7 +124,7 @@ int run_lod(const LodArgs& a) {
     std::printf(
         "{\"tool\":\"qem lod\",\"in_faces\":%zu,\"levels\":%zu,\"simplify_cpu_s\":%s,\"replay_cpu_s\":%s,"
         "\"write_cpu_s\":%s,\"cpu_s\":%s,\"total_s\":%s,\"peak_rss_mb\":%s}\n",
-        record.base.face_count(), levels.size(), json_number(simplify_cpu).c_str(),
+        base_faces, levels.size(), json_number(simplify_cpu).c_str(),
         json_number(replay_cpu).c_str(), json_number(write_cpu).c_str(),
         json_number(process_cpu_seconds() - cpu_start).c_str(), json_number(total.seconds()).c_str(),
         json_number(peak_rss_mb()).c_str());

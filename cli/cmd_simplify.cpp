@@ -71,6 +71,10 @@ int run_simplify(const SimplifyArgs& a) {
   Stopwatch t_load;
   Mesh mesh = load_input(a.input, load, &report);
   const double load_s = t_load.seconds();
+  if (!a.record.empty() && !mesh.attributes.empty())
+    throw Error(a.input + ": --record keeps positions and faces only, and this mesh has attributes (" +
+                mesh.attributes.front().name + ", ...) that a replay would lose; simplify without --record, or " +
+                "use `qem lod`, which makes each level with its attributes");
 
   Stopwatch t_simplify;
   const double cpu0 = process_cpu_seconds();

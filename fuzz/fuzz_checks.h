@@ -41,7 +41,30 @@ inline std::string check_mesh(const Mesh& m) {
     if (p.values.size() != nv)
       return "property " + p.name + " has " + std::to_string(p.values.size()) + " values for " +
              std::to_string(nv) + " vertices";
+  for (const VertexAttribute& a : m.attributes) {
+    if (a.components < 1 || a.components > 4 || a.values.size() != std::size_t{a.components} * nv)
+      return "attribute " + a.name + " has " + std::to_string(a.values.size()) + " values for " +
+             std::to_string(nv) + " vertices of " + std::to_string(a.components) + " components";
+    for (double v : a.values)
+      if (!std::isfinite(v)) return "attribute " + a.name + " has a non-finite value";
+  }
+  if (!m.face_materials.empty() && m.face_materials.size() != m.face_count())
+    return "face_materials is not one per face";
+  for (std::uint32_t f : m.face_materials)
+    if (f >= m.material_names.size()) return "face material " + std::to_string(f) + " has no name";
   return "";
+}
+
+/// Each face corner's position and attribute values: what a round trip must keep however the
+/// writer numbers vertices (an OBJ with vt/vn is welded on write and read back as wedges).
+inline std::vector<double> corner_values(const Mesh& m) {
+  std::vector<double> r;
+  for (std::uint32_t v : m.indices) {
+    r.insert(r.end(), m.positions.begin() + 3 * v, m.positions.begin() + 3 * v + 3);
+    for (const VertexAttribute& a : m.attributes)
+      r.insert(r.end(), a.values.begin() + a.components * v, a.values.begin() + a.components * (v + 1));
+  }
+  return r;
 }
 
 /// Every way a mesh can be written in `format`: text and binary (PLY, STL; glTF .gltf and .glb),
@@ -98,7 +121,15 @@ inline std::string check_parse(std::string_view bytes, FileFormat format) {
              " to " + std::to_string(again.face_count());
     // A double PLY, OBJ and OFF keep every coordinate exactly (shortest round-trip text or the
     // raw bits); float formats keep them to float precision.
-    if (o.double_precision || format == FileFormat::Obj || format == FileFormat::Off) {
+    const bool wedges = format == FileFormat::Obj && (mesh.find_attribute(AttributeKind::TexCoord) ||
+                                                      mesh.find_attribute(AttributeKind::Normal));
+    if (wedges) {
+      // Vertices may be renumbered (duplicate v lines are welded); every vertex and corner stays.
+      if (again.vertex_count() != mesh.vertex_count())
+        return "an OBJ round trip changed the vertex count from " + std::to_string(mesh.vertex_count()) +
+               " to " + std::to_string(again.vertex_count());
+      if (corner_values(again) != corner_values(mesh)) return "an OBJ round trip changed a corner's values";
+    } else if (o.double_precision || format == FileFormat::Obj || format == FileFormat::Off) {
       if (again.positions != mesh.positions) return "a lossless write/read round trip changed a coordinate";
     }
   }

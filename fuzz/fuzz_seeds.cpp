@@ -77,16 +77,39 @@ qem::Mesh odd() {
   return m;
 }
 
+/// A tetrahedron split into 12 wedges (one per face corner, as a UV-mapped, flat-shaded mesh reads)
+/// with normals, texture coordinates, RGBA colours and two materials: the attribute paths of every
+/// reader and writer.
+qem::Mesh attributed() {
+  const qem::Mesh t = tetrahedron();
+  qem::Mesh m;
+  qem::VertexAttribute n{"NORMAL", qem::AttributeKind::Normal, 3, {}};
+  qem::VertexAttribute uv{"TEXCOORD_0", qem::AttributeKind::TexCoord, 2, {}};
+  qem::VertexAttribute c{"COLOR_0", qem::AttributeKind::Color, 4, {}};
+  for (std::size_t f = 0; f < t.face_count(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t v = t.indices[3 * f + k];
+      m.positions.insert(m.positions.end(), t.positions.begin() + 3 * v, t.positions.begin() + 3 * v + 3);
+      m.indices.push_back(std::uint32_t(m.indices.size()));
+      n.values.insert(n.values.end(), {0.0, 0.0, f % 2 ? 1.0 : -1.0});
+      uv.values.insert(uv.values.end(), {k == 1 ? 1.0 : 0.0, k == 2 ? 1.0 : 0.0});
+      c.values.insert(c.values.end(), {double(f) / 4, double(k) / 3, 0.5, 1.0});
+    }
+  m.attributes = {n, uv, c};
+  m.face_materials = {0, 0, 1, 1};
+  m.material_names = {"red", "blue"};
+  m.material_library = "tetra.mtl";
+  return m;
+}
+
 void serialised_seeds(const fs::path& out) {
   struct Named {
     const char* name;
     qem::Mesh mesh;
   };
-  const std::vector<Named> meshes = {{"tetrahedron", tetrahedron()},
-                                     {"cube", cube()},
-                                     {"grid", grid(3)},
-                                     {"odd", odd()},
-                                     {"empty", qem::Mesh{}}};
+  const std::vector<Named> meshes = {
+      {"tetrahedron", tetrahedron()}, {"cube", cube()},      {"grid", grid(3)}, {"odd", odd()},
+      {"attributed", attributed()},   {"empty", qem::Mesh{}}};
   struct Format {
     qem::FileFormat format;
     const char* dir;
@@ -141,6 +164,11 @@ void handwritten_seeds(const fs::path& out) {
              "mtllib x.mtl\no thing\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 0.5 1 0.2 0.4 0.6\n"
              "vt 0 0\nvt 1 0\nvn 0 0 1\ng top\nusemtl red\ns off\n"
              "f 1/1/1 2/2/1 3//1 4\nf -5 -4 \\\n -1\nf 2 3 5\nl 1 2\n");
+  write_file(out / "obj" / "hand_attributes",
+             "# vt/vn corners, a corner without vt, 1D and 3D vt, colours, materials before and after\n"
+             "mtllib a b.mtl\nv 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 1 1 0\nv 0 1 0 0.5 0.5 0.5\n"
+             "vt 0 0\nvt 1\nvt 1 1 0\nvn 0 0 1\nvn 0 0 -1\nf 1/1/1 2/2/1 3/3/1\nusemtl m1\n"
+             "f 1/-3/-2 3/-1/-2 4\nusemtl\nf 4//2 3//2 2//2\nusemtl m1\nf 1/1 2/2 4/3 3/1\n");
   write_file(out / "obj" / "hand_crlf", "v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 3\r\n");
   write_file(out / "ply" / "hand_ascii_props",
              "ply\nformat ascii 1.0\nelement vertex 4\nproperty double x\nproperty double y\n"
@@ -155,6 +183,23 @@ void handwritten_seeds(const fs::path& out) {
              "element vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\n"
              "property float ny\nproperty float nz\nelement face 1\nproperty list uchar uint vertex_indices\n"
              "end_header\n0 0 0 0 0 1\n1 0 0 0 0 1\n1 1 0 0 0 1\n0 1 0 0 0 1\n4 0 1 2 3\n");
+  // Attribute properties in every spelling: float colours with alpha, texture_u/v, ushort and face
+  // colours.
+  write_file(
+      out / "ply" / "hand_attributes",
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+      "property float nx\nproperty float ny\nproperty float nz\nproperty float texture_u\n"
+      "property float texture_v\nproperty float red\nproperty float green\nproperty float blue\n"
+      "property float alpha\nproperty ushort quality\nelement face 2\n"
+      "property list uchar int vertex_indices\nproperty uchar red\nproperty uchar green\n"
+      "property uchar blue\nend_header\n0 0 0 0 0 1 0 0 1 0 0 1 7\n1 0 0 0 0 1 1 0 0 1 0 0.5 8\n"
+      "1 1 0 0 0 1 1 1 0 0 1 1 9\n0 1 0 0 0 1 0 1 0.2 0.2 0.2 0 10\n3 0 1 2 255 0 0\n3 0 2 3 0 0 255\n");
+  write_file(
+      out / "ply" / "hand_uchar_colours",
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty float s\nproperty float t\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0 255 0 0 0 0\n1 0 0 0 255 0 1 0\n0 1 0 0 0 255 0 1\n3 0 1 2\n");
   write_file(
       out / "stl" / "hand_ascii",
       "solid part\n  facet normal 0 0 1\n    outer loop\n      vertex 0 0 0\n      vertex 1 0 0\n"
@@ -226,7 +271,7 @@ void dictionaries(const fs::path& out) {
                      "\\\"SCALAR\\\"",
                      "data:application/octet-stream;base64,"});
   dict("obj.dict", {"v ", "vt ", "vn ", "f ", "/", "//", "-1", "#", "\\\\\\x0a", "g ", "o ", "usemtl ",
-                    "mtllib ", "1e308", "nan", "inf", "\\x0d\\x0a"});
+                    "mtllib ", "1e308", "nan", "inf", "\\x0d\\x0a", "/1/", "/-1"});
   dict("ply.dict", {"ply\\x0a",
                     "format ",
                     "ascii 1.0",
@@ -259,6 +304,11 @@ void dictionaries(const fs::path& out) {
                     "x",
                     "y",
                     "z",
+                    "nx",
+                    "red",
+                    "alpha",
+                    "texture_u",
+                    "s",
                     "\\xff\\xff\\xff\\xff"});
   dict("stl.dict", {"solid ", "facet normal ", "outer loop", "vertex ", "endloop", "endfacet", "endsolid",
                     "\\x00\\x00\\x00\\x00", "\\xff\\xff\\xff\\x7f"});

@@ -33,7 +33,9 @@ namespace {
 SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options, SimplifyObserver* observer,
                                   std::vector<std::uint32_t>* consumed_indices) {
   check_options(options);
-  const bool refit = options.refit_rounds > 0;
+  // The refit moves vertices to the input surface, which would pull seam vertices off their seams
+  // and leave the attributes fitted to the old positions: not made with attributes.
+  const bool refit = options.refit_rounds > 0 && input.attributes.empty();
   // The refit fits the input's vertices weighted by their share of the area: taken before the
   // core releases a consumed input's faces.
   std::vector<double> weights;
@@ -46,9 +48,15 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
   if (refit && out.contractions > 0 && out.stop_reason != StopReason::Cancelled) {
     if (!consumed_indices) weights = refit_detail::vertex_areas(input);
     const refit_detail::FitPoints points(input.positions, weights);
+    RefitOptions refit_options = refit_options_for(options);
+    std::vector<std::uint8_t> fixed;  // the locked vertices stay
+    if (!options.vertex_lock.empty()) {
+      fixed.assign(out.mesh.vertex_count(), 0);
+      for (std::size_t v = 0; v < out.vertex_source.size(); ++v) fixed[v] = options.vertex_lock[out.vertex_source[v]];
+      refit_options.fixed_vertices = fixed;
+    }
     // Its first search for each input vertex's closest face starts at the vertex it went into.
-    const RefitResult fit = refit_detail::refit_to_points(points, out.mesh, refit_options_for(options),
-                                                          out.output_vertex_of_input);
+    const RefitResult fit = refit_detail::refit_to_points(points, out.mesh, refit_options, out.output_vertex_of_input);
     out.refit_rms_before = fit.rms_before;
     out.refit_rms_after = fit.rms_after;
     out.refit_rounds = fit.rounds;
@@ -64,7 +72,10 @@ SimplifyResult simplify(MeshView input, const SimplifyOptions& options, Simplify
 }
 
 SimplifyResult simplify(Mesh&& input, const SimplifyOptions& options, SimplifyObserver* observer) {
-  return simplify_and_refit(input, options, observer, &input.indices);
+  SimplifyResult out = simplify_and_refit(input, options, observer, &input.indices);
+  out.mesh.material_names = std::move(input.material_names);
+  out.mesh.material_library = std::move(input.material_library);
+  return out;
 }
 
 void ContractionRecorder::on_start(std::span<const std::uint32_t> input_faces) {

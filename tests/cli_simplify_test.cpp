@@ -176,7 +176,16 @@ TEST(CliSimplify, BadOptionsAreRejected) {
   EXPECT_NE(run("simplify " + sphere_file() + " " + out + " --ratio 1.5").exit_code, 0);
   EXPECT_NE(run("simplify " + sphere_file() + " " + out + " --faces 10 --max-turn 120").exit_code, 0);
   EXPECT_NE(run("simplify /nonexistent/x.ply " + out + " --faces 10").exit_code, 0);
+  for (const char* bad : {"gloss=1", "normal", "normal=-1", "uv=x", "color=1e999"}) {
+    const CliRun r = run("simplify " + sphere_file() + " " + out + " --faces 10 --attribute-weight " + bad);
+    EXPECT_NE(r.exit_code, 0) << bad;
+    EXPECT_NE(r.out.find("--attribute-weight"), std::string::npos) << r.out;
+  }
   EXPECT_FALSE(fs::exists(out));
+  EXPECT_EQ(run("simplify " + sphere_file() + " " + out + " --faces 10 --attribute-weight normal=0.5,uv=2 "
+                "--attribute-weight color=0")
+                .exit_code,
+            0);
 }
 
 TEST(CliSimplify, HelpDocumentsEveryOption) {

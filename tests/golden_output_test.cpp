@@ -176,7 +176,11 @@ TEST_P(Golden, OutputBytesUnchanged) {
   else {
     const std::string path = test::shared_data(name);
     if (path.empty()) GTEST_SKIP() << "../shared/data not found";
-    mesh = load_mesh(path);
+    // Positions only: the checksums are of the simplifier's output for these positions and faces,
+    // which the wedges of trimesh_chair.obj's vt indices would change (they split its UV seams).
+    LoadOptions positions_only;
+    positions_only.read_attributes = false;
+    mesh = load_mesh(path, positions_only);
   }
   check_mesh(name, mesh);
 }

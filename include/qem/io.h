@@ -32,6 +32,10 @@ struct LoadOptions {
   FileFormat format = FileFormat::Auto;  ///< Auto: by extension, then by content
   Weld weld = Weld::Auto;                ///< merge exactly coincident vertices (Auto = STL only)
   bool keep_vertex_properties = false;   ///< PLY: keep extra scalar vertex properties
+  /// Read normals, texture coordinates, vertex colours and materials into Mesh::attributes,
+  /// face_materials, material_names and material_library (docs/attributes.md). Off: positions and
+  /// faces only, and an OBJ's vertices are its `v` lines even where faces index `vt`/`vn`.
+  bool read_attributes = true;
 };
 
 /// What a reader found and did, for `qem info` and the CLI summary.
@@ -67,7 +71,8 @@ std::string serialize_mesh(const Mesh& mesh, FileFormat format, bool binary = tr
 /// Same, with every save option; `options.format` must not be Auto.
 std::string serialize_mesh(const Mesh& mesh, const SaveOptions& options);
 
-/// Merges vertices with exactly equal coordinates; returns how many were removed.
+/// Merges vertices with exactly equal coordinates; returns how many were removed. When the mesh has
+/// attributes, only vertices whose attribute values are equal too (a seam's wedges stay apart).
 std::size_t weld_exact(Mesh& mesh);
 
 }  // namespace qem

@@ -34,6 +34,11 @@ struct MeshInfo {
   /// 2-manifold without repeated-index faces (from chi = 2c - 2g); -1 otherwise.
   long long genus = -1;
   Box box;
+  /// Positions held by more than one vertex (bit-identical coordinates): the seams of a wedge mesh
+  /// (UV seams, normal creases, OBJ corners with different vt/vn), or an unwelded mesh.
+  std::size_t seam_vertices = 0;
+  /// Distinct material indices used by the faces (0 when the mesh has no face materials).
+  std::size_t materials = 0;
 
   /// No boundary edges and no non-manifold edges.
   bool watertight() const { return boundary_edges == 0 && non_manifold_edges == 0; }

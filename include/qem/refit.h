@@ -34,6 +34,9 @@ struct RefitOptions {
   /// the cost follows the approximation's size, not the original's. 2 is about the fewest that
   /// fit a noisy surface rather than its noise; with fewer points the reported RMS is over them.
   double points_per_vertex = 0;
+  /// Per approximation vertex (empty: none), nonzero = it stays where it is (simplify passes its
+  /// SimplifyOptions::vertex_lock through). The caller's buffer must outlive the call.
+  std::span<const std::uint8_t> fixed_vertices;
 };
 
 struct RefitResult {

@@ -83,6 +83,17 @@ struct ContractionLog {
   std::size_t size() const { return kept.size(); }
 };
 
+/// How much a unit of each attribute counts against a unit of distance, in the normalised frame
+/// (bounding-box diagonal 1): an attribute difference of 1 / weight costs as much as a distance of
+/// one diagonal (Hoppe 1999's attribute quadric, area weighted like the positions). Kinds not
+/// listed (joints, skin weights, tangents) are never interpolated: the survivor's are kept.
+struct AttributeWeights {
+  double normal = 0.03;     ///< a normal turned by ~0.17 rad (10 degrees) ~ 0.5 % of the diagonal
+  double tex_coord = 0.5;   ///< a UV shift of 0.01 ~ 0.5 % of the diagonal
+  double color = 0.1;       ///< a colour change of 0.05 ~ 0.5 % of the diagonal
+  double scalar = 0.01;     ///< other per-vertex values
+};
+
 struct SimplifyOptions {
   // --- stop criteria: any combination, the first reached wins -----------------------------------
   std::size_t target_faces = 0;     ///< stop at or below this many faces (0 = no face target)
@@ -102,6 +113,10 @@ struct SimplifyOptions {
   /// Penalty weight of the boundary constraint planes (GH97 §6); 0 disables them.
   double boundary_weight = 1;
   bool lock_border = false;  ///< boundary vertices never move
+  /// Per input vertex (empty: none), nonzero = locked: it never moves and is never removed (the
+  /// other end of a contraction comes to it). With attributes, a position is locked when any of
+  /// its vertices is. The caller's buffer must outlive the call.
+  std::span<const std::uint8_t> vertex_lock;
   InversionPolicy inversion = InversionPolicy::Forbid;
   /// A face that turns by more than this (degrees) counts as an inversion; must be < 90.
   double max_normal_turn_degrees = 75;
@@ -125,6 +140,9 @@ struct SimplifyOptions {
   /// The refit's input points per output vertex, 0 = every input vertex (RefitOptions::
   /// points_per_vertex): the time saved grows with the input's vertices per output vertex.
   double refit_points_per_vertex = 0;
+
+  /// With attributes (MeshView::attributes), their weights in the error.
+  AttributeWeights attribute_weights;
 
   /// Fill SimplifyResult::output_vertex_of_input (one entry per input vertex).
   bool map_input_vertices = false;

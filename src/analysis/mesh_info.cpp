@@ -16,6 +16,7 @@
 
 #include "analysis/disjoint_sets.h"
 #include "check_mesh.h"
+#include "io/weld.h"
 #include "qem/error.h"
 
 namespace qem {
@@ -194,6 +195,23 @@ MeshInfo mesh_info(MeshView mesh) {
   const bool closed_manifold = info.boundary_edges == 0 && info.manifold() && repeated_count == 0;
   if (closed_manifold && info.orientation_conflicts == 0 && info.components > 0)
     info.genus = (2 * (long long)info.components - info.euler) / 2;
+
+  // --- seams and materials ------------------------------------------------------------------------
+  {
+    std::vector<double> unique;
+    unique.reserve(mesh.positions.size());
+    io::VertexWelder welder(unique, nv);
+    std::vector<std::uint32_t> count(nv, 0);  // vertices per distinct position
+    for (std::size_t v = 0; v < nv; ++v) {
+      const double* p = &mesh.positions[3 * v];
+      if (++count[welder.add(p[0], p[1], p[2])] == 2) ++info.seam_vertices;
+    }
+  }
+  if (!mesh.face_materials.empty()) {
+    std::vector<std::uint32_t> m(mesh.face_materials.begin(), mesh.face_materials.end());
+    std::sort(m.begin(), m.end());
+    info.materials = std::size_t(std::unique(m.begin(), m.end()) - m.begin());
+  }
   return info;
 }
 

@@ -11,6 +11,7 @@
 #include "core/pair_set.h"
 #include "core/quadric.h"
 #include "core/settings.h"
+#include "core/wedges.h"
 #include "core/working_mesh.h"
 #include "qem/simplify.h"
 
@@ -23,6 +24,7 @@ struct Worker {
   std::uint32_t stamp = 0;  // last stamp used in Context::marks; every stamp is used once in a run
   std::vector<std::uint32_t> faces, pairs;  // scratch: the survivor's faces and pairs
   std::vector<std::uint32_t> dead_faces;    // input faces killed by the last contraction, if observed
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> wedge_map;  // removed wedge -> survivor's
   std::size_t faces_killed = 0, vertices_removed = 0, contractions = 0;
   std::size_t blocked_topology = 0, blocked_inversion = 0, blocked_error = 0;
   double max_error = 0;  // in the working frame
@@ -44,6 +46,7 @@ struct Context {
   SimplifyResult& totals;    // contractions, rejections, stop reason
   double max_error = 0;      // largest contraction error made, working frame
   std::size_t next_progress = 0;
+  Wedges* wedges = nullptr;  // with attributes only
 
   bool done() const { return settings.reached(mesh); }
 

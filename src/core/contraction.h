@@ -69,7 +69,17 @@ inline void merge_faces(Context& c, std::uint32_t a, std::uint32_t b, bool may_d
     if (!m.face_alive[f]) continue;
     std::uint32_t* t = &m.tri[3 * std::size_t(f)];
     for (int k = 0; k < 3; ++k)
-      if (t[k] == b) t[k] = a;
+      if (t[k] == b) {
+        t[k] = a;
+        if (c.wedges) {  // the corner's wedge goes with it to its partner at a (w.wedge_map)
+          std::uint32_t& corner = m.corner_wedge[3 * std::size_t(f) + k];
+          for (const auto& [removed, kept] : w.wedge_map)
+            if (corner == removed) {
+              corner = kept;
+              break;
+            }
+        }
+      }
     if (may_duplicate && kill_if_coincident(c, f, own, w)) continue;
     faces.push_back(f);
   }
@@ -135,7 +145,8 @@ void contract(Context& c, Lists& lists, std::uint32_t p, const Quadric& q, const
   // survives, so its exact input coordinates reach the output untouched.
   const auto same = [](const Vec3& x, const Vec3& y) { return x.x == y.x && x.y == y.y && x.z == y.z; };
   if (same(target, m.pos[b]) && !same(target, m.pos[a])) std::swap(a, b);
-  m.moved[a] |= !same(target, m.pos[a]);
+  const bool moves = !same(target, m.pos[a]);
+  m.moved[a] |= moves;
   w.last_kept = a, w.last_removed = b;
   if (c.map) c.map->contracted(a, b);
   m.pos[a] = target;
@@ -144,8 +155,10 @@ void contract(Context& c, Lists& lists, std::uint32_t p, const Quadric& q, const
   ++w.vertices_removed;
   m.aggregated[a] |= m.aggregated[b] | c.pairs.pairs[p].is_virtual;
 
+  if (c.wedges) map_wedges(m, *c.wedges, a, b, w.wedge_map);  // checked by place_pair
   merge_faces(c, a, b, m.aggregated[a] || !c.settings.preserve_topology, w);
   merge_pairs(c, lists, p, a, b, w);
+  if (c.wedges) c.wedges->merge(a, b, moves, target, w.wedge_map);
   lists.contracted(a, b, w.faces, w.pairs);
   // GH97 §4 step 5: update the costs of all valid pairs involving the new vertex.
   for (std::uint32_t r : w.pairs)
@@ -183,7 +196,11 @@ bool try_contract(Context& c, Lists& lists, std::uint32_t p, Worker& w) {
   }
   Quadric q;
   Placed placed;
-  place_pair(c, p, q, placed);
+  if (!place_pair(c, p, q, placed)) {  // with attributes: the seams around it changed
+    ++w.blocked_topology;
+    ps.block(p);
+    return false;
+  }
   if (c.settings.inversion == InversionPolicy::Forbid && flips(c.mesh, a, b, placed.position, c.settings.cos_max_turn)) {
     ++w.blocked_inversion;
     ps.block(p);

@@ -23,15 +23,26 @@ inline double normalized_error(double q_error, double weight) {
   return weight > 0 ? std::sqrt(q_error / weight) : std::sqrt(q_error);
 }
 
+/// With attributes: the placement of the collapse of (a, b) over the positional quadric q plus the
+/// reduced attribute quadrics of the wedges it merges (Hoppe 1999; Hoppe & Marschner 2000's reduced
+/// solve, through place()). A seam or material boundary stays where it is: when either end has
+/// more than one wedge, the survivor stays at its own position, and the removed end's wedges must
+/// each meet one of the survivor's on the edge's faces (the collapse runs along the seam, both
+/// sides together). False if neither direction is allowed.
+bool place_with_wedges(const Context& c, std::uint32_t a, std::uint32_t b, const Quadric& q, Placed& placed);
+
 /// The quadric and placement of pair p. False if the pair can never move (both ends on a locked
-/// border); with one end there, that end is the placement.
+/// border, or, with attributes, a collapse that would move or close a seam); with one end on a
+/// locked border, that end is the placement.
 inline bool place_pair(const Context& c, std::uint32_t p, Quadric& q, Placed& placed) {
   const std::uint32_t a = c.pairs.pairs[p].v[0], b = c.pairs.pairs[p].v[1];
   const WorkingMesh& m = c.mesh;
   q = c.quadric[a] + c.quadric[b];
-  if (c.settings.lock_border && (m.boundary[a] || m.boundary[b])) {
-    if (m.boundary[a] && m.boundary[b]) return false;
-    const Vec3& fixed = m.boundary[a] ? m.pos[a] : m.pos[b];
+  if (c.wedges) return place_with_wedges(c, a, b, q, placed);
+  const bool held_a = m.held(a, c.settings.lock_border), held_b = m.held(b, c.settings.lock_border);
+  if (held_a || held_b) {
+    if (held_a && held_b) return false;
+    const Vec3& fixed = held_a ? m.pos[a] : m.pos[b];
     placed = {fixed, q.evaluate(fixed)};
     return true;
   }

@@ -29,6 +29,7 @@ void renumber_densely(Context& c, PassState& s) {
   squeeze_by(vertex_to, count, s.touched_in_pass);
   c.marks.assign(count, 0);
   if (c.map) c.map->renumber(vertex_to, count);
+  if (c.wedges) c.wedges->renumber(vertex_to, count);
 }
 
 }  // namespace qem::core

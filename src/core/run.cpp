@@ -11,7 +11,9 @@
 #include "core/parallel_chunks.h"
 #include "core/settings.h"
 #include "core/valid_pairs.h"
+#include "core/wedges.h"
 #include "core/working_mesh.h"
+#include "qem/error.h"
 
 namespace qem::core {
 
@@ -19,6 +21,11 @@ namespace {
 
 // The mesh with what the contractions left of it, and the maps the caller asked for.
 void finish(Context& c, std::optional<ContractionMap>& map, MeshView input, SimplifyResult& result) {
+  if (c.wedges) {
+    result.mesh = build_wedge_output(c.mesh, *c.wedges, input, result.vertex_source, result.face_source,
+                                     map ? &result.output_vertex_of_input : nullptr);
+    return;
+  }
   std::vector<std::uint32_t> output_index;
   result.mesh = build_output(c.mesh, input, &result.vertex_source, &result.face_source,
                              map ? &output_index : nullptr);
@@ -28,12 +35,31 @@ void finish(Context& c, std::optional<ContractionMap>& map, MeshView input, Simp
   }
 }
 
+// A working vertex is locked when any input vertex on it is.
+void lock_vertices(std::span<const std::uint8_t> lock, MeshView input, const Wedges* wedges, WorkingMesh& mesh) {
+  if (lock.size() != input.vertex_count())
+    throw Error("vertex_lock has " + std::to_string(lock.size()) + " entries for " +
+                std::to_string(input.vertex_count()) + " vertices");
+  mesh.locked.assign(mesh.vertex_count(), 0);
+  if (wedges) {
+    for (std::uint32_t w = 0; w < wedges->count(); ++w)
+      if (lock[wedges->source[w]]) mesh.locked[wedges->vertex[w]] = 1;
+  } else {
+    for (std::uint32_t v = 0; v < mesh.vertex_count(); ++v) mesh.locked[v] = lock[mesh.source_vertex[v]] != 0;
+  }
+}
+
 }  // namespace
 
 SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHooks& hooks) {
   validate(options);
   SimplifyResult result;
-  WorkingMesh mesh = prepare_input(input);  // check, drop degenerate and duplicate faces, frame
+  std::vector<std::uint32_t> internal;  // with attributes: each input vertex's working vertex
+  WorkingMesh mesh = prepare_input(input, &internal);  // check, drop degenerate and duplicate faces, frame
+  std::optional<Wedges> wedges;  // with attributes, on the input's vertices (Hoppe 1999)
+  if (!input.attributes.empty()) wedges.emplace(build_wedges(input, internal, mesh, options));
+  std::vector<std::uint32_t>().swap(internal);
+  if (!options.vertex_lock.empty()) lock_vertices(options.vertex_lock, input, wedges ? &*wedges : nullptr, mesh);
   result.input_faces = mesh.faces_alive, result.input_vertices = mesh.vertices_alive;
   result.dropped_degenerate_faces = mesh.dropped_degenerate, result.dropped_duplicate_faces = mesh.dropped_duplicate;
   std::optional<ContractionMap> map;
@@ -50,6 +76,7 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   PairSet pairs;
   Context c{settings, input, mesh, pairs, quadric, hooks.observer,
             hooks.observer && hooks.observer->wants_contractions(), map ? &*map : nullptr, {}, {}, result};
+  if (wedges) c.wedges = &*wedges;
   if (c.done()) {
     result.stop_reason = StopReason::AlreadyBelowTarget;
     result.stop_detail = stop_detail(result.stop_reason, result, settings.lock_border);

@@ -15,6 +15,19 @@ namespace {
 
 bool degenerate(const std::uint32_t* t) { return t[0] == t[1] || t[1] == t[2] || t[0] == t[2]; }
 
+// For each of `used`, the first of `used` (in input order) at exactly the same position.
+std::vector<std::uint32_t> first_at_same_position(MeshView in, const std::vector<std::uint32_t>& used) {
+  std::vector<std::uint32_t> first(in.vertex_count(), kNoVertex), order = used;
+  const auto at = [&](std::uint32_t v) {
+    return std::array<double, 3>{in.positions[3 * std::size_t(v)], in.positions[3 * std::size_t(v) + 1],
+                                 in.positions[3 * std::size_t(v) + 2]};
+  };
+  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return at(a) < at(b); });
+  for (std::size_t i = 0; i < order.size(); ++i)
+    first[order[i]] = i > 0 && at(order[i]) == at(order[i - 1]) ? first[order[i - 1]] : order[i];
+  return first;
+}
+
 // The referenced vertices (those of a face that is not degenerate: a degenerate face carries no
 // plane and no area), in input order. Unreferenced ones take no part and leave the output.
 std::vector<std::uint32_t> referenced_vertices(MeshView in, std::size_t& degenerate_faces) {
@@ -67,7 +80,7 @@ std::vector<std::uint32_t> number_vertices(MeshView in, std::vector<std::uint32_
 // together in memory). Duplicates (same three vertices, either orientation) share a bucket: they
 // would count their plane twice and survive as duplicates in the output, so only the first in
 // input order is kept.
-void add_faces(MeshView in, const std::vector<std::uint32_t>& internal, WorkingMesh& m) {
+void add_faces(MeshView in, const std::vector<std::uint32_t>& internal, bool welded, WorkingMesh& m) {
   const std::size_t nf = in.face_count(), n = m.pos.size();
   auto sorted_corners = [&](std::size_t f) {
     std::array<std::uint32_t, 3> t{internal[in.indices[3 * f]], internal[in.indices[3 * f + 1]],
@@ -75,15 +88,25 @@ void add_faces(MeshView in, const std::vector<std::uint32_t>& internal, WorkingM
     std::sort(t.begin(), t.end());
     return t;
   };
+  // On working vertices: with attributes, two corners of different input vertices may share a
+  // position (welded), and the face is degenerate too.
+  auto collapsed = [&](std::size_t f) {
+    if (!welded) return degenerate(&in.indices[3 * f]);
+    const std::array<std::uint32_t, 3> t = sorted_corners(f);
+    return t[0] == t[1] || t[1] == t[2];
+  };
+  if (welded)
+    for (std::size_t f = 0; f < nf; ++f)
+      if (collapsed(f) && !degenerate(&in.indices[3 * f])) ++m.dropped_degenerate;
   std::vector<std::uint32_t> bucket_start(n + 1, 0);
   for (std::size_t f = 0; f < nf; ++f)
-    if (!degenerate(&in.indices[3 * f])) ++bucket_start[sorted_corners(f)[0] + 1];
+    if (!collapsed(f)) ++bucket_start[sorted_corners(f)[0] + 1];
   for (std::size_t i = 0; i < n; ++i) bucket_start[i + 1] += bucket_start[i];
   std::vector<std::uint32_t> bucketed(bucket_start[n]);
   {
     std::vector<std::uint32_t> fill(bucket_start.begin(), bucket_start.end() - 1);
     for (std::size_t f = 0; f < nf; ++f)
-      if (!degenerate(&in.indices[3 * f])) bucketed[fill[sorted_corners(f)[0]]++] = std::uint32_t(f);
+      if (!collapsed(f)) bucketed[fill[sorted_corners(f)[0]]++] = std::uint32_t(f);
   }
   m.tri.reserve(3 * bucketed.size());
   m.face_source.reserve(bucketed.size());
@@ -107,13 +130,26 @@ void add_faces(MeshView in, const std::vector<std::uint32_t>& internal, WorkingM
 
 }  // namespace
 
-WorkingMesh prepare_input(MeshView in) {
+WorkingMesh prepare_input(MeshView in, std::vector<std::uint32_t>* internal_out) {
   check_mesh(in, "input");
   WorkingMesh m;
   std::vector<std::uint32_t> used = referenced_vertices(in, m.dropped_degenerate);
   set_frame(in, used, m);
-  const std::vector<std::uint32_t> internal = number_vertices(in, std::move(used), m);
-  add_faces(in, internal, m);
+  if (in.attributes.empty()) {
+    const std::vector<std::uint32_t> internal = number_vertices(in, std::move(used), m);
+    add_faces(in, internal, false, m);
+  } else {
+    // With attributes, the working vertices are the distinct positions (the wedges on them are
+    // the input's vertices): a seam is not a hole.
+    const std::vector<std::uint32_t> first = first_at_same_position(in, used);
+    std::vector<std::uint32_t> distinct;
+    for (std::uint32_t v : used)
+      if (first[v] == v) distinct.push_back(v);
+    std::vector<std::uint32_t> internal = number_vertices(in, std::move(distinct), m);
+    for (std::uint32_t v : used) internal[v] = internal[first[v]];
+    add_faces(in, internal, true, m);
+    if (internal_out) *internal_out = std::move(internal);
+  }
   const std::size_t n = m.pos.size();
   m.faces_alive = m.face_source.size();
   m.face_alive.assign(m.faces_alive, 1);
@@ -137,9 +173,12 @@ void WorkingMesh::squeeze_faces(const std::vector<std::uint32_t>& vertex_to) {
   for (std::size_t f = 0; f < face_alive.size(); ++f) {
     if (!face_alive[f]) continue;
     for (int k = 0; k < 3; ++k) tri[3 * next + k] = vertex_to[tri[3 * f + k]];
+    if (!corner_wedge.empty())
+      for (int k = 0; k < 3; ++k) corner_wedge[3 * next + k] = corner_wedge[3 * f + k];
     face_source[next++] = face_source[f];
   }
   tri.resize(3 * next), face_source.resize(next);
+  if (!corner_wedge.empty()) corner_wedge.resize(3 * next);
   face_alive.assign(next, 1);
 }
 
@@ -149,6 +188,7 @@ void WorkingMesh::squeeze_vertices(const std::vector<std::uint32_t>& vertex_to, 
   squeeze_by(vertex_to, count, moved);
   squeeze_by(vertex_to, count, aggregated);
   squeeze_by(vertex_to, count, source_vertex);
+  if (!locked.empty()) squeeze_by(vertex_to, count, locked);
 }
 
 Mesh build_output(const WorkingMesh& m, MeshView input, std::vector<std::uint32_t>* vertex_source,

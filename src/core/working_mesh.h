@@ -23,6 +23,7 @@ struct WorkingMesh {
 
   std::vector<Vec3> pos;
   std::vector<std::uint32_t> tri;            ///< 3 per working face
+  std::vector<std::uint32_t> corner_wedge;   ///< with attributes, 3 per working face (wedges.h)
   std::vector<std::uint8_t> face_alive;
   std::vector<std::uint32_t> face_source;    ///< input face of each working face
   std::vector<std::uint32_t> source_vertex;  ///< input vertex of each working vertex
@@ -31,6 +32,7 @@ struct WorkingMesh {
   /// Set on both ends of a contracted threshold pair and inherited through merges: an aggregation
   /// joint, non-manifold by design (GH97 §3.2), where the link condition does not apply.
   std::vector<std::uint8_t> aggregated;
+  std::vector<std::uint8_t> locked;  ///< SimplifyOptions::vertex_lock per working vertex (empty: none)
   VertexLists vertex_faces;  ///< each vertex's faces (exact in the greedy order; see order_passes)
 
   std::size_t faces_alive = 0, vertices_alive = 0;
@@ -48,6 +50,10 @@ struct WorkingMesh {
     const Vec3& p1 = t[1] == moved_vertex ? to : pos[t[1]];
     const Vec3& p2 = t[2] == moved_vertex ? to : pos[t[2]];
     return cross(p1 - p0, p2 - p0);
+  }
+  /// Whether v may not move: locked, or on a border under --lock-border.
+  bool held(std::uint32_t v, bool lock_border) const {
+    return (lock_border && boundary[v]) || (!locked.empty() && locked[v]);
   }
   /// A vertex's position in the input's frame: its exact input coordinates if it never moved.
   Vec3 output_position(std::uint32_t v, MeshView input) const {
@@ -74,7 +80,9 @@ void squeeze_by(const std::vector<std::uint32_t>& vertex_to, std::size_t count, 
 
 /// Checks the input (check_mesh), keeps its referenced vertices and its faces that are neither
 /// degenerate nor duplicates (kept once, the first in input order), and normalises the frame.
-WorkingMesh prepare_input(MeshView input);
+/// With attributes, the working vertices are the input's distinct positions, and `internal` (if
+/// given) gets each input vertex's working vertex.
+WorkingMesh prepare_input(MeshView input, std::vector<std::uint32_t>* internal = nullptr);
 
 /// The output: surviving vertices and faces in input order. Fills, when not null, each output
 /// vertex's and face's input index, and the new index of each working vertex (kNoVertex: dropped).

@@ -144,6 +144,24 @@ class TextCursor {
   bool starts_with(std::string_view s) const {
     return static_cast<std::size_t>(end_ - p_) >= s.size() && std::string_view(p_, s.size()) == s;
   }
+  /// Consumes `c` if it is the next character.
+  bool skip_char(char c) {
+    if (p_ < end_ && *p_ == c) {
+      ++p_;
+      return true;
+    }
+    return false;
+  }
+  /// The rest of the statement, blanks trimmed at both ends (OBJ `mtllib` / `usemtl` names, which
+  /// may contain spaces).
+  std::string_view rest_of_line() {
+    skip_blank();
+    const char* b = p_;
+    while (p_ < end_ && *p_ != '\n' && !(comment_ && *p_ == comment_)) ++p_;
+    const char* e = p_;
+    while (e > b && (e[-1] == ' ' || e[-1] == '\t' || e[-1] == '\r' || e[-1] == '\f' || e[-1] == '\v')) --e;
+    return {b, static_cast<std::size_t>(e - b)};
+  }
   /// Skips characters up to the next blank/newline (the "/vt/vn" tail of an OBJ index).
   void skip_word() {
     while (p_ < end_ && !is_delim(*p_)) ++p_;

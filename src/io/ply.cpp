@@ -8,8 +8,12 @@
 // binary layouts (fixed-size vertex rows, faces "uchar count + int indices") run through tight
 // memcpy loops.
 #include <algorithm>
+#include <array>
 #include <bit>
+#include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -62,6 +66,7 @@ struct Property {
   Type type = Type::F32;
   bool is_list = false;
   Type count_type = Type::U8;
+  std::size_t line = 0;  ///< its header line, for errors about the property itself
 };
 
 struct Element {
@@ -187,6 +192,7 @@ Header parse_header(std::string_view bytes, const std::string& name, std::vector
       in.skip_blank();
       p.name = std::string(in.word());
       if (p.name.empty()) in.fail("property without a name");
+      p.line = in.line();
       h.elements.back().props.push_back(std::move(p));
     } else if (kw == "comment" || kw == "obj_info" || kw.empty()) {
       // ignored
@@ -298,6 +304,7 @@ class BodyReader {
         swap_((h.encoding == Encoding::Big) == (std::endian::native == std::endian::little)) {}
 
   bool ascii() const { return ascii_; }
+  const std::string& name() const { return name_; }
   bool swap() const { return swap_; }
   std::uint64_t remaining() const {
     return ascii_ ? static_cast<std::uint64_t>(text_end() - text_.pos())
@@ -406,6 +413,80 @@ bool is_index_list(const Property& p) {
   return p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index");
 }
 
+/// Where a vertex property goes when it is an attribute component (attribute < 0: it is not).
+struct AttributeSlot {
+  int attribute = -1;
+  std::uint32_t component = 0;
+  double scale = 1;  ///< integer colours to [0, 1]
+};
+
+/// The names writers use for texture coordinates, most common first: Blender writes `s t`,
+/// MeshLab `texture_u texture_v`; all of them are read by Blender, MeshLab and trimesh.
+constexpr std::string_view kTexCoordNames[][2] = {
+    {"s", "t"}, {"u", "v"}, {"texture_u", "texture_v"}, {"texture_s", "texture_t"}};
+
+/// Finds normals (nx ny nz), texture coordinates and colours (red green blue [alpha]) among the
+/// vertex properties and adds their attributes to `mesh`. Colours must be uchar (0..255), ushort
+/// (0..65535) or floating point ([0, 1] as is): an integer of another type has no agreed scale.
+std::vector<AttributeSlot> find_attributes(const Element& e, Mesh& mesh, std::size_t n,
+                                           const std::string& name) {
+  std::vector<AttributeSlot> slots(e.props.size());
+  auto find = [&](std::string_view prop) -> int {
+    for (std::size_t k = 0; k < e.props.size(); ++k)
+      if (!e.props[k].is_list && e.props[k].name == prop && slots[k].attribute < 0)
+        return static_cast<int>(k);
+    return -1;
+  };
+  auto add = [&](const char* attr, AttributeKind kind, const std::vector<int>& props) {
+    const int a = static_cast<int>(mesh.attributes.size());
+    mesh.attributes.push_back(
+        {attr, kind, static_cast<std::uint32_t>(props.size()), std::vector<double>(props.size() * n)});
+    for (std::size_t c = 0; c < props.size(); ++c) {
+      AttributeSlot& s = slots[static_cast<std::size_t>(props[c])];
+      s.attribute = a;
+      s.component = static_cast<std::uint32_t>(c);
+      if (kind != AttributeKind::Color) continue;
+      const Property& p = e.props[static_cast<std::size_t>(props[c])];
+      if (p.type == Type::U8)
+        s.scale = 1.0 / 255;
+      else if (p.type == Type::U16)
+        s.scale = 1.0 / 65535;
+      else if (is_integral(p.type))
+        fail_line(name, p.line,
+                  "vertex colour property '" + p.name +
+                      "' has an integer type other than uchar or ushort "
+                      "(its scale is unknown; uchar, ushort, float or double expected)");
+    }
+  };
+  const int nx = find("nx"), ny = find("ny"), nz = find("nz");
+  if (nx >= 0 && ny >= 0 && nz >= 0) add("NORMAL", AttributeKind::Normal, {nx, ny, nz});
+  for (const auto& pair : kTexCoordNames) {
+    const int u = find(pair[0]), v = find(pair[1]);
+    if (u >= 0 && v >= 0) {
+      add("TEXCOORD_0", AttributeKind::TexCoord, {u, v});
+      break;
+    }
+  }
+  const int r = find("red"), g = find("green"), b = find("blue"), alpha = find("alpha");
+  if (r >= 0 && g >= 0 && b >= 0)
+    add("COLOR_0", AttributeKind::Color,
+        alpha >= 0 ? std::vector<int>{r, g, b, alpha} : std::vector<int>{r, g, b});
+  return slots;
+}
+
+/// Refuses a NaN or infinite attribute value of vertex `i`, like a non-finite coordinate.
+void check_attributes_finite(BodyReader& in, const Element& e, const Mesh& mesh, std::size_t i) {
+  for (const VertexAttribute& a : mesh.attributes)
+    for (std::uint32_t c = 0; c < a.components; ++c)
+      if (!std::isfinite(a.values[a.components * i + c])) {
+        in.set_context(&e, i);
+        in.fail(std::string(a.kind == AttributeKind::Normal     ? "normal"
+                            : a.kind == AttributeKind::TexCoord ? "texture coordinate"
+                                                                : "colour") +
+                " is not finite");
+      }
+}
+
 /// Reads the vertex element: x, y, z (and, if asked, every other scalar property).
 void read_vertices(BodyReader& in, const Element& e, Mesh& mesh, const LoadOptions& options,
                    LoadReport& report) {
@@ -428,11 +509,14 @@ void read_vertices(BodyReader& in, const Element& e, Mesh& mesh, const LoadOptio
     in.fail("header declares " + std::to_string(e.count) + " vertices but the file is too short for them");
   const std::size_t n = static_cast<std::size_t>(e.count);
   mesh.positions.resize(3 * n);
+  std::vector<AttributeSlot> attr_slot = options.read_attributes ? find_attributes(e, mesh, n, in.name())
+                                                                 : std::vector<AttributeSlot>(e.props.size());
   std::vector<int> prop_slot(e.props.size(), -1);  // index into mesh.vertex_properties
   if (options.keep_vertex_properties)
     for (std::size_t k = 0; k < e.props.size(); ++k) {
       const Property& p = e.props[k];
-      if (p.is_list || static_cast<int>(k) == ix || static_cast<int>(k) == iy || static_cast<int>(k) == iz)
+      if (p.is_list || static_cast<int>(k) == ix || static_cast<int>(k) == iy || static_cast<int>(k) == iz ||
+          attr_slot[k].attribute >= 0)  // already an attribute: a second copy would be written twice
         continue;
       prop_slot[k] = static_cast<int>(mesh.vertex_properties.size());
       mesh.vertex_properties.push_back({p.name, std::vector<double>(n)});
@@ -480,11 +564,21 @@ void read_vertices(BodyReader& in, const Element& e, Mesh& mesh, const LoadOptio
           const unsigned char* r = in.ptr() + offsets[k];
           for (std::size_t i = 0; i < n; ++i, r += stride) dst[i] = load_as_double(r, e.props[k].type, swap);
         }
-    for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t k = 0; k < e.props.size(); ++k)
+      if (attr_slot[k].attribute >= 0) {
+        const AttributeSlot& a = attr_slot[k];
+        VertexAttribute& dst = mesh.attributes[static_cast<std::size_t>(a.attribute)];
+        const unsigned char* r = in.ptr() + offsets[k];
+        for (std::size_t i = 0; i < n; ++i, r += stride)
+          dst.values[dst.components * i + a.component] = load_as_double(r, e.props[k].type, swap) * a.scale;
+      }
+    for (std::size_t i = 0; i < n; ++i) {
       if (!finite3(pos[3 * i], pos[3 * i + 1], pos[3 * i + 2])) {
         in.set_context(&e, i);
         in.fail("vertex coordinate is not finite");
       }
+      check_attributes_finite(in, e, mesh, i);
+    }
     in.advance(stride * n);
     return;
   }
@@ -504,10 +598,14 @@ void read_vertices(BodyReader& in, const Element& e, Mesh& mesh, const LoadOptio
         pos[3 * i + 1] = v;
       else if (static_cast<int>(k) == iz)
         pos[3 * i + 2] = v;
-      else if (prop_slot[k] >= 0)
+      else if (attr_slot[k].attribute >= 0) {
+        VertexAttribute& a = mesh.attributes[static_cast<std::size_t>(attr_slot[k].attribute)];
+        a.values[a.components * i + attr_slot[k].component] = v * attr_slot[k].scale;
+      } else if (prop_slot[k] >= 0)
         mesh.vertex_properties[prop_slot[k]].values[i] = v;
     }
     if (!finite3(pos[3 * i], pos[3 * i + 1], pos[3 * i + 2])) in.fail("vertex coordinate is not finite");
+    check_attributes_finite(in, e, mesh, i);
   }
 }
 
@@ -591,7 +689,54 @@ bool read_faces_fast(BodyReader& in, const Element& e, std::size_t list_prop, st
 }
 
 /// Reads a face element (vertex_indices list) or a tristrips element.
-void read_faces(BodyReader& in, const Element& e, std::uint64_t nv, bool strips, PolygonSink& sink) {
+/// Face colours read as materials: each distinct colour is one material named "rgb(R,G,B)" (bytes),
+/// in order of first use; the writer turns such materials back into face colours.
+struct FaceColours {
+  int channel[3] = {-1, -1, -1};  ///< the red, green, blue properties of the face element
+  std::vector<std::uint32_t>* face_materials = nullptr;
+  std::vector<std::string>* names = nullptr;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> index;  ///< (packed rgb, material), unsorted: few
+
+  /// Finds red, green and blue among `e`'s scalar properties; false when any is missing.
+  bool find(const Element& e, const std::string& name) {
+    const char* names_rgb[3] = {"red", "green", "blue"};
+    for (int c = 0; c < 3; ++c)
+      for (std::size_t k = 0; k < e.props.size() && channel[c] < 0; ++k)
+        if (!e.props[k].is_list && e.props[k].name == names_rgb[c]) channel[c] = static_cast<int>(k);
+    if (channel[0] < 0 || channel[1] < 0 || channel[2] < 0) return false;
+    for (int c : channel) {
+      const Property& p = e.props[static_cast<std::size_t>(c)];
+      if (p.type != Type::U8 && is_integral(p.type))
+        fail_line(name, p.line,
+                  "face colour property '" + p.name +
+                      "' has an integer type other than uchar (uchar, float or "
+                      "double expected)");
+    }
+    return true;
+  }
+  /// The material of a face whose colour is `rgb` (bytes), added if new.
+  std::uint32_t material(const std::uint8_t rgb[3]) {
+    const std::uint32_t key = std::uint32_t{rgb[0]} << 16 | std::uint32_t{rgb[1]} << 8 | rgb[2];
+    for (const auto& [k, m] : index)
+      if (k == key) return m;
+    const auto m = static_cast<std::uint32_t>(names->size());
+    names->push_back("rgb(" + std::to_string(rgb[0]) + "," + std::to_string(rgb[1]) + "," +
+                     std::to_string(rgb[2]) + ")");
+    index.emplace_back(key, m);
+    return m;
+  }
+};
+
+/// A colour channel as a byte: uchar as is, a real in [0, 1] scaled; clamped and rounded (an
+/// ASCII file may hold 300 in a uchar).
+std::uint8_t channel_byte(double v, Type t) {
+  double x = t == Type::U8 ? v / 255 : v;
+  x = x > 0 ? (x < 1 ? x : 1) : 0;
+  return static_cast<std::uint8_t>(x * 255 + 0.5);
+}
+
+void read_faces(BodyReader& in, const Element& e, std::uint64_t nv, bool strips, PolygonSink& sink,
+                FaceColours* colours = nullptr) {
   std::size_t list_prop = e.props.size();
   for (std::size_t k = 0; k < e.props.size(); ++k)
     if (is_index_list(e.props[k])) {
@@ -606,15 +751,25 @@ void read_faces(BodyReader& in, const Element& e, std::uint64_t nv, bool strips,
   if (!fits(e.count, min_row, in.remaining() + 1))
     in.fail("header declares " + std::to_string(e.count) + " " + e.name +
             " elements but the file is too short for them");
-  if (!strips && read_faces_fast(in, e, list_prop, nv, sink)) return;
+  if (!strips && !colours && read_faces_fast(in, e, list_prop, nv, sink)) return;
 
   std::vector<std::uint32_t> corners;
   const Property& lp = e.props[list_prop];
   for (std::uint64_t i = 0; i < e.count; ++i) {
     in.set_context(&e, i);
+    const std::size_t before = sink.indices->size();
+    std::uint8_t rgb[3] = {0, 0, 0};
     for (std::size_t k = 0; k < e.props.size(); ++k) {
       if (k != list_prop) {
-        in.skip_property(e.props[k]);
+        int c = 0;
+        while (colours && c < 3 && colours->channel[c] != static_cast<int>(k)) ++c;
+        if (colours && c < 3) {
+          const double v = in.real(e.props[k].type);
+          if (!std::isfinite(v)) in.fail("face colour is not finite");
+          rgb[c] = channel_byte(v, e.props[k].type);
+        } else {
+          in.skip_property(e.props[k]);
+        }
         continue;
       }
       std::size_t c = in.list_count(lp);
@@ -650,6 +805,9 @@ void read_faces(BodyReader& in, const Element& e, std::uint64_t nv, bool strips,
         start = j + 1;
       }
     }
+    if (colours)
+      colours->face_materials->insert(colours->face_materials->end(), (sink.indices->size() - before) / 3,
+                                      colours->material(rgb));
   }
 }
 
@@ -669,6 +827,21 @@ void skip_element(BodyReader& in, const Element& e) {
     in.set_context(&e, i);
     for (const Property& p : e.props) in.skip_property(p);
   }
+}
+
+}  // namespace
+
+namespace {
+
+/// Gives the triangles of a face element without colours, read after a coloured one, the material
+/// "rgb(0,0,0)", so face_materials stays one per face.
+void pad_materials(Mesh& mesh) {
+  if (mesh.face_materials.empty() || mesh.face_materials.size() == mesh.face_count()) return;
+  const std::string black = "rgb(0,0,0)";
+  auto it = std::find(mesh.material_names.begin(), mesh.material_names.end(), black);
+  const auto m = static_cast<std::uint32_t>(it - mesh.material_names.begin());
+  if (it == mesh.material_names.end()) mesh.material_names.push_back(black);
+  mesh.face_materials.resize(mesh.face_count(), m);
 }
 
 }  // namespace
@@ -698,11 +871,25 @@ Mesh parse_ply(std::string_view bytes, const std::string& name, const LoadOption
     in.set_context(&e, 0);
     if (&e == vertex)
       read_vertices(in, e, mesh, options, report);
-    else if (e.name == "face")
-      read_faces(in, e, nv, false, sink);
-    else if (e.name == "tristrips")
+    else if (e.name == "face") {
+      // Face colours become materials (one per distinct colour): the faces keep their colour
+      // through a write, and a colour boundary is a seam to the simplifier, as a material's is.
+      FaceColours colours;
+      colours.face_materials = &mesh.face_materials;
+      colours.names = &mesh.material_names;
+      const bool coloured = options.read_attributes && mesh.face_materials.empty() && colours.find(e, name);
+      const std::size_t before = mesh.face_count();
+      read_faces(in, e, nv, false, sink, coloured ? &colours : nullptr);
+      if (coloured && before > 0) {
+        // The triangles of earlier face elements had no colour: black, the colour of none.
+        const std::uint8_t black[3] = {0, 0, 0};
+        mesh.face_materials.insert(mesh.face_materials.begin(), before, colours.material(black));
+      }
+      pad_materials(mesh);
+    } else if (e.name == "tristrips") {
       read_faces(in, e, nv, true, sink);
-    else
+      pad_materials(mesh);
+    } else
       skip_element(in, e);
   }
   if (mesh.indices.empty()) fail(name, "no faces");
@@ -730,14 +917,76 @@ bool valid_property_name(const std::string& s) {
   return true;
 }
 
+/// The attributes a PLY holds, each written as its conventional properties: the first normal
+/// (nx ny nz), texture coordinate (s t, Blender's names) and colour (red green blue [alpha] as
+/// uchar, what MeshLab and Blender read). Others are not written.
+struct PlyAttributes {
+  const VertexAttribute* normal;
+  const VertexAttribute* texcoord;
+  const VertexAttribute* colour;
+  explicit PlyAttributes(const Mesh& m)
+      : normal(m.find_attribute(AttributeKind::Normal)),
+        texcoord(m.find_attribute(AttributeKind::TexCoord)),
+        colour(m.find_attribute(AttributeKind::Color)) {}
+  std::uint32_t colour_channels() const { return colour ? (colour->components >= 4 ? 4 : 3) : 0; }
+  /// True when a vertex property of this name would repeat an attribute's property.
+  bool claims(const std::string& p) const {
+    if (normal && (p == "nx" || p == "ny" || p == "nz")) return true;
+    if (texcoord && (p == "s" || p == "t")) return true;
+    return colour && (p == "red" || p == "green" || p == "blue" || (colour_channels() == 4 && p == "alpha"));
+  }
+};
+
+/// The byte colour of each material when every material is named "rgb(R,G,B)" (as the reader
+/// names face colours), else empty: other materials (OBJ's named ones) have no PLY form.
+std::vector<std::array<std::uint8_t, 3>> face_colours(const Mesh& m) {
+  std::vector<std::array<std::uint8_t, 3>> colours;
+  if (m.face_materials.empty()) return colours;
+  for (const std::string& n : m.material_names) {
+    unsigned rgb[3];
+    int used = 0;
+    if (std::sscanf(n.c_str(), "rgb(%u,%u,%u)%n", &rgb[0], &rgb[1], &rgb[2], &used) != 3 ||
+        static_cast<std::size_t>(used) != n.size() || rgb[0] > 255 || rgb[1] > 255 || rgb[2] > 255)
+      return {};
+    colours.push_back({std::uint8_t(rgb[0]), std::uint8_t(rgb[1]), std::uint8_t(rgb[2])});
+  }
+  for (std::uint32_t f : m.face_materials)
+    if (f >= colours.size()) return {};
+  return colours;
+}
+
+/// A [0, 1] colour value as a byte, clamped and rounded.
+std::uint8_t colour_byte(double v) {
+  const double x = v < 0 ? 0 : v > 1 ? 1 : v;
+  return static_cast<std::uint8_t>(x * 255 + 0.5);
+}
+
+/// Component k of vertex i of `a`, 0 where the attribute has fewer components.
+double component(const VertexAttribute& a, std::size_t i, std::uint32_t k) {
+  return k < a.components ? a.values[a.components * i + k] : 0.0;
+}
+
 }  // namespace
 
 std::string write_ply(const Mesh& mesh, bool binary, bool double_precision) {
   const std::size_t nv = mesh.vertex_count(), nf = mesh.face_count();
+  const PlyAttributes attrs(mesh);
   for (const VertexProperty& p : mesh.vertex_properties)
     if (!valid_property_name(p.name) || p.name == "x" || p.name == "y" || p.name == "z")
       throw Error("cannot write PLY: invalid vertex property name '" + p.name + "'");
-  if (!double_precision) check_fits_in_float(mesh, true, "PLY with float values");
+  std::vector<const VertexProperty*> props;
+  for (const VertexProperty& p : mesh.vertex_properties)
+    if (!attrs.claims(p.name)) props.push_back(&p);
+  if (!double_precision) {
+    check_fits_in_float(mesh, true, "PLY with float values");
+    for (const VertexAttribute* a : {attrs.normal, attrs.texcoord})
+      if (a)
+        for (std::size_t i = 0; i < a->values.size(); ++i)
+          if (std::fabs(a->values[i]) > std::numeric_limits<float>::max())
+            throw Error("cannot write PLY with float values: vertex " + std::to_string(i / a->components) +
+                        " has attribute '" + a->name +
+                        "' beyond single precision; write a PLY with double values (qem --double)");
+  }
   const char* type = double_precision ? "double" : "float";
   std::string out;
   out += "ply\nformat ";
@@ -746,33 +995,60 @@ std::string write_ply(const Mesh& mesh, bool binary, bool double_precision) {
   append_uint(out, nv);
   out += '\n';
   for (const char* axis : {"x", "y", "z"}) out += std::string("property ") + type + " " + axis + "\n";
-  for (const VertexProperty& p : mesh.vertex_properties)
-    out += std::string("property ") + type + " " + p.name + "\n";
+  if (attrs.normal)
+    for (const char* c : {"nx", "ny", "nz"}) out += std::string("property ") + type + " " + c + "\n";
+  if (attrs.texcoord)
+    for (const char* c : {"s", "t"}) out += std::string("property ") + type + " " + c + "\n";
+  const char* channels[] = {"red", "green", "blue", "alpha"};
+  for (std::uint32_t k = 0; k < attrs.colour_channels(); ++k)
+    out += std::string("property uchar ") + channels[k] + "\n";
+  for (const VertexProperty* p : props) out += std::string("property ") + type + " " + p->name + "\n";
   out += "element face ";
   append_uint(out, nf);
-  out += "\nproperty list uchar int vertex_indices\nend_header\n";
+  out += "\nproperty list uchar int vertex_indices\n";
+  const std::vector<std::array<std::uint8_t, 3>> fcol = face_colours(mesh);
+  if (!fcol.empty()) out += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+  out += "end_header\n";
 
-  const std::size_t np = mesh.vertex_properties.size();
+  // One row of real values per vertex, in header order; colours are bytes.
+  std::vector<double> row;
+  auto fill_row = [&](std::size_t i) {
+    row.clear();
+    for (int k = 0; k < 3; ++k) row.push_back(mesh.positions[3 * i + k]);
+    if (attrs.normal)
+      for (std::uint32_t k = 0; k < 3; ++k) row.push_back(component(*attrs.normal, i, k));
+    if (attrs.texcoord)
+      for (std::uint32_t k = 0; k < 2; ++k) row.push_back(component(*attrs.texcoord, i, k));
+  };
+  auto colour_at = [&](std::size_t i, std::uint32_t k) {
+    // A missing alpha never happens (colour_channels() is 3 then); missing RGB components are 0.
+    return colour_byte(component(*attrs.colour, i, k));
+  };
+  const std::uint32_t nc = attrs.colour_channels();
   if (binary) {
-    out.reserve(out.size() + nv * (3 + np) * (double_precision ? 8 : 4) + nf * 13);
+    const std::size_t reals = 3 + (attrs.normal ? 3 : 0) + (attrs.texcoord ? 2 : 0) + props.size();
+    out.reserve(out.size() + nv * (reals * (double_precision ? 8 : 4) + nc) + nf * 13);
     for (std::size_t i = 0; i < nv; ++i) {
-      for (int k = 0; k < 3; ++k) {
-        double v = mesh.positions[3 * i + k];
+      fill_row(i);
+      for (double v : row) {
         if (double_precision)
           put(out, v);
         else
           put(out, static_cast<float>(v));
       }
-      for (const VertexProperty& p : mesh.vertex_properties) {
+      for (std::uint32_t k = 0; k < nc; ++k) out += static_cast<char>(colour_at(i, k));
+      for (const VertexProperty* p : props) {
         if (double_precision)
-          put(out, p.values[i]);
+          put(out, p->values[i]);
         else
-          put(out, static_cast<float>(p.values[i]));
+          put(out, static_cast<float>(p->values[i]));
       }
     }
     for (std::size_t f = 0; f < nf; ++f) {
       out += '\3';
       for (int k = 0; k < 3; ++k) put(out, static_cast<std::int32_t>(mesh.indices[3 * f + k]));
+      if (!fcol.empty())
+        for (std::uint8_t c : fcol[mesh.face_materials[f]]) out += static_cast<char>(c);
     }
     return out;
   }
@@ -783,14 +1059,18 @@ std::string write_ply(const Mesh& mesh, bool binary, bool double_precision) {
       append_number(out, static_cast<float>(v));
   };
   for (std::size_t i = 0; i < nv; ++i) {
-    number(mesh.positions[3 * i]);
-    out += ' ';
-    number(mesh.positions[3 * i + 1]);
-    out += ' ';
-    number(mesh.positions[3 * i + 2]);
-    for (const VertexProperty& p : mesh.vertex_properties) {
+    fill_row(i);
+    for (std::size_t k = 0; k < row.size(); ++k) {
+      if (k) out += ' ';
+      number(row[k]);
+    }
+    for (std::uint32_t k = 0; k < nc; ++k) {
       out += ' ';
-      number(p.values[i]);
+      append_uint(out, colour_at(i, k));
+    }
+    for (const VertexProperty* p : props) {
+      out += ' ';
+      number(p->values[i]);
     }
     out += '\n';
   }
@@ -801,6 +1081,11 @@ std::string write_ply(const Mesh& mesh, bool binary, bool double_precision) {
     append_uint(out, mesh.indices[3 * f + 1]);
     out += ' ';
     append_uint(out, mesh.indices[3 * f + 2]);
+    if (!fcol.empty())
+      for (std::uint8_t c : fcol[mesh.face_materials[f]]) {
+        out += ' ';
+        append_uint(out, c);
+      }
     out += '\n';
   }
   return out;

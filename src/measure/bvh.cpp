@@ -196,6 +196,25 @@ TriangleBvh::Hit TriangleBvh::closest(const double p[3], std::uint32_t* hint) co
   return hit;
 }
 
+void TriangleBvh::within(const double p[3], double max_d2, std::vector<std::uint32_t>& out) const {
+  if (nodes_.empty()) return;
+  std::uint32_t stack[kStack];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    if (box_d2(p, node.lo, node.hi) > max_d2) continue;
+    if (node.count == 0) {
+      stack[top++] = node.first;
+      stack[top++] = node.first + 1;
+      continue;
+    }
+    double point[3];
+    for (std::uint32_t i = node.first; i < node.first + node.count; ++i)
+      if (slot_d2(p, i, point) <= max_d2) out.push_back(ids_[i]);
+  }
+}
+
 TriangleBvh::Hit TriangleBvh::search(const double p[3], double best, std::uint32_t best_tri) const {
   Hit hit;
   if (nodes_.empty()) return hit;

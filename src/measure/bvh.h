@@ -11,6 +11,9 @@
 
 namespace qem::measure_detail {
 
+/// Queries per work item, and per warm-started run: fixed, so results never depend on the threads.
+inline constexpr std::size_t kQueryChunk = 4096;
+
 class TriangleBvh {
  public:
   struct Hit {
@@ -30,6 +33,9 @@ class TriangleBvh {
   /// UINT32_MAX for none) bounds the search from the start, which prunes most of the tree when
   /// consecutive queries are near each other. `*hint` is set to the closest triangle found.
   Hit closest(const double p[3], std::uint32_t* hint) const;
+
+  /// Appends to `out` the (input) index of every triangle within sqrt(max_d2) of `p`, in no order.
+  void within(const double p[3], double max_d2, std::vector<std::uint32_t>& out) const;
 
   std::size_t triangle_count() const { return ids_.size(); }
   std::size_t node_count() const { return nodes_.size(); }

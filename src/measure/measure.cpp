@@ -12,6 +12,7 @@
 #include "core/spatial_order.h"
 #include "geometry/box.h"
 #include "geometry/vec3.h"
+#include "measure/attribute_error.h"
 #include "measure/bvh.h"
 #include "measure/surface_sampling.h"
 #include "qem/error.h"
@@ -23,7 +24,7 @@ namespace {
 using measure_detail::Surface;
 using measure_detail::TriangleBvh;
 
-constexpr std::size_t kChunk = 4096;  // queries per work item (and per warm-start run)
+using measure_detail::kQueryChunk;
 
 struct Distances {
   double sum_d2 = 0, sum_d = 0, max_d = 0;
@@ -33,8 +34,10 @@ struct Distances {
 /// Distances from `samples` (counted in the sums and the max) and `vertices` (max only) to `tree`.
 /// Queries run in Morton order, warm-started from the previous answer within each fixed chunk; the
 /// sums then run in sample order on one thread, so nothing depends on the thread count.
+/// `sample_hits`, if given, receives the closest triangle of each sample (for the attribute error).
 Distances distances(const TriangleBvh& tree, const std::vector<double>& samples,
-                    const std::vector<double>& vertices, unsigned threads) {
+                    const std::vector<double>& vertices, unsigned threads,
+                    std::vector<std::uint32_t>* sample_hits = nullptr) {
   const std::size_t ns = samples.size() / 3;
   std::vector<double> points = samples;
   points.insert(points.end(), vertices.begin(), vertices.end());
@@ -42,9 +45,14 @@ Distances distances(const TriangleBvh& tree, const std::vector<double>& samples,
     return Vec3(points[3 * i], points[3 * i + 1], points[3 * i + 2]);
   });
   std::vector<double> d2(order.size());
-  core::for_chunks(order.size(), kChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
+  if (sample_hits) sample_hits->assign(ns, UINT32_MAX);
+  core::for_chunks(order.size(), kQueryChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
     std::uint32_t hint = UINT32_MAX;  // reset per chunk: the warm start never crosses chunks
-    for (std::size_t j = begin; j < end; ++j) d2[order[j]] = tree.closest(&points[3 * order[j]], &hint).d2;
+    for (std::size_t j = begin; j < end; ++j) {
+      const std::uint32_t i = order[j];
+      d2[i] = tree.closest(&points[3 * i], &hint).d2;
+      if (sample_hits && i < ns) (*sample_hits)[i] = hint;  // the closest triangle, as closest() left it
+    }
   });
   Distances total;
   for (std::size_t i = 0; i < d2.size(); ++i) {
@@ -74,6 +82,9 @@ MeasureResult measure(MeshView original, MeshView approx, const MeasureOptions& 
   ni = std::max<std::size_t>(ni, 1);
 
   // The two trees are independent: build the second on another thread when we have one.
+  // The attribute error reuses the samples on the original and their closest triangles.
+  const bool attributes = measure_detail::has_comparable_attributes(original, approx);
+  std::vector<measure_detail::SamplePlace> places;
   TriangleBvh tree_n, tree_i;
   std::vector<double> xn, xi;
   core::side_by_side(
@@ -84,10 +95,12 @@ MeasureResult measure(MeshView original, MeshView approx, const MeasureOptions& 
       },
       [&] {
         tree_n = TriangleBvh(sn.corners);
-        xn = measure_detail::sample_surface(sn, nn, options.seed * 2);
+        xn = measure_detail::sample_surface(sn, nn, options.seed * 2, attributes ? &places : nullptr);
       });
   static const std::vector<double> kNone;
-  const Distances o2a = distances(tree_i, xn, options.include_vertices ? sn.vertices : kNone, threads);
+  std::vector<std::uint32_t> hits;
+  const Distances o2a = distances(tree_i, xn, options.include_vertices ? sn.vertices : kNone, threads,
+                                  attributes ? &hits : nullptr);
   const Distances a2o = distances(tree_n, xi, options.include_vertices ? si.vertices : kNone, threads);
 
   MeasureResult r;
@@ -112,10 +125,21 @@ MeasureResult measure(MeshView original, MeshView approx, const MeasureOptions& 
   r.mean_rel = r.mean / diag;
   r.hausdorff_rel = r.hausdorff / diag;
 
+  if (attributes) {
+    const measure_detail::AttributeErrors ae =
+        measure_detail::attribute_errors(original, sn, approx, si, tree_i, xn, places, hits, threads);
+    r.uv_rms = ae.uv_rms, r.normal_rms_deg = ae.normal_rms_deg, r.color_rms = ae.color_rms;
+    r.attributes_by_material = ae.by_material;
+  }
+  // Cracks concern any mesh with seams, attributes or not: always counted (two sorts, cheap).
+  r.cracks_in = measure_detail::welded_boundary_edges(original);
+  r.cracks_out = measure_detail::welded_boundary_edges(approx);
+  r.seam_cracks = r.cracks_out > r.cracks_in ? r.cracks_out - r.cracks_in : 0;
+
   if (options.per_vertex) {
     const std::size_t nv = approx.vertex_count();
     r.vertex_distance.assign(nv, 0.0);
-    core::for_chunks(nv, kChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
+    core::for_chunks(nv, kQueryChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
       std::uint32_t hint = UINT32_MAX;  // mesh vertex order is usually coherent enough
       for (std::size_t v = begin; v < end; ++v)
         r.vertex_distance[v] = std::sqrt(tree_n.closest(&approx.positions[3 * v], &hint).d2);

@@ -37,17 +37,20 @@ Surface make_surface(MeshView mesh, const char* what) {
     s.corners.insert(s.corners.end(), {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z});
     s.area += area;
     s.cum_area.push_back(s.area);
+    s.face_of.push_back(std::uint32_t(f));
   }
   for (std::size_t v = 0; v < nv; ++v)
     if (used[v]) s.vertices.insert(s.vertices.end(), {P[3 * v], P[3 * v + 1], P[3 * v + 2]});
   return s;
 }
 
-std::vector<double> sample_surface(const Surface& s, std::size_t n, std::uint64_t seed) {
+std::vector<double> sample_surface(const Surface& s, std::size_t n, std::uint64_t seed,
+                                   std::vector<SamplePlace>* places) {
   std::vector<double> out;
   const std::size_t nt = s.triangle_count();
   if (nt == 0) return out;
   out.resize(3 * n);
+  if (places) places->resize(n);
   Rng rng(seed);
   for (std::size_t k = 0; k < n; ++k) {
     const double r = rng.uniform() * s.area;
@@ -59,6 +62,7 @@ std::vector<double> sample_surface(const Surface& s, std::size_t n, std::uint64_
     const double wa = 1 - r1, wb = r1 * (1 - r2), wc = r1 * r2;
     const double* t = &s.corners[9 * f];
     for (int i = 0; i < 3; ++i) out[3 * k + i] = wa * t[i] + wb * t[3 + i] + wc * t[6 + i];
+    if (places) (*places)[k] = {std::uint32_t(f), {wa, wb, wc}};
   }
   return out;
 }

@@ -220,6 +220,12 @@ class Refitter {
     }
     fixed_.assign(approx.vertex_count(), 0);
     if (o.lock_border) mark_border();
+    if (!o.fixed_vertices.empty()) {
+      if (o.fixed_vertices.size() != fixed_.size())
+        throw Error("refit: fixed_vertices has " + std::to_string(o.fixed_vertices.size()) + " entries for " +
+                    std::to_string(fixed_.size()) + " vertices");
+      for (std::size_t v = 0; v < fixed_.size(); ++v) fixed_[v] |= o.fixed_vertices[v] != 0;
+    }
     // Faces around each vertex (CSR), for the projections after the first.
     ring_start_.assign(approx.vertex_count() + 1, 0);
     for (std::uint32_t v : tri_) ++ring_start_[v + 1];

@@ -1,0 +1,544 @@
+"""qem: triangle mesh simplification with quadric error metrics (Garland & Heckbert 1997), on numpy.
+
+    import qem
+    mesh = qem.load("bunny.ply")
+    result = qem.simplify(mesh.vertices, mesh.faces, target_ratio=0.1)
+    qem.save("bunny_10.ply", result)
+    print(result.max_error, result.stop_detail, qem.measure(mesh, result).E)
+
+Arrays in: vertices (n, 3) of any float (or integer) dtype, faces (m, 3) of any integer dtype, in C
+or Fortran order. float64 vertices and int32/uint32 faces in C order are read in place (no copy);
+anything else is converted once. Arrays out: vertices float64 (n, 3), faces int32 (m, 3) (int64
+only for meshes of 2**31 vertices or more), maps int32; all of them own their memory.
+
+Bad input raises ValueError naming the argument (shape, dtype, index out of range, NaN); what the
+library refuses raises qem.Error, a subclass of ValueError.
+"""
+
+from __future__ import annotations
+
+import math as _math
+import re as _re
+from typing import Callable, Optional
+
+from . import _qem
+
+__all__ = [
+    "Error",
+    "Mesh",
+    "SimplifyResult",
+    "Record",
+    "Measure",
+    "Level",
+    "simplify",
+    "load",
+    "save",
+    "measure",
+    "cluster",
+    "info",
+    "lod",
+    "option_names",
+]
+
+Error = _qem.Error
+Error.__doc__ = "A failure the library reports (bad option, unreadable file, bad mesh); a ValueError."
+
+
+class Mesh:
+    """A triangle mesh: `vertices` (n, 3) float64, `faces` (m, 3) int32, `attributes` {name: array}.
+
+    Any object with `.vertices` and `.faces` (or a `(vertices, faces)` pair) is accepted where a
+    mesh is expected; this class is what qem returns.
+    """
+
+    __slots__ = ("vertices", "faces", "attributes", "attribute_kinds")
+
+    def __init__(self, vertices, faces, attributes=None, attribute_kinds=None):
+        self.vertices = vertices
+        self.faces = faces
+        self.attributes = dict(attributes or {})
+        self.attribute_kinds = dict(attribute_kinds or {})
+
+    def __iter__(self):  # so that `vertices, faces = mesh` works
+        return iter((self.vertices, self.faces))
+
+    def __repr__(self):
+        return f"qem.Mesh({len(self.vertices)} vertices, {len(self.faces)} faces)"
+
+
+def _mesh_from_dict(d, cls=None, **extra):
+    attributes = {name: a["values"] for name, a in d["attributes"].items()}
+    kinds = {name: a["kind"] for name, a in d["attributes"].items()}
+    m = (cls or Mesh).__new__(cls or Mesh)
+    Mesh.__init__(m, d["vertices"], d["faces"], attributes, kinds)
+    for k, v in extra.items():
+        setattr(m, k, v)
+    return m
+
+
+class Record:
+    """The progressive record of one run (GH97 §3): the base mesh and its contraction sequence.
+
+    `record.replay(faces)` rebuilds, bit for bit, the mesh `simplify` returns for a target of
+    `faces` (with the same options, refit off), for any count between `final_faces` and
+    `base_faces`. `save(path)` / `Record.load(path)` use the file format of
+    docs/record-format.md, which `qem replay` and `qem lod` read too.
+    """
+
+    __slots__ = ("_record",)
+
+    def __init__(self, record):
+        if not isinstance(record, _qem.Record):
+            raise TypeError("qem.Record is made by qem.simplify(..., record=True) or Record.load(path)")
+        self._record = record
+
+    def replay(self, faces: int) -> Mesh:
+        """The mesh after the shortest prefix of contractions that leaves at most `faces` faces."""
+        if faces < 0:
+            raise ValueError(f"faces: must not be negative, got {faces}")
+        return _mesh_from_dict(self._record.replay(int(faces)))
+
+    def save(self, path: str) -> None:
+        """Writes the record (atomically: a temporary file beside `path`, then renamed)."""
+        self._record.save(str(path))
+
+    @staticmethod
+    def load(path: str) -> "Record":
+        """Reads and validates a record file; qem.Error if it is malformed."""
+        return Record(_qem.Record.load(str(path)))
+
+    def to_bytes(self) -> bytes:
+        """The record file's bytes."""
+        return self._record.to_bytes()
+
+    @staticmethod
+    def from_bytes(data: bytes) -> "Record":
+        """Parses and validates a record held in memory."""
+        return Record(_qem.Record.from_bytes(bytes(data)))
+
+    def __len__(self):
+        """The number of contractions."""
+        return len(self._record)
+
+    @property
+    def base_faces(self) -> int:
+        """Faces of the base mesh (the input without degenerate and duplicate faces)."""
+        return self._record.base_faces
+
+    @property
+    def base_vertices(self) -> int:
+        """Vertices of the base mesh (the input's referenced vertices)."""
+        return self._record.base_vertices
+
+    @property
+    def final_faces(self) -> int:
+        """Faces after every contraction: the smallest count a replay reaches."""
+        return self._record.final_faces
+
+    def __repr__(self):
+        return f"qem.Record({len(self)} contractions, {self.base_faces} -> {self.final_faces} faces)"
+
+
+class SimplifyResult(Mesh):
+    """What `simplify` returns: a Mesh plus how the run went.
+
+    vertices, faces, attributes: the approximation (attributes only as given to simplify).
+    max_error: the largest contraction error made (distance units); max_error_relative: over the
+      bounding-box diagonal.
+    stop_reason: "target reached", "error limit reached", "no valid contraction left",
+      "input already at or below target" or "cancelled" (the CLI's --json "stop");
+      stop_detail: a sentence saying why.
+    contractions, input_faces, input_vertices, refit_rounds, refit_rms_before, refit_rms_after,
+      dropped_degenerate_faces, dropped_duplicate_faces: counts as in qem::SimplifyResult.
+    With return_mapping=True (else None):
+      vertex_source: (n_out,) int32, the input vertex each output vertex started from;
+      face_source: (m_out,) int32, the input face each output face is;
+      output_vertex_of_input: (n_in,) int32, the output vertex each input vertex was contracted
+        into, -1 for unreferenced input vertices and parts that vanished.
+    record: a qem.Record with record=True, else None.
+    """
+
+    __slots__ = (
+        "max_error", "max_error_relative", "stop_reason", "stop_detail", "contractions", "input_faces",
+        "input_vertices", "refit_rounds", "refit_rms_before", "refit_rms_after", "dropped_degenerate_faces",
+        "dropped_duplicate_faces", "vertex_source", "face_source", "output_vertex_of_input", "record",
+    )
+
+    def __repr__(self):
+        return (f"qem.SimplifyResult({len(self.vertices)} vertices, {len(self.faces)} faces, "
+                f"max_error={self.max_error:.4g}, stop_reason={self.stop_reason!r})")
+
+
+def option_names(option: str) -> list:
+    """The accepted values of `weighting`, `placement`, `scheme` or `inversion`."""
+    if option not in _OPTION_NAMES:
+        raise ValueError(f"option: expected weighting, placement, scheme or inversion, got {option!r}")
+    return list(_OPTION_NAMES[option])
+
+
+# The library's names (src/option_names.cpp): one list, written once.
+_OPTION_NAMES = {option: tuple(_qem.option_names(option)) for option in ("weighting", "placement", "scheme", "inversion")}
+
+# The command line's default refit (cli/algorithm_options.h): one round, about 2 input vertices
+# per output vertex, made only with optimal placement. "full" is `--refit`: 3 rounds, every vertex.
+_REFIT = {"light": (1, 2.0), "full": (3, 0.0), "none": (0, 0.0)}
+
+_KIND_OF_NAME = [
+    (r"NORMAL", "normal"),
+    (r"TEXCOORD_\d+", "texcoord"),
+    (r"COLOR_\d+", "color"),
+    (r"JOINTS_\d+", "joint_indices"),
+    (r"WEIGHTS_\d+", "joint_weights"),
+    (r"TANGENT", "tangent"),
+]
+
+
+def _attribute_list(attributes):
+    """[(name, kind, values)] from {name: values or (values, kind)}; the kind from glTF names."""
+    if attributes is None:
+        return []
+    if not isinstance(attributes, dict):
+        raise ValueError("attributes: expected a dict {name: (n, k) array} or {name: (array, kind)}")
+    out = []
+    for name, value in attributes.items():
+        if not isinstance(name, str):
+            raise ValueError(f"attributes: names must be strings, got {name!r}")
+        kind = None
+        if isinstance(value, tuple) and len(value) == 2 and isinstance(value[1], str):
+            value, kind = value
+        if kind is None:
+            kind = next((k for pattern, k in _KIND_OF_NAME if _re.fullmatch(pattern, name)), "scalar")
+        out.append((name, kind, value))
+    return out
+
+
+def _options(*, target_faces, target_ratio, target_vertices, max_error, max_error_relative, threshold,
+             threshold_relative, weighting, placement, boundary_weight, lock_border, inversion, max_turn,
+             allow_non_manifold, scheme, refit, threads, record):
+    o = _qem.SimplifyOptions()
+
+    def count(name, value):
+        if value is None:
+            return 0
+        if isinstance(value, bool) or not isinstance(value, (int,)) and not hasattr(value, "__index__"):
+            raise ValueError(f"{name}: expected an integer, got {value!r}")
+        value = int(value)
+        if value <= 0:
+            raise ValueError(f"{name}: must be positive, got {value}")
+        return value
+
+    def number(name, value):
+        try:
+            value = float(value)
+        except (TypeError, ValueError):
+            raise ValueError(f"{name}: expected a number, got {value!r}") from None
+        if _math.isnan(value):
+            raise ValueError(f"{name}: expected a number, got nan")
+        return value
+
+    o.target_faces = count("target_faces", target_faces)
+    o.target_vertices = count("target_vertices", target_vertices)
+    if target_ratio is not None:
+        r = number("target_ratio", target_ratio)
+        if not 0 < r <= 1:
+            raise ValueError(f"target_ratio: the fraction of faces kept must be in (0, 1], got {r}")
+        o.target_ratio = r
+    if max_error is not None and max_error_relative is not None:
+        raise ValueError("give max_error or max_error_relative, not both")
+    for name, value, relative in (("max_error", max_error, False), ("max_error_relative", max_error_relative, True)):
+        if value is not None:
+            e = number(name, value)
+            if e < 0:
+                raise ValueError(f"{name}: must not be negative, got {e}")
+            o.max_error, o.max_error_is_relative = e, relative
+    if (target_faces, target_ratio, target_vertices, max_error, max_error_relative) == (None,) * 5:
+        raise ValueError("no stop criterion: give target_faces, target_ratio, target_vertices, max_error "
+                         "or max_error_relative")
+    if threshold and threshold_relative:
+        raise ValueError("give threshold or threshold_relative, not both")
+    if threshold_relative:
+        o.threshold, o.threshold_is_relative = number("threshold_relative", threshold_relative), True
+    else:
+        o.threshold = number("threshold", threshold)
+    for name, value in (("weighting", weighting), ("placement", placement), ("inversion", inversion),
+                        ("scheme", scheme)):
+        if not isinstance(value, str):
+            raise ValueError(f"{name}: expected one of {', '.join(_OPTION_NAMES[name])}, got {value!r}")
+        setattr(o, name, value)
+    o.boundary_weight = number("boundary_weight", boundary_weight)
+    o.lock_border = bool(lock_border)
+    o.max_normal_turn_degrees = number("max_turn", max_turn)
+    o.preserve_topology = not allow_non_manifold
+    if isinstance(threads, bool) or not isinstance(threads, int) or threads < 0:
+        raise ValueError(f"threads: expected a count >= 0 (0 = all cores), got {threads!r}")
+    o.threads = threads
+
+    if refit in (None, False):
+        refit = "none"
+    if refit is True:
+        refit = "full"
+    if isinstance(refit, str):
+        if refit not in _REFIT:
+            raise ValueError(f"refit: expected 'light', 'full', 'none' or (rounds, points_per_vertex), got {refit!r}")
+        explicit = refit == "full"
+        rounds, points = _REFIT[refit]
+        # The light default follows the command line: only with optimal placement (others keep
+        # their vertices where they put them) and never with a record.
+        if refit == "light" and (placement != "optimal" or record):
+            rounds = 0
+    else:
+        try:
+            rounds, points = refit
+            rounds, points = int(rounds), float(points)
+        except (TypeError, ValueError):
+            raise ValueError(f"refit: expected 'light', 'full', 'none' or (rounds, points_per_vertex), "
+                             f"got {refit!r}") from None
+        explicit = rounds > 0
+    if record and explicit:
+        raise ValueError("refit: a record replays the contractions and the refit moves every vertex after them, "
+                         "so record=True cannot be combined with a refit; use qem.lod, which refits each level")
+    o.refit_rounds, o.refit_points_per_vertex = rounds, points
+    return o
+
+
+def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_ratio: Optional[float] = None,
+             target_vertices: Optional[int] = None, max_error: Optional[float] = None,
+             max_error_relative: Optional[float] = None, threshold: float = 0.0,
+             threshold_relative: Optional[float] = None, weighting: str = "area", placement: str = "optimal",
+             boundary_weight: float = 1.0, lock_border: bool = False, inversion: str = "forbid",
+             max_turn: float = 75.0, allow_non_manifold: bool = False, scheme: str = "passes",
+             refit="light", threads: int = 0, attributes: Optional[dict] = None,
+             attribute_weights: Optional[dict] = None, vertex_lock=None, return_mapping: bool = False,
+             record: bool = False, progress: Optional[Callable[[float], Optional[bool]]] = None) -> SimplifyResult:
+    """Simplifies a triangle mesh by quadric-error pair contraction (Garland & Heckbert 1997).
+
+    vertices: (n, 3) array, any float dtype; faces: (m, 3) array of vertex indices, any integer dtype.
+    Stop criteria (at least one; they combine and the first reached wins):
+      target_faces: stop at or below this many faces.
+      target_ratio: the fraction of the input's faces kept, in (0, 1] (0.1 keeps 10 %).
+      target_vertices: stop at or below this many vertices.
+      max_error: never make a contraction whose error exceeds this distance (model units): the
+        weighted RMS distance of the new vertex to the planes it stands for.
+      max_error_relative: the same as a fraction of the bounding-box diagonal.
+    The algorithm (the command line's defaults, so the same options give the same bytes as `qem simplify`):
+      threshold: vertices closer than this (model units) are pairs too, so separate parts can join
+        (GH97 §3.2; 0 = edges only); threshold_relative: the same over the bounding-box diagonal.
+      weighting: "area" (HG99), "uniform" (GH97), "angle".
+      placement: "optimal", "segment", "midpoint", "endpoints".
+      boundary_weight: weight of the planes that hold open borders in place (0 = none).
+      lock_border: border vertices never move.
+      inversion: "forbid", "penalize" or "off": contractions that turn a face by more than max_turn degrees.
+      allow_non_manifold: skip the link condition (edge collapses may make non-manifold edges).
+      scheme: "passes" (fast) or "greedy" (GH97's heap: strictly cheapest first).
+      refit: after the last contraction move the vertices to fit the input surface, faces fixed:
+        "light" (default, as the command line: 1 round on ~2 input vertices per output vertex, only
+        with optimal placement and without record), "full" (3 rounds, every vertex), "none", or
+        (rounds, points_per_vertex).
+      threads: threads for the parallel parts (0 = all cores); the result is the same for any count.
+    Data carried along:
+      attributes: {name: (n, k) array} of per-vertex data, or {name: (array, kind)}; the kind
+        (normal, texcoord, color, joint_indices, joint_weights, tangent, scalar) follows glTF names
+        (NORMAL, TEXCOORD_0, COLOR_0, ...) when not given. Returned in result.attributes by the
+        simplified mesh: one vertex per wedge (a position may carry several attribute sets, split at
+        seams), seams kept closed and in place, normals unit, colours in [0, 1].
+      attribute_weights: {"normal": w, "uv": w, "color": w, "scalar": w}: what a unit of each
+        attribute costs against a unit of distance (1/w costs one bounding-box diagonal); the
+        library's defaults otherwise.
+      vertex_lock: not available yet (NotImplementedError when given).
+      return_mapping: fill result.vertex_source, face_source and output_vertex_of_input.
+      record: keep the contraction sequence in result.record (a qem.Record; no refit then).
+    progress: called with the fraction done (0..1) every few thousand contractions; returning
+      False cancels (result.stop_reason == "cancelled"). An exception it raises, or Ctrl-C
+      (KeyboardInterrupt), cancels the run and is raised. The GIL is released while the library works.
+
+    Returns a qem.SimplifyResult: vertices (float64), faces (int32), attributes, max_error,
+    stop_reason, stop_detail and, with return_mapping, the provenance maps.
+    Raises ValueError naming a bad argument, qem.Error for what the library refuses.
+    """
+    if attribute_weights is not None and not isinstance(attribute_weights, dict):
+        raise ValueError("attribute_weights: expected a dict {kind: weight} with kinds normal, uv, color, scalar")
+    if record and attributes:
+        raise ValueError("record: a record keeps positions and faces only, and the attributes would be lost "
+                         "on replay; simplify without record=True, or carry them with return_mapping")
+    if vertex_lock is not None:
+        raise NotImplementedError("vertex_lock: locking chosen vertices is not in the library yet; "
+                                  "leave vertex_lock=None (lock_border=True locks the border)")
+    if progress is not None and not callable(progress):
+        raise ValueError(f"progress: expected a callable taking the fraction done, got {progress!r}")
+    options = _options(target_faces=target_faces, target_ratio=target_ratio, target_vertices=target_vertices,
+                       max_error=max_error, max_error_relative=max_error_relative, threshold=threshold,
+                       threshold_relative=threshold_relative, weighting=weighting, placement=placement,
+                       boundary_weight=boundary_weight, lock_border=lock_border, inversion=inversion,
+                       max_turn=max_turn, allow_non_manifold=allow_non_manifold, scheme=scheme, refit=refit,
+                       threads=threads, record=record)
+    options.map_input_vertices = bool(return_mapping)
+    if attribute_weights is not None:
+        options.attribute_weights = attribute_weights
+    d = _qem.simplify(vertices, faces, options, _attribute_list(attributes), bool(record), progress)
+    result = _mesh_from_dict(d, SimplifyResult)
+    for key in SimplifyResult.__slots__:
+        if key in ("record",):
+            continue
+        setattr(result, key, d[key])
+    if not return_mapping:
+        result.vertex_source = result.face_source = result.output_vertex_of_input = None
+    result.record = Record(d["record"]) if d["record"] is not None else None
+    return result
+
+
+def load(path, *, weld: str = "auto") -> Mesh:
+    """Reads a mesh file: OBJ, PLY (ASCII, binary little and big endian), STL (ASCII, binary), OFF.
+
+    The format follows the extension (then the content). Polygons are triangulated (fan).
+    weld: "auto" (STL only: its triangles store their own corners), "on" or "off": merge exactly
+    coincident vertices. Returns a qem.Mesh (float64 vertices, int32 faces) with `double_precision`
+    (a PLY that stored doubles) and `warnings` (what was read leniently). Raises qem.Error on a
+    malformed or unreadable file, naming the file and the line.
+    """
+    return _loaded(_qem.load(str(path), weld))
+
+
+class _LoadedMesh(Mesh):
+    __slots__ = ("double_precision", "warnings")
+
+
+def _loaded(d):
+    m = _mesh_from_dict(d, _LoadedMesh)
+    m.double_precision, m.warnings = d["double_precision"], list(d["warnings"])
+    return m
+
+
+def save(path, mesh, *, binary: bool = True, double: Optional[bool] = None) -> None:
+    """Writes a mesh: OBJ, PLY, STL or OFF, by extension, atomically (temporary file, then renamed).
+
+    mesh: a qem.Mesh / SimplifyResult, anything with .vertices and .faces (or an Open3D
+    TriangleMesh), or a (vertices, faces) pair. binary: PLY and STL binary (little endian) or ASCII.
+    double: PLY coordinates as double (default: as the loaded mesh was stored, else float; the
+    command line writes a double PLY's simplification with doubles: pass double=True for that).
+    The result of qem.simplify saved with the defaults is the same bytes as `qem simplify`'s output.
+    """
+    vertices, faces, attributes = _mesh_arrays(mesh, "mesh")
+    if double is None:
+        double = bool(getattr(mesh, "double_precision", False))
+    _qem.save(str(path), vertices, faces, _attribute_list(attributes), bool(binary), bool(double))
+
+
+def _mesh_arrays(mesh, name):
+    if isinstance(mesh, (tuple, list)) and len(mesh) == 2:
+        return mesh[0], mesh[1], None
+    if hasattr(mesh, "vertices") and hasattr(mesh, "faces"):
+        attributes = getattr(mesh, "attributes", None)
+        kinds = getattr(mesh, "attribute_kinds", {}) or {}
+        if attributes:
+            attributes = {k: (v, kinds[k]) if k in kinds else v for k, v in attributes.items()}
+        return mesh.vertices, mesh.faces, attributes
+    if hasattr(mesh, "vertices") and hasattr(mesh, "triangles"):  # Open3D TriangleMesh
+        import numpy as np
+        return np.asarray(mesh.vertices), np.asarray(mesh.triangles), None
+    raise ValueError(f"{name}: expected a mesh (.vertices, .faces) or a (vertices, faces) pair, got {type(mesh).__name__}")
+
+
+class Measure:
+    """What `measure` returns (GH97 §6.1): distances in model units, *_rel over the original's diagonal.
+
+    E: mean squared distance over both sample sets; rms = sqrt(E); mean; hausdorff (symmetric) and
+    its one-sided parts h_original_to_approx, h_approx_to_original; bbox_diag, areas, sample counts.
+    """
+
+    def __init__(self, d):
+        self.__dict__.update(d)
+
+    def __repr__(self):
+        return f"qem.Measure(E={self.E:.6g}, hausdorff={self.hausdorff:.6g}, rms={self.rms:.6g})"
+
+
+def measure(original, approx, *, samples: int = 1_000_000, seed: int = 1, threads: int = 0) -> Measure:
+    """The error between two surfaces from `samples` points spread uniformly by area over both.
+
+    original, approx: meshes (.vertices and .faces, an Open3D TriangleMesh, or (vertices, faces)).
+    Returns a qem.Measure with E (mean squared distance, GH97 §6.1), hausdorff, rms, mean and their
+    *_rel over the original's bounding-box diagonal. Deterministic for a seed, any thread count.
+    """
+    if samples <= 0:
+        raise ValueError(f"samples: must be positive, got {samples}")
+    return Measure(_qem.measure(_as_pair(original, "original"), _as_pair(approx, "approx"), int(samples), int(seed),
+                                int(threads)))
+
+
+def _as_pair(mesh, name):
+    vertices, faces, _ = _mesh_arrays(mesh, name)
+    return (vertices, faces)
+
+
+def cluster(vertices, faces, *, grid=None, cell: Optional[float] = None, cell_relative: Optional[float] = None,
+            placement: str = "quadric") -> Mesh:
+    """Vertex clustering (Rossignac & Borrel 1993), the baseline GH97 compares against.
+
+    grid: (nx, ny, nz) cells over the bounding box; or cell: the cells' edge length (model units);
+    or cell_relative: the same as a fraction of the bounding-box diagonal. placement: "quadric"
+    (Lindstrom 2000) or "mean". Returns a qem.Mesh.
+    """
+    given = [x is not None for x in (grid, cell, cell_relative)]
+    if sum(given) != 1:
+        raise ValueError("give exactly one of grid, cell and cell_relative")
+    size = cell if cell is not None else cell_relative
+    d = _qem.cluster(vertices, faces, list(grid) if grid is not None else [], float(size or 0),
+                     cell_relative is not None, placement)
+    return _mesh_from_dict(d)
+
+
+class Info:
+    """What `info` returns: counts (vertices, faces, edges, boundary_edges, boundary_loops,
+    non_manifold_edges, non_manifold_vertices, components, duplicate_faces, degenerate_faces,
+    zero_area_faces, orientation_conflicts, unreferenced_vertices), euler, genus (-1 unless a
+    closed oriented manifold), watertight, manifold, bbox_min, bbox_max, diagonal."""
+
+    def __init__(self, d):
+        self.__dict__.update(d)
+
+    def __repr__(self):
+        return "qem.Info(" + ", ".join(f"{k}={v!r}" for k, v in self.__dict__.items()) + ")"
+
+
+def info(vertices, faces) -> Info:
+    """Topological and geometric facts about a mesh, as `qem info` prints them."""
+    return Info(_qem.info(vertices, faces))
+
+
+class Level(Mesh):
+    """One level of `lod`: a Mesh plus target_faces, contractions (prefix length) and max_error."""
+
+    __slots__ = ("target_faces", "contractions", "max_error")
+
+
+def lod(vertices, faces, *, ratios=None, target_faces=None, refit="light", **options) -> list:
+    """An LOD chain from one recorded run: levels finest first, as `qem lod` writes them.
+
+    ratios: fractions of the input's faces kept, e.g. [0.5, 0.25, 0.1]; or target_faces: face
+    counts. Every other option of `simplify` (weighting, placement, threshold, ..., threads)
+    applies; each level is refitted as `refit` says (the light refit by default, as the CLI).
+    Returns a list of qem.Level (vertices, faces, target_faces, contractions, max_error).
+    """
+    if (ratios is None) == (target_faces is None):
+        raise ValueError("give the levels as either ratios or target_faces")
+    for bad in ("target_ratio", "target_vertices", "max_error", "max_error_relative", "record", "progress",
+                "attributes", "return_mapping", "attribute_weights", "vertex_lock"):
+        if bad in options:
+            raise ValueError(f"{bad}: not an option of lod (the levels are its targets)")
+    defaults = dict(threshold=0.0, threshold_relative=None, weighting="area", placement="optimal",
+                    boundary_weight=1.0, lock_border=False, inversion="forbid", max_turn=75.0,
+                    allow_non_manifold=False, scheme="passes", threads=0)
+    unknown = set(options) - set(defaults)
+    if unknown:
+        raise TypeError(f"lod() got unexpected keyword arguments: {', '.join(sorted(unknown))}")
+    defaults.update(options)
+    o = _options(target_faces=None, target_ratio=1.0, target_vertices=None, max_error=None,
+                 max_error_relative=None, refit=refit, record=False, **defaults)
+    o.target_ratio = 0
+    levels = _qem.lod(vertices, faces, o, [int(n) for n in (target_faces or [])], [float(r) for r in (ratios or [])])
+    out = []
+    for d in levels:
+        level = _mesh_from_dict(d, Level)
+        level.target_faces, level.contractions, level.max_error = d["target_faces"], d["contractions"], d["max_error"]
+        out.append(level)
+    return out

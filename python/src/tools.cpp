@@ -1,0 +1,187 @@
+// qem._qem's file I/O, measure, cluster, info and lod: thin wrappers, each releasing the GIL
+// while the library works.
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+
+#include "arrays.h"
+#include "bindings.h"
+#include "qem/cluster.h"
+#include "qem/io.h"
+#include "qem/measure.h"
+#include "qem/mesh_info.h"
+#include "qem/progressive.h"
+#include "qem/refit.h"
+
+namespace qem::python {
+namespace {
+
+py::dict load(const std::string& path, const std::string& weld) {
+  LoadOptions options;
+  if (weld == "on") options.weld = Weld::On;
+  else if (weld == "off") options.weld = Weld::Off;
+  else if (weld != "auto") throw py::value_error("weld: expected 'auto', 'on' or 'off', got '" + weld + "'");
+  LoadReport report;
+  Mesh mesh;
+  {
+    py::gil_scoped_release nogil;
+    mesh = load_mesh(path, options, &report);
+  }
+  py::dict out = mesh_to_python(std::move(mesh));
+  out["double_precision"] = report.double_precision;
+  out["warnings"] = report.warnings;
+  return out;
+}
+
+void save(const std::string& path, py::handle vertices, py::handle faces, const py::list& attributes,
+          bool binary, bool double_precision) {
+  Positions p = positions_from(vertices, "mesh.vertices");
+  Indices f = indices_from(faces, "mesh.faces", p.data.size() / 3);
+  Mesh mesh;
+  mesh.positions.assign(p.data.begin(), p.data.end());
+  mesh.indices.assign(f.data.begin(), f.data.end());
+  mesh.attributes = attributes_from_python(attributes, mesh.vertex_count());
+  SaveOptions options;
+  options.binary = binary;
+  options.double_precision = double_precision;
+  py::gil_scoped_release nogil;
+  save_mesh(path, mesh, options);
+}
+
+py::dict measure(py::handle original, py::handle approx, std::size_t samples, std::uint64_t seed, unsigned threads) {
+  MeshArrays a = mesh_from(original, "original"), b = mesh_from(approx, "approx");
+  MeasureOptions options;
+  options.samples = samples;
+  options.seed = seed;
+  options.threads = threads;
+  MeasureResult r;
+  {
+    py::gil_scoped_release nogil;
+    r = qem::measure(a.view(), b.view(), options);
+  }
+  py::dict out;
+  out["E"] = r.E, out["E_rel"] = r.E_rel;
+  out["rms"] = r.rms, out["rms_rel"] = r.rms_rel;
+  out["mean"] = r.mean, out["mean_rel"] = r.mean_rel;
+  out["hausdorff"] = r.hausdorff, out["hausdorff_rel"] = r.hausdorff_rel;
+  out["h_original_to_approx"] = r.h_original_to_approx, out["h_approx_to_original"] = r.h_approx_to_original;
+  out["bbox_diag"] = r.bbox_diag;
+  out["area_original"] = r.area_original, out["area_approx"] = r.area_approx;
+  out["samples_original"] = r.samples_original, out["samples_approx"] = r.samples_approx;
+  return out;
+}
+
+py::dict cluster(py::handle vertices, py::handle faces, std::vector<int> grid, double cell, bool cell_relative,
+                 const std::string& placement) {
+  Positions p = positions_from(vertices, "vertices");
+  Indices f = indices_from(faces, "faces", p.data.size() / 3);
+  ClusterOptions options;
+  if (!grid.empty()) {
+    if (grid.size() != 3) throw py::value_error("grid: expected 3 cell counts (nx, ny, nz)");
+    std::copy(grid.begin(), grid.end(), options.grid);
+  }
+  options.cell = cell;
+  options.cell_relative = cell_relative;
+  if (placement == "quadric") options.placement = ClusterPlacement::Quadric;
+  else if (placement == "mean") options.placement = ClusterPlacement::Mean;
+  else throw py::value_error("placement: expected 'quadric' or 'mean', got '" + placement + "'");
+  Mesh out;
+  {
+    py::gil_scoped_release nogil;
+    out = qem::cluster(MeshView(p.data, f.data), options);
+  }
+  return mesh_to_python(std::move(out));
+}
+
+py::dict info(py::handle vertices, py::handle faces) {
+  Positions p = positions_from(vertices, "vertices");
+  Indices f = indices_from(faces, "faces", p.data.size() / 3);
+  MeshInfo i;
+  {
+    py::gil_scoped_release nogil;
+    i = mesh_info(MeshView(p.data, f.data));
+  }
+  py::dict out;
+  out["vertices"] = i.vertices, out["faces"] = i.faces, out["unreferenced_vertices"] = i.unreferenced_vertices;
+  out["edges"] = i.edges, out["boundary_edges"] = i.boundary_edges, out["boundary_loops"] = i.boundary_loops;
+  out["non_manifold_edges"] = i.non_manifold_edges, out["non_manifold_vertices"] = i.non_manifold_vertices;
+  out["components"] = i.components, out["duplicate_faces"] = i.duplicate_faces;
+  out["degenerate_faces"] = i.degenerate_faces, out["zero_area_faces"] = i.zero_area_faces;
+  out["orientation_conflicts"] = i.orientation_conflicts, out["euler"] = i.euler, out["genus"] = i.genus;
+  out["watertight"] = i.watertight(), out["manifold"] = i.manifold();
+  out["bbox_min"] = std::vector<double>(i.box.lo, i.box.lo + 3);
+  out["bbox_max"] = std::vector<double>(i.box.hi, i.box.hi + 3);
+  out["diagonal"] = i.box.diagonal();
+  return out;
+}
+
+// One recorded run to the smallest level, every level replayed from it, then each refitted as the
+// options say: what `qem lod` does (cli/cmd_lod.cpp).
+py::list lod(py::handle vertices, py::handle faces, SimplifyOptions options, const std::vector<std::size_t>& faces_targets,
+             const std::vector<double>& ratios) {
+  if (faces_targets.empty() == ratios.empty()) throw py::value_error("give the levels as either target_faces or ratios");
+  for (double r : ratios)
+    if (!(r > 0 && r <= 1)) throw py::value_error("ratios: every ratio must be in (0, 1]");
+  for (std::size_t n : faces_targets)
+    if (n == 0) throw py::value_error("target_faces: every face count must be positive");
+  Positions p = positions_from(vertices, "vertices");
+  Indices f = indices_from(faces, "faces", p.data.size() / 3);
+  RefitOptions refit;
+  refit.rounds = options.refit_rounds;
+  refit.points_per_vertex = options.refit_points_per_vertex;
+  refit.lock_border = options.lock_border;
+  refit.max_normal_turn_degrees = options.max_normal_turn_degrees;
+  refit.threads = options.threads;
+  options.refit_rounds = 0;
+  if (!faces_targets.empty())
+    options.target_faces = *std::min_element(faces_targets.begin(), faces_targets.end());
+  else
+    options.target_ratio = *std::min_element(ratios.begin(), ratios.end());
+  check_options(options);
+  std::vector<ReplayLevel> levels;
+  {
+    py::gil_scoped_release nogil;
+    const MeshView view(p.data, f.data);
+    ContractionRecorder recorder;
+    qem::simplify(view, options, &recorder);
+    const Record record = make_record(view, recorder.log);
+    std::vector<std::size_t> targets = faces_targets;
+    for (double r : ratios) targets.push_back(std::size_t(std::floor(r * double(record.base.face_count()))));
+    std::sort(targets.begin(), targets.end(), std::greater<>());
+    targets.erase(std::unique(targets.begin(), targets.end()), targets.end());
+    levels = replay_levels(record, targets);
+    if (refit.rounds > 0) {
+      std::vector<Mesh*> meshes;
+      for (ReplayLevel& l : levels) meshes.push_back(&l.mesh);
+      qem::refit(view, meshes, refit);
+    }
+  }
+  py::list out;
+  for (ReplayLevel& l : levels) {
+    py::dict d = mesh_to_python(std::move(l.mesh));
+    d["target_faces"] = l.target_faces;
+    d["contractions"] = l.contractions;
+    d["max_error"] = l.max_error;
+    out.append(d);
+  }
+  return out;
+}
+
+}  // namespace
+
+void bind_tools(py::module_& m) {
+  m.def("load", &load, py::arg("path"), py::arg("weld"));
+  m.def("save", &save, py::arg("path"), py::arg("vertices"), py::arg("faces"), py::arg("attributes"),
+        py::arg("binary"), py::arg("double_precision"));
+  m.def("measure", &measure, py::arg("original"), py::arg("approx"), py::arg("samples"), py::arg("seed"),
+        py::arg("threads"));
+  m.def("cluster", &cluster, py::arg("vertices"), py::arg("faces"), py::arg("grid"), py::arg("cell"),
+        py::arg("cell_relative"), py::arg("placement"));
+  m.def("info", &info, py::arg("vertices"), py::arg("faces"));
+  m.def("lod", &lod, py::arg("vertices"), py::arg("faces"), py::arg("options"), py::arg("target_faces"),
+        py::arg("ratios"));
+}
+
+}  // namespace qem::python

@@ -1,0 +1,172 @@
+"""Arrays in: every dtype and order gives the same result; every bad input is a ValueError naming it."""
+import numpy as np
+import pytest
+
+import qem
+
+
+def reference(mesh):
+    v, f = mesh
+    return qem.simplify(v, f, target_faces=500, refit="none")
+
+
+@pytest.mark.parametrize("vdtype", [np.float32, np.float64, np.float16])
+@pytest.mark.parametrize("fdtype", [np.int32, np.int64, np.uint32, np.uint64, np.int16])
+@pytest.mark.parametrize("order", ["C", "F"])
+def test_every_dtype_and_order(small_torus, vdtype, fdtype, order):
+    v, f = small_torus
+    v_in = np.asarray(v, dtype=vdtype, order=order)
+    f_in = np.asarray(f, dtype=fdtype, order=order)
+    r = qem.simplify(v_in, f_in, target_faces=500, refit="none")
+    # The same coordinates (as doubles) give the same output whatever the container.
+    expected = qem.simplify(v_in.astype(np.float64), f, target_faces=500, refit="none")
+    assert r.vertices.dtype == np.float64 and r.faces.dtype == np.int32
+    assert r.vertices.shape[1] == 3 and r.faces.shape == (len(r.faces), 3)
+    np.testing.assert_array_equal(r.vertices, expected.vertices)
+    np.testing.assert_array_equal(r.faces, expected.faces)
+
+
+def test_strided_views_and_lists(small_torus):
+    v, f = small_torus
+    wide = np.zeros((len(v), 6))
+    wide[:, ::2] = v  # a non-contiguous view
+    r = qem.simplify(wide[:, ::2], f, target_faces=500, refit="none")
+    expected = reference(small_torus)
+    np.testing.assert_array_equal(r.faces, expected.faces)
+    r2 = qem.simplify(v.tolist(), f.tolist(), target_faces=500, refit="none")
+    np.testing.assert_array_equal(r2.faces, expected.faces)
+
+
+def test_outputs_own_their_memory(small_torus):
+    r = reference(small_torus)
+    for a in (r.vertices, r.faces):
+        assert a.flags.c_contiguous
+        a[0] = a[0]  # writable
+    # Handed over from the library's vectors (a capsule frees them), not copied.
+    assert type(r.vertices.base).__name__ == "PyCapsule" and type(r.faces.base).__name__ == "PyCapsule"
+    v2 = r.vertices
+    del r
+    assert np.isfinite(v2).all()  # still valid after the result is gone
+
+
+@pytest.mark.parametrize(
+    "make, name, words",
+    [
+        (lambda v, f: (v[:, :2], f), "vertices", "shape"),
+        (lambda v, f: (v.ravel(), f), "vertices", "shape"),
+        (lambda v, f: (v, f[:, :2]), "faces", "shape"),
+        (lambda v, f: (v, f.astype(np.float64)), "faces", "integer"),
+        (lambda v, f: (v.astype(str), f), "vertices", "float"),
+        (lambda v, f: (v, np.where(f == 5, len(v), f)), "faces", "out of range"),
+        (lambda v, f: (v, np.where(f == 5, -1, f)), "faces", "out of range"),
+        (lambda v, f: (v, np.where(f == 5, -1, f).astype(np.int64)), "faces", "out of range"),
+        (lambda v, f: (np.where(np.arange(len(v))[:, None] == 3, np.nan, v), f), "vertices", "nan"),
+        (lambda v, f: (np.where(np.arange(len(v))[:, None] == 3, np.inf, v), f), "vertices", "inf"),
+        (lambda v, f: (None, f), "vertices", "None"),
+        (lambda v, f: ("abc", f), "vertices", ""),
+    ],
+)
+def test_bad_arrays(small_torus, make, name, words):
+    v, f = make(*small_torus)
+    with pytest.raises(ValueError) as e:
+        qem.simplify(v, f, target_faces=100)
+    assert str(e.value).startswith(name), str(e.value)
+    assert words in str(e.value), str(e.value)
+
+
+@pytest.mark.parametrize(
+    "kwargs, name",
+    [
+        (dict(), "no stop criterion"),
+        (dict(target_faces=0), "target_faces"),
+        (dict(target_faces=-3), "target_faces"),
+        (dict(target_faces=1.5), "target_faces"),
+        (dict(target_ratio=0), "target_ratio"),
+        (dict(target_ratio=1.5), "target_ratio"),
+        (dict(target_ratio=float("nan")), "target_ratio"),
+        (dict(max_error=-1), "max_error"),
+        (dict(target_faces=10, weighting="areal"), "weighting"),
+        (dict(target_faces=10, placement=3), "placement"),
+        (dict(target_faces=10, threads=-1), "threads"),
+        (dict(target_faces=10, refit="heavy"), "refit"),
+        (dict(target_faces=10, record=True, refit="full"), "refit"),
+        (dict(target_faces=10, progress=3), "progress"),
+        (dict(target_faces=10, attributes=[1]), "attributes"),
+        (dict(target_faces=10, attributes={"COLOR_0": np.zeros((3, 3))}), "attributes['COLOR_0']"),
+        (dict(target_faces=10, attributes={"x": (np.zeros((3600, 3)), "colour")}), "attributes['x']"),
+    ],
+)
+def test_bad_options(small_torus, kwargs, name):
+    with pytest.raises(ValueError) as e:
+        qem.simplify(*small_torus, **kwargs)
+    assert name in str(e.value), str(e.value)
+
+
+def test_library_errors_are_qem_error(small_torus):
+    assert issubclass(qem.Error, ValueError)
+    with pytest.raises(qem.Error, match="inversion angle"):
+        qem.simplify(*small_torus, target_faces=10, max_turn=95)
+    with pytest.raises(qem.Error):
+        qem.load("/nonexistent/mesh.ply")
+
+
+def test_not_implemented_arguments_say_so(small_torus):
+    with pytest.raises(NotImplementedError, match="vertex_lock"):
+        qem.simplify(*small_torus, target_faces=10, vertex_lock=np.zeros(3600, bool))
+
+
+def test_empty_and_tiny_meshes_do_not_crash():
+    for v, f in [(np.zeros((0, 3)), np.zeros((0, 3), np.int32)),
+                 (np.eye(3), np.array([[0, 1, 2]])),
+                 (np.zeros((3, 3)), np.array([[0, 1, 2]]))]:
+        try:
+            r = qem.simplify(v, f, target_faces=1)
+            assert len(r.faces) <= 1
+        except ValueError:
+            pass
+
+
+def test_attributes_are_checked_and_passed(small_torus):
+    v, f = small_torus
+    r = qem.simplify(v, f, target_faces=500, attributes={"NORMAL": v / np.linalg.norm(v, axis=1)[:, None],
+                                                         "TEXCOORD_0": v[:, :2].astype(np.float32),
+                                                         "k1": v[:, 0]})
+    assert set(r.attributes) == {"NORMAL", "TEXCOORD_0", "k1"}
+    n = r.attributes["NORMAL"]
+    assert n.shape == (len(r.vertices), 3)
+    assert np.allclose(np.linalg.norm(n, axis=1), 1.0)
+    assert r.attributes["TEXCOORD_0"].shape == (len(r.vertices), 2)
+    # The weights change the result; a bad kind is named.
+    heavy = qem.simplify(v, f, target_faces=500, attributes={"NORMAL": v / np.linalg.norm(v, axis=1)[:, None]},
+                         attribute_weights={"normal": 10.0})
+    light = qem.simplify(v, f, target_faces=500, attributes={"NORMAL": v / np.linalg.norm(v, axis=1)[:, None]},
+                         attribute_weights={"normal": 0.0})
+    assert not np.array_equal(heavy.vertices, light.vertices)
+    with pytest.raises(ValueError, match="gloss"):
+        qem.simplify(v, f, target_faces=500, attributes={"NORMAL": v}, attribute_weights={"gloss": 1.0})
+    with pytest.raises(ValueError, match="record"):
+        qem.simplify(v, f, target_faces=500, attributes={"NORMAL": v}, record=True)
+
+
+def test_bad_input_to_the_other_functions(small_torus):
+    v, f = small_torus
+    bad_f = f.copy()
+    bad_f[7, 1] = len(v)
+    for call in (lambda: qem.info(v, bad_f), lambda: qem.cluster(v, bad_f, grid=(4, 4, 4)),
+                 lambda: qem.lod(v, bad_f, ratios=[0.5]), lambda: qem.save("/tmp/x.ply", (v, bad_f))):
+        with pytest.raises(ValueError, match="faces"):
+            call()
+    with pytest.raises(ValueError, match="approx.faces"):
+        qem.measure((v, f), (v, bad_f))
+    with pytest.raises(ValueError, match="original"):
+        qem.measure(42, (v, f))
+    with pytest.raises(ValueError, match="grid"):
+        qem.cluster(v, f, grid=(4, 4))
+    with pytest.raises(ValueError, match="exactly one"):
+        qem.cluster(v, f)
+    with pytest.raises(ValueError, match="ratios"):
+        qem.lod(v, f, ratios=[1.5])
+    with pytest.raises(ValueError, match="samples"):
+        qem.measure((v, f), (v, f), samples=0)
+    with pytest.raises(qem.Error):
+        qem.Record.from_bytes(b"not a record")

@@ -1,0 +1,167 @@
+"""simplify: results, provenance maps, records, progress and cancelling, the GIL, threads."""
+import _thread
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import qem
+
+
+def test_result_fields(small_torus):
+    r = qem.simplify(*small_torus, target_ratio=0.25)
+    assert len(r.faces) <= 900 and r.stop_reason == "target reached"
+    assert r.max_error > 0 and r.stop_detail and r.contractions > 0
+    assert r.vertex_source is None and r.record is None
+    assert r.faces.min() >= 0 and r.faces.max() < len(r.vertices)
+    assert "target_ratio" in qem.simplify.__doc__ and "fraction" in qem.simplify.__doc__
+
+
+def test_stop_criteria(small_torus):
+    r = qem.simplify(*small_torus, max_error_relative=1e-3, refit="none")
+    assert r.stop_reason == "error limit reached" and r.max_error_relative <= 1e-3
+    r = qem.simplify(*small_torus, target_vertices=100)
+    assert len(r.vertices) <= 100
+
+
+def test_threads_give_the_same_bytes(large_torus):
+    v, f = large_torus
+    a = qem.simplify(v, f, target_ratio=0.1, threads=1)
+    b = qem.simplify(v, f, target_ratio=0.1, threads=2)
+    assert a.vertices.tobytes() == b.vertices.tobytes() and a.faces.tobytes() == b.faces.tobytes()
+
+
+def test_mapping(small_torus):
+    """Provenance: maps agree with each other and with the faces; an output vertex lies at its
+    source (never contracted) or within the run's error of the planes of the vertices merged into it."""
+    v, f = small_torus
+    r = qem.simplify(v, f, target_faces=400, weighting="uniform", refit="none", return_mapping=True)
+    to_out = r.output_vertex_of_input
+    assert to_out.shape == (len(v),) and to_out.dtype == np.int32
+    assert r.vertex_source.shape == (len(r.vertices),) and r.face_source.shape == (len(r.faces),)
+    # Every output vertex's source went into it; every output face is its source face renamed.
+    np.testing.assert_array_equal(to_out[r.vertex_source], np.arange(len(r.vertices)))
+    np.testing.assert_array_equal(to_out[f[r.face_source]], r.faces)
+    # Vertices that took part in no contraction keep their exact coordinates.
+    merged = np.bincount(to_out[to_out >= 0], minlength=len(r.vertices))
+    alone = merged == 1
+    np.testing.assert_array_equal(r.vertices[alone], v[r.vertex_source[alone]])
+    # The others: RMS distance to the planes of every input face corner merged into them (the
+    # vertex's quadric, uniform weights) within the largest contraction error.
+    p0, p1, p2 = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    n = np.cross(p1 - p0, p2 - p0)
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    offset = -np.einsum("ij,ij->i", n, p0)
+    corners_out = to_out[f]  # (m, 3): the output vertex of each corner
+    d2 = np.zeros(len(r.vertices))
+    count = np.zeros(len(r.vertices))
+    for c in range(3):
+        o = corners_out[:, c]
+        dist = np.einsum("ij,ij->i", n, r.vertices[o]) + offset
+        np.add.at(d2, o, dist**2)
+        np.add.at(count, o, 1)
+    rms = np.sqrt(d2 / count)
+    assert (rms[~alone] <= r.max_error * (1 + 1e-3) + 1e-12).all(), (rms.max(), r.max_error)
+    assert (np.linalg.norm(r.vertices - v[r.vertex_source], axis=1)[alone] == 0).all()
+
+
+def test_mapping_carries_user_data(small_torus):
+    v, f = small_torus
+    colors = np.random.default_rng(1).random((len(v), 3))
+    r = qem.simplify(v, f, target_ratio=0.2, return_mapping=True)
+    out_colors = colors[r.vertex_source]  # the documented one-liner
+    assert out_colors.shape == (len(r.vertices), 3)
+
+
+def test_record_replays_exactly(small_torus):
+    v, f = small_torus
+    r = qem.simplify(v, f, target_faces=200, record=True)
+    rec = r.record
+    assert isinstance(rec, qem.Record) and len(rec) == r.contractions and rec.final_faces == len(r.faces)
+    final = rec.replay(200)
+    np.testing.assert_array_equal(final.vertices, r.vertices)
+    np.testing.assert_array_equal(final.faces, r.faces)
+    mid = rec.replay(1000)
+    direct = qem.simplify(v, f, target_faces=1000, refit="none")
+    assert mid.vertices.tobytes() == direct.vertices.tobytes() and mid.faces.tobytes() == direct.faces.tobytes()
+    again = qem.Record.from_bytes(rec.to_bytes())
+    assert again.replay(1000).faces.tobytes() == mid.faces.tobytes()
+
+
+def test_progress_and_cancel(large_torus):
+    seen = []
+    r = qem.simplify(*large_torus, target_ratio=0.1, progress=seen.append)
+    assert seen and seen[-1] == 1.0 and seen == sorted(seen)
+
+    def stop(fraction):
+        return fraction < 0.2
+
+    r = qem.simplify(*large_torus, target_ratio=0.1, progress=stop)
+    assert r.stop_reason == "cancelled" and len(r.faces) > 0.1 * len(large_torus[1])
+
+
+def test_progress_exception_cancels_and_is_raised(large_torus):
+    def boom(fraction):
+        if fraction > 0.1:
+            raise RuntimeError("from the callback")
+
+    with pytest.raises(RuntimeError, match="from the callback"):
+        qem.simplify(*large_torus, target_ratio=0.1, progress=boom)
+
+
+def test_keyboard_interrupt_cancels(large_torus):
+    started = threading.Event()
+
+    def interrupt():
+        started.wait(30)
+        _thread.interrupt_main()  # as Ctrl-C: the signal arrives while the library runs
+
+    threading.Thread(target=interrupt, daemon=True).start()
+    t0 = time.perf_counter()
+    with pytest.raises(KeyboardInterrupt):
+        qem.simplify(*large_torus, target_faces=100, progress=lambda f: started.set())
+        time.sleep(5)  # not reached when the run was cancelled
+    # The interpreter goes on working normally afterwards.
+    assert time.perf_counter() - t0 < 30
+    assert len(qem.simplify(*large_torus, target_ratio=0.5).faces) > 0
+
+
+def test_gil_is_released(large_torus):
+    """A second Python thread keeps running while a large simplification runs."""
+    v, f = large_torus
+    ticks = []
+    running = threading.Event()
+    done = threading.Event()
+
+    def other():
+        running.set()
+        while not done.is_set():
+            ticks.append(time.perf_counter())
+            time.sleep(0.001)
+
+    t = threading.Thread(target=other)
+    t.start()
+    running.wait()
+    t0 = time.perf_counter()
+    qem.simplify(v, f, target_faces=1000, threads=1)
+    t1 = time.perf_counter()
+    done.set()
+    t.join()
+    during = [x for x in ticks if t0 <= x <= t1]
+    # With the GIL held the other thread would get no tick in; released, about one a millisecond
+    # (fewer on a loaded machine: the bound is loose).
+    assert t1 - t0 > 0.1
+    assert len(during) >= max(10, 0.05 * (t1 - t0) / 0.001), (len(during), t1 - t0)
+
+
+def test_help_is_the_manual():
+    for fn in (qem.simplify, qem.load, qem.save, qem.measure, qem.cluster, qem.info, qem.lod, qem.Record.replay):
+        assert fn.__doc__ and len(fn.__doc__) > 40, fn
+
+
+def test_option_names_are_the_librarys():
+    assert qem.option_names("placement") == ["optimal", "segment", "midpoint", "endpoints"]
+    assert "passes" in qem.option_names("scheme") and "forbid" in qem.option_names("inversion")
+    with pytest.raises(ValueError, match="weighting"):
+        qem.simplify(np.eye(3), [[0, 1, 2]], target_faces=1, weighting="areal")

@@ -1,0 +1,33 @@
+#include "core/cost_model.h"
+
+namespace qem::core {
+
+bool place_with_wedges(const Context& c, std::uint32_t a, std::uint32_t b, const Quadric& q, Placed& placed) {
+  const Wedges& wg = *c.wedges;
+  const WorkingMesh& m = c.mesh;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> map;
+  bool found = false;
+  for (int direction = 0; direction < 2; ++direction) {
+    const std::uint32_t survivor = direction == 0 ? a : b, removed = direction == 0 ? b : a;
+    if (m.held(removed, c.settings.lock_border)) continue;  // locked: it must stay
+    if (!map_wedges(m, wg, survivor, removed, map)) continue;
+    Quadric total = q;
+    std::uint32_t w = wg.first[survivor];
+    do {
+      std::uint32_t partner = kNoVertex;
+      for (const auto& [r, s] : map)
+        if (s == w) partner = r;
+      total += wg.reduced(w, partner);
+      w = wg.next[w];
+    } while (w != wg.first[survivor]);
+    const bool free = wg.single(a) && wg.single(b) && !m.held(survivor, c.settings.lock_border);
+    const Placed candidate =
+        free ? place(total, m.pos[a], m.pos[b], c.settings.placement) : Placed{m.pos[survivor], total.evaluate(m.pos[survivor])};
+    if (!found || candidate.error < placed.error) placed = candidate;
+    found = true;
+    if (free) break;  // both directions place the same way
+  }
+  return found;
+}
+
+}  // namespace qem::core

@@ -1,0 +1,286 @@
+#include "core/wedges.h"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+namespace qem::core {
+
+// A wedge's quadric row: A (6: a00 a01 a02 a11 a12 a22), b (3), c, W, then per interpolated
+// component G (3) and D. Q(p, s) = p'Ap + 2 b.p + c + sum_j (W s_j^2 - 2 s_j (G_j.p + D_j)).
+namespace {
+
+constexpr std::uint32_t kHead = 11;
+
+double weight_of(AttributeKind kind, const AttributeWeights& w) {
+  switch (kind) {
+    case AttributeKind::Normal: return w.normal;
+    case AttributeKind::TexCoord: return w.tex_coord;
+    case AttributeKind::Color: return w.color;
+    case AttributeKind::Scalar: return w.scalar;
+    case AttributeKind::JointIndices:  // ids: never interpolated
+    case AttributeKind::JointWeights:  // taken with the joints they weigh
+    case AttributeKind::Tangent:       // recomputed from the normals and UVs by renderers
+      return 0;
+  }
+  return 0;
+}
+
+// Adds, for every interpolated channel, the face's linear fit g.p + d of the corner values (g in
+// the face's plane: the gradient of the barycentric interpolation) to each corner wedge, weighted
+// by the face's area (HG99 §2's area weighting, so the error stays a surface integral).
+void add_face(Wedges& wg, const Vec3 p[3], const std::uint32_t w[3]) {
+  const Vec3 e1 = p[1] - p[0], e2 = p[2] - p[0], n = cross(e1, e2);
+  const double n2 = dot(n, n);
+  if (!(n2 > 0)) return;
+  const double area = std::sqrt(n2) / 2;
+  const Vec3 u = cross(e2, n) * (1.0 / n2), v = cross(n, e1) * (1.0 / n2);
+  for (int k = 0; k < 3; ++k) {
+    double* q = &wg.quadric[std::size_t(w[k]) * wg.quadric_width];
+    q[10] += area;
+    std::uint32_t j = 0;
+    for (const Channel& ch : wg.channels) {
+      if (ch.weight == 0) continue;
+      for (std::uint32_t c = 0; c < ch.components; ++c, ++j) {
+        const auto s = [&](int corner) { return ch.weight * wg.value[std::size_t(w[corner]) * wg.width + ch.first + c]; };
+        const Vec3 g = u * (s(1) - s(0)) + v * (s(2) - s(0));
+        const double d = s(0) - dot(g, p[0]);
+        q[0] += area * g.x * g.x, q[1] += area * g.x * g.y, q[2] += area * g.x * g.z;
+        q[3] += area * g.y * g.y, q[4] += area * g.y * g.z, q[5] += area * g.z * g.z;
+        q[6] += area * d * g.x, q[7] += area * d * g.y, q[8] += area * d * g.z;
+        q[9] += area * d * d;
+        double* gd = q + kHead + 4 * j;
+        gd[0] += area * g.x, gd[1] += area * g.y, gd[2] += area * g.z, gd[3] += area * d;
+      }
+    }
+  }
+}
+
+}  // namespace
+
+Quadric Wedges::reduced(std::uint32_t w, std::uint32_t w2) const {
+  double row[kHead + 4 * 32];
+  std::vector<double> big;
+  double* q = row;
+  if (quadric_width > sizeof row / sizeof row[0]) big.resize(quadric_width), q = big.data();
+  const double* a = &quadric[std::size_t(w) * quadric_width];
+  for (std::uint32_t i = 0; i < quadric_width; ++i) q[i] = a[i];
+  if (w2 != kNoVertex) {
+    const double* b = &quadric[std::size_t(w2) * quadric_width];
+    for (std::uint32_t i = 0; i < quadric_width; ++i) q[i] += b[i];
+  }
+  Quadric r;
+  r.a00 = q[0], r.a01 = q[1], r.a02 = q[2], r.a11 = q[3], r.a12 = q[4], r.a22 = q[5];
+  r.b0 = q[6], r.b1 = q[7], r.b2 = q[8], r.c = q[9];
+  const double W = q[10];
+  if (!(W > 0)) return r;
+  for (std::uint32_t j = 0; kHead + 4 * j < quadric_width; ++j) {
+    const double* gd = q + kHead + 4 * j;
+    const double gx = gd[0], gy = gd[1], gz = gd[2], d = gd[3];
+    r.a00 -= gx * gx / W, r.a01 -= gx * gy / W, r.a02 -= gx * gz / W;
+    r.a11 -= gy * gy / W, r.a12 -= gy * gz / W, r.a22 -= gz * gz / W;
+    r.b0 -= gx * d / W, r.b1 -= gy * d / W, r.b2 -= gz * d / W;
+    r.c -= d * d / W;
+  }
+  r.weight = 0;
+  return r;
+}
+
+void Wedges::update_values(std::uint32_t w, const Vec3& p) {
+  const double* q = &quadric[std::size_t(w) * quadric_width];
+  const double W = q[10];
+  if (!(W > 0)) return;
+  std::uint32_t j = 0;
+  for (const Channel& ch : channels) {
+    if (ch.weight == 0) continue;
+    for (std::uint32_t c = 0; c < ch.components; ++c, ++j) {
+      const double* gd = q + kHead + 4 * j;
+      value[std::size_t(w) * width + ch.first + c] = (gd[0] * p.x + gd[1] * p.y + gd[2] * p.z + gd[3]) / W / ch.weight;
+    }
+  }
+}
+
+void Wedges::merge(std::uint32_t survivor, std::uint32_t removed, bool moved, const Vec3& p,
+                   const std::vector<std::pair<std::uint32_t, std::uint32_t>>& map) {
+  for (const auto& [r, s] : map) {
+    double* into = &quadric[std::size_t(s) * quadric_width];
+    const double* from = &quadric[std::size_t(r) * quadric_width];
+    for (std::uint32_t i = 0; i < quadric_width; ++i) into[i] += from[i];
+    merged_into[r] = s;
+  }
+  first[removed] = kNoVertex;
+  if (!moved) return;
+  std::uint32_t w = first[survivor];
+  do update_values(w, p), w = next[w];
+  while (w != first[survivor]);
+}
+
+void Wedges::renumber(const std::vector<std::uint32_t>& vertex_to, std::size_t count) {
+  for (std::uint32_t& v : vertex) v = v == kNoVertex ? kNoVertex : vertex_to[v];
+  squeeze_by(vertex_to, count, first);
+}
+
+std::uint32_t Wedges::final_wedge_of_input(std::uint32_t v) const {
+  std::uint32_t w = of_input[v];
+  if (w == kNoVertex) return w;
+  while (merged_into[w] != kNoVertex) w = merged_into[w];
+  return w;
+}
+
+Wedges build_wedges(MeshView in, const std::vector<std::uint32_t>& internal, WorkingMesh& m,
+                    const SimplifyOptions& options) {
+  Wedges wg;
+  std::uint32_t interpolated = 0;
+  for (const VertexAttribute& a : in.attributes) {
+    const double weight = weight_of(a.kind, options.attribute_weights);
+    wg.channels.push_back({a.kind, wg.width, a.components, weight});
+    wg.width += a.components;
+    if (weight > 0) interpolated += a.components;
+  }
+  wg.quadric_width = kHead + 4 * interpolated;
+
+  // One wedge per input vertex and material, in the order of first use by a working face.
+  std::vector<std::uint32_t> wedge_of(in.vertex_count(), kNoVertex);
+  std::unordered_map<std::uint64_t, std::uint32_t> other_material;  // (vertex, material) beyond the first
+  std::vector<std::uint32_t> material_of;
+  auto wedge = [&](std::uint32_t v, std::uint32_t material) {
+    std::uint32_t& w = wedge_of[v];
+    if (w != kNoVertex && material_of[w] == material) return w;
+    if (w != kNoVertex) {
+      auto [it, fresh] = other_material.try_emplace((std::uint64_t(v) << 32) | material, std::uint32_t(wg.count()));
+      if (!fresh) return it->second;
+    } else {
+      w = std::uint32_t(wg.count());
+    }
+    const std::uint32_t id = std::uint32_t(wg.count());
+    wg.vertex.push_back(internal[v]);
+    wg.source.push_back(v);
+    material_of.push_back(material);
+    for (const VertexAttribute& a : in.attributes)
+      for (std::uint32_t c = 0; c < a.components; ++c)
+        wg.value.push_back(a.values[std::size_t(v) * a.components + c]);
+    return id;
+  };
+  m.corner_wedge.resize(m.tri.size());
+  for (std::size_t f = 0; f < m.face_source.size(); ++f) {
+    const std::uint32_t source = m.face_source[f];
+    const std::uint32_t material = in.face_materials.empty() ? 0 : in.face_materials[source];
+    for (int k = 0; k < 3; ++k) m.corner_wedge[3 * f + k] = wedge(in.indices[3 * std::size_t(source) + k], material);
+  }
+  wg.of_input = std::move(wedge_of);
+
+  // The rings of wedges per working vertex.
+  wg.first.assign(m.vertex_count(), kNoVertex);
+  wg.next.resize(wg.count());
+  wg.merged_into.assign(wg.count(), kNoVertex);
+  for (std::uint32_t w = 0; w < wg.count(); ++w) {
+    std::uint32_t& head = wg.first[wg.vertex[w]];
+    if (head == kNoVertex) {
+      head = w, wg.next[w] = w;
+    } else {
+      wg.next[w] = wg.next[head], wg.next[head] = w;
+    }
+  }
+  wg.quadric.assign(wg.count() * std::size_t(wg.quadric_width), 0);
+  for (std::uint32_t f = 0; f < m.face_source.size(); ++f) {
+    const std::uint32_t* t = m.face(f);
+    const Vec3 p[3] = {m.pos[t[0]], m.pos[t[1]], m.pos[t[2]]};
+    add_face(wg, p, &m.corner_wedge[3 * std::size_t(f)]);
+  }
+  return wg;
+}
+
+bool map_wedges(const WorkingMesh& m, const Wedges& wg, std::uint32_t survivor, std::uint32_t removed,
+                std::vector<std::pair<std::uint32_t, std::uint32_t>>& map) {
+  map.clear();
+  for (std::uint32_t f : m.vertex_faces[survivor]) {
+    if (!m.face_alive[f] || !m.face_has(f, removed)) continue;
+    const std::uint32_t* t = m.face(f);
+    std::uint32_t ws = kNoVertex, wr = kNoVertex;
+    for (int k = 0; k < 3; ++k) {
+      if (t[k] == survivor) ws = m.corner_wedge[3 * std::size_t(f) + k];
+      if (t[k] == removed) wr = m.corner_wedge[3 * std::size_t(f) + k];
+    }
+    bool known = false;
+    for (const auto& [r, s] : map) {
+      if (r == wr && s == ws) known = true;
+      else if (r == wr || s == ws) return false;  // one wedge to two, or two into one
+    }
+    if (!known) map.push_back({wr, ws});
+  }
+  std::size_t removed_wedges = 0;
+  std::uint32_t w = wg.first[removed];
+  do ++removed_wedges, w = wg.next[w];
+  while (w != wg.first[removed]);
+  return !map.empty() && map.size() == removed_wedges;
+}
+
+Mesh build_wedge_output(const WorkingMesh& m, const Wedges& wg, MeshView input, std::vector<std::uint32_t>& vertex_source,
+                        std::vector<std::uint32_t>& face_source, std::vector<std::uint32_t>* output_vertex_of_input) {
+  std::vector<std::uint32_t> faces;
+  std::vector<std::uint8_t> used(wg.count(), 0);
+  for (std::uint32_t f = 0; f < m.face_alive.size(); ++f)
+    if (m.face_alive[f]) {
+      faces.push_back(f);
+      for (int k = 0; k < 3; ++k) used[m.corner_wedge[3 * std::size_t(f) + k]] = 1;
+    }
+  std::sort(faces.begin(), faces.end(), [&](std::uint32_t x, std::uint32_t y) { return m.face_source[x] < m.face_source[y]; });
+  std::vector<std::uint32_t> survivors;
+  for (std::uint32_t w = 0; w < wg.count(); ++w)
+    if (used[w]) survivors.push_back(w);
+  std::sort(survivors.begin(), survivors.end(), [&](std::uint32_t x, std::uint32_t y) {
+    return wg.source[x] != wg.source[y] ? wg.source[x] < wg.source[y] : x < y;
+  });
+  Mesh out;
+  for (const VertexAttribute& a : input.attributes) {
+    out.attributes.push_back({a.name, a.kind, a.components, {}});
+    out.attributes.back().values.reserve(survivors.size() * a.components);
+  }
+  std::vector<std::uint32_t> remap(wg.count(), kNoVertex);
+  std::vector<double> values(wg.width);
+  for (std::uint32_t w : survivors) {
+    remap[w] = std::uint32_t(vertex_source.size());
+    vertex_source.push_back(wg.source[w]);
+    const Vec3 p = m.output_position(wg.vertex[w], input);
+    out.positions.insert(out.positions.end(), {p.x, p.y, p.z});
+    output_values(wg, w, values.data());
+    for (std::size_t i = 0; i < wg.channels.size(); ++i)
+      out.attributes[i].values.insert(out.attributes[i].values.end(), values.begin() + wg.channels[i].first,
+                                      values.begin() + wg.channels[i].first + wg.channels[i].components);
+  }
+  for (std::uint32_t f : faces) {
+    for (int k = 0; k < 3; ++k) out.indices.push_back(remap[m.corner_wedge[3 * std::size_t(f) + k]]);
+    face_source.push_back(m.face_source[f]);
+    if (!input.face_materials.empty()) out.face_materials.push_back(input.face_materials[m.face_source[f]]);
+  }
+  if (output_vertex_of_input) {
+    output_vertex_of_input->assign(input.vertex_count(), kNoVertex);
+    for (std::uint32_t v = 0; v < input.vertex_count(); ++v) {
+      const std::uint32_t w = wg.final_wedge_of_input(v);
+      if (w != kNoVertex) (*output_vertex_of_input)[v] = remap[w];
+    }
+  }
+  return out;
+}
+
+void output_values(const Wedges& wg, std::uint32_t w, double* out) {
+  const double* v = &wg.value[std::size_t(w) * wg.width];
+  for (const Channel& ch : wg.channels) {
+    double* o = out + ch.first;
+    for (std::uint32_t c = 0; c < ch.components; ++c) o[c] = v[ch.first + c];
+    if (ch.kind == AttributeKind::Normal && ch.components == 3) {
+      const double len = std::sqrt(o[0] * o[0] + o[1] * o[1] + o[2] * o[2]);
+      if (len > 0)
+        for (int c = 0; c < 3; ++c) o[c] /= len;
+    } else if (ch.kind == AttributeKind::Color) {
+      for (std::uint32_t c = 0; c < ch.components; ++c) o[c] = std::clamp(o[c], 0.0, 1.0);
+    } else if (ch.kind == AttributeKind::JointWeights) {
+      double sum = 0;
+      for (std::uint32_t c = 0; c < ch.components; ++c) sum += o[c] = std::max(o[c], 0.0);
+      if (sum > 0)
+        for (std::uint32_t c = 0; c < ch.components; ++c) o[c] /= sum;
+    }
+  }
+}
+
+}  // namespace qem::core

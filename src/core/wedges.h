@@ -1,0 +1,86 @@
+// Appearance attributes on wedges (Hoppe 1999, "New quadric metric for simplifying meshes with
+// appearance attributes"). The working vertices are the input's distinct positions; a wedge is one
+// set of attribute values at a position (the input's vertices that share it: split at UV seams,
+// normal creases, colour and material boundaries). The link condition, borders and inversion see
+// the welded surface; the wedges are what the attributes live on.
+//
+// Each wedge carries Hoppe's attribute quadric: for every face around it and every attribute
+// channel, the area-weighted squared difference between the channel's value s and the face's
+// linear fit g.p + d of that channel, 11 + 4m numbers for m channels. Minimised over s (each s at
+// its optimum (G.p + D) / W), it is a plain quadric in p, added to the positional one: the
+// placement then minimises both together (the reduced 3x3 solve of Hoppe & Marschner 2000).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/quadric.h"
+#include "core/working_mesh.h"
+#include "qem/simplify.h"
+
+namespace qem::core {
+
+/// Where one attribute's channels sit in a wedge's values, and how it is treated.
+struct Channel {
+  AttributeKind kind;
+  std::uint32_t first, components;  // in the wedge's value row
+  double weight;                    // 0: carried from the survivor, never interpolated
+};
+
+struct Wedges {
+  std::vector<Channel> channels;
+  std::uint32_t width = 0;            ///< values per wedge (all channels' components)
+  std::uint32_t quadric_width = 0;    ///< 11 + 4 x interpolated components
+  std::vector<std::uint32_t> vertex;  ///< working vertex of each wedge
+  std::vector<std::uint32_t> next;    ///< the next wedge of the same vertex (a ring)
+  std::vector<std::uint32_t> first;   ///< per working vertex, one of its wedges (kNoVertex: none)
+  std::vector<std::uint32_t> source;  ///< input vertex of each wedge
+  std::vector<std::uint32_t> merged_into;  ///< kNoVertex, or the wedge this one was merged into
+  std::vector<double> value;          ///< `width` per wedge, as given (the quadrics hold the weights)
+  std::vector<double> quadric;        ///< `quadric_width` per wedge (see wedges.cpp)
+
+  std::size_t count() const { return vertex.size(); }
+  bool single(std::uint32_t v) const { return next[first[v]] == first[v]; }
+  /// The reduced quadric of wedge w (or of w and w2 merged, w2 != kNoVertex): its attribute error
+  /// with every channel at its optimum, as a quadric in the position (weight 0: it adds error, not
+  /// surface).
+  Quadric reduced(std::uint32_t w, std::uint32_t w2) const;
+  /// Sets w's interpolated channels to their optimum at p (after the merge).
+  void update_values(std::uint32_t w, const Vec3& p);
+  /// `removed` went into `survivor`, now at p: each removed wedge's quadric joins its partner's
+  /// (map from map_wedges), and, if the survivor moved, its wedges take their optimal values at p.
+  /// A survivor that stays (a seam, a border, an endpoint placement) keeps its values, as it keeps
+  /// its position: a seam's UVs stay exactly on the chart's edge.
+  void merge(std::uint32_t survivor, std::uint32_t removed, bool moved, const Vec3& p,
+             const std::vector<std::pair<std::uint32_t, std::uint32_t>>& map);
+  /// Renumbering (renumber.h): working vertex v is now vertex_to[v].
+  void renumber(const std::vector<std::uint32_t>& vertex_to, std::size_t count);
+  /// The surviving wedge an input vertex's values went into (kNoVertex: none).
+  std::uint32_t final_wedge_of_input(std::uint32_t v) const;
+  std::vector<std::uint32_t> of_input;  ///< the (first) wedge of each input vertex
+};
+
+/// The wedges of `input` (one per referenced input vertex and face material) on the working
+/// vertices `internal` (per input vertex), their attribute quadrics from the working faces, and the
+/// wedge of every face corner (mesh.corner_wedge). Weights per kind from `options`.
+Wedges build_wedges(MeshView input, const std::vector<std::uint32_t>& internal, WorkingMesh& mesh,
+                    const SimplifyOptions& options);
+
+/// The wedge map of collapsing `removed` into `survivor`: each of the removed vertex's wedges to the
+/// survivor's wedge on the same side of the edge's faces. False if a wedge of the removed vertex is
+/// on no face of the edge (the collapse would move a seam or open it) or two wedges would merge into
+/// one (the collapse would close a seam). `map` gets (removed wedge, survivor wedge) pairs.
+bool map_wedges(const WorkingMesh& mesh, const Wedges& wedges, std::uint32_t survivor, std::uint32_t removed,
+                std::vector<std::pair<std::uint32_t, std::uint32_t>>& map);
+
+/// The output with attributes: one vertex per surviving wedge, in input order, with the input's
+/// attributes (output_values) and face materials; provenance as build_output's, and, when asked,
+/// each input vertex's output vertex.
+Mesh build_wedge_output(const WorkingMesh& mesh, const Wedges& wedges, MeshView input, std::vector<std::uint32_t>& vertex_source,
+                        std::vector<std::uint32_t>& face_source, std::vector<std::uint32_t>* output_vertex_of_input);
+
+/// The output's attribute values of wedge w: unweighted, normals unit, colours in [0, 1], skin
+/// weights summing to 1.
+void output_values(const Wedges& wedges, std::uint32_t w, double* out);
+
+}  // namespace qem::core

@@ -1,0 +1,250 @@
+// Simplification with appearance attributes on wedges (Hoppe 1999): seams stay closed and in
+// place, materials never merge, attributes keep their meaning (unit normals, colours in range,
+// no bleeding across a step), and a mesh without attributes is untouched by all of it.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <set>
+
+#include "qem/error.h"
+#include "qem/simplify.h"
+#include "test_meshes.h"
+
+using namespace qem;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// A latitude-longitude sphere with a UV seam: the column at u = 1 repeats the positions of u = 0
+// with other texture coordinates (split vertices, as exporters write them); the poles are fans.
+Mesh uv_sphere(int rings, int segments) {
+  Mesh m;
+  VertexAttribute uv{"TEXCOORD_0", AttributeKind::TexCoord, 2, {}};
+  VertexAttribute normal{"NORMAL", AttributeKind::Normal, 3, {}};
+  for (int i = 0; i <= rings; ++i)
+    for (int j = 0; j <= segments; ++j) {
+      const double theta = kPi * i / rings, phi = 2 * kPi * (j % segments) / segments;
+      double p[3] = {std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)};
+      if (i == 0 || i == rings) p[0] = p[1] = 0;  // the poles: one position for the whole ring
+      // A little relief so that there is something to keep.
+      const double r = 1 + 0.05 * std::sin(5 * theta) * std::cos(3 * phi);
+      m.positions.insert(m.positions.end(), {r * p[0], r * p[1], r * p[2]});
+      uv.values.insert(uv.values.end(), {double(j) / segments, double(i) / rings});
+      normal.values.insert(normal.values.end(), {p[0], p[1], p[2]});
+    }
+  auto id = [&](int i, int j) { return std::uint32_t(i * (segments + 1) + j); };
+  for (int i = 0; i < rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      if (i > 0) m.indices.insert(m.indices.end(), {id(i, j), id(i + 1, j), id(i, j + 1)});
+      if (i + 1 < rings) m.indices.insert(m.indices.end(), {id(i, j + 1), id(i + 1, j), id(i + 1, j + 1)});
+    }
+  m.attributes = {uv, normal};
+  return m;
+}
+
+// Edges used by one face once the vertices are welded by position: holes and cracks. With
+// `square`, those on the unit square's outline (a flat grid's own border) are not counted.
+std::size_t open_edges_welded(const Mesh& m, bool square = false) {
+  std::map<std::array<double, 3>, std::uint32_t> id;
+  std::vector<std::uint32_t> welded(m.vertex_count());
+  for (std::size_t v = 0; v < m.vertex_count(); ++v)
+    welded[v] = id.try_emplace({m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]},
+                               std::uint32_t(id.size()))
+                    .first->second;
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
+  for (std::size_t f = 0; f < m.face_count(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      std::uint32_t a = welded[m.indices[3 * f + k]], b = welded[m.indices[3 * f + (k + 1) % 3]];
+      ++uses[{std::min(a, b), std::max(a, b)}];
+    }
+  std::vector<std::array<double, 3>> at(id.size());
+  for (const auto& [p, i] : id) at[i] = p;
+  auto on_outline = [&](std::uint32_t a, std::uint32_t b) {
+    for (int k = 0; k < 2; ++k)
+      for (double side : {0.0, 1.0})  // GH97 §6's border planes are a penalty: corners may drift a little
+        if (std::abs(at[a][k] - side) < 1e-9 && std::abs(at[b][k] - side) < 1e-9) return true;
+    return false;
+  };
+  std::size_t open = 0;
+  for (const auto& [edge, n] : uses) open += n == 1 && !(square && on_outline(edge.first, edge.second));
+  return open;
+}
+
+const VertexAttribute& attribute(const Mesh& m, AttributeKind kind) {
+  const VertexAttribute* a = m.find_attribute(kind);
+  EXPECT_NE(a, nullptr);
+  return *a;
+}
+
+}  // namespace
+
+TEST(Attributes, UvSeamStaysClosedAndOnItsLine) {
+  const Mesh in = uv_sphere(40, 80);
+  ASSERT_EQ(open_edges_welded(in), 0u);
+  for (Scheme scheme : {Scheme::Passes, Scheme::Greedy}) {
+    SimplifyOptions o;
+    o.scheme = scheme;
+    o.target_ratio = 0.1;
+    const SimplifyResult r = simplify(in, o);
+    SCOPED_TRACE(to_string(scheme));
+    EXPECT_LE(r.mesh.face_count(), in.face_count() / 10 + 2);
+    EXPECT_EQ(open_edges_welded(r.mesh), 0u) << "a crack opened";
+    const VertexAttribute& uv = attribute(r.mesh, AttributeKind::TexCoord);
+    ASSERT_EQ(uv.values.size(), 2 * r.mesh.vertex_count());
+    // The seam's vertices (u = 0 or u = 1 in the input) stay on the seam's plane (y = 0, x >= 0)
+    // with their u; every u stays in the chart.
+    for (std::size_t v = 0; v < r.mesh.vertex_count(); ++v) {
+      const double u = uv.values[2 * v];
+      EXPECT_GE(u, -1e-9);
+      EXPECT_LE(u, 1 + 1e-9);
+      const std::uint32_t s = r.vertex_source[v];
+      const double su = in.attributes[0].values[2 * s];
+      if (su == 0 || su == 1) {
+        EXPECT_EQ(r.mesh.positions[3 * v + 1], 0.0) << "seam vertex " << v << " left the seam";
+        EXPECT_EQ(u, su);
+      }
+    }
+  }
+}
+
+TEST(Attributes, NormalsStayUnitAndWeightsSumToOne) {
+  Mesh in = uv_sphere(30, 60);
+  VertexAttribute weights{"WEIGHTS_0", AttributeKind::JointWeights, 4, {}};
+  VertexAttribute colour{"COLOR_0", AttributeKind::Color, 4, {}};
+  for (std::size_t v = 0; v < in.vertex_count(); ++v) {
+    const double z = in.positions[3 * v + 2];
+    weights.values.insert(weights.values.end(), {0.5 + 0.4 * z, 0.5 - 0.4 * z, 0, 0});
+    colour.values.insert(colour.values.end(), {0.5 + 0.5 * z, 0.2, 1.0, 1.0});
+  }
+  in.attributes.push_back(weights);
+  in.attributes.push_back(colour);
+  SimplifyOptions o;
+  o.target_faces = 300;
+  const SimplifyResult r = simplify(in, o);
+  ASSERT_EQ(r.mesh.attributes.size(), 4u);
+  const VertexAttribute& n = attribute(r.mesh, AttributeKind::Normal);
+  const VertexAttribute& w = attribute(r.mesh, AttributeKind::JointWeights);
+  const VertexAttribute& c = attribute(r.mesh, AttributeKind::Color);
+  for (std::size_t v = 0; v < r.mesh.vertex_count(); ++v) {
+    EXPECT_NEAR(std::hypot(n.values[3 * v], n.values[3 * v + 1], n.values[3 * v + 2]), 1.0, 1e-12);
+    EXPECT_NEAR(w.values[4 * v] + w.values[4 * v + 1] + w.values[4 * v + 2] + w.values[4 * v + 3], 1.0, 1e-12);
+    for (int k = 0; k < 4; ++k) {
+      EXPECT_GE(c.values[4 * v + k], 0.0);
+      EXPECT_LE(c.values[4 * v + k], 1.0);
+    }
+  }
+}
+
+TEST(Attributes, ColourStepDoesNotBleed) {
+  // A flat grid, red left of x = 0.5 and blue right of it, split there into two wedges per
+  // position (a colour boundary): simplified hard, no vertex left of the step turns blue.
+  const int n = 40;
+  Mesh in;
+  VertexAttribute colour{"COLOR_0", AttributeKind::Color, 3, {}};
+  std::map<std::pair<int, int>, std::uint32_t> left, right;
+  auto vertex = [&](int i, int j, bool on_right) {
+    auto& side = on_right ? right : left;
+    auto [it, fresh] = side.try_emplace({i, j}, std::uint32_t(in.vertex_count()));
+    if (fresh) {
+      in.positions.insert(in.positions.end(), {double(i) / n, double(j) / n, 0});
+      colour.values.insert(colour.values.end(), {on_right ? 0.0 : 1.0, 0.0, on_right ? 1.0 : 0.0});
+    }
+    return it->second;
+  };
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const bool on_right = i >= n / 2;
+      const std::uint32_t a = vertex(i, j, on_right), b = vertex(i + 1, j, on_right), c = vertex(i + 1, j + 1, on_right),
+                          d = vertex(i, j + 1, on_right);
+      in.indices.insert(in.indices.end(), {a, b, c, a, c, d});
+    }
+  in.attributes = {colour};
+  SimplifyOptions o;
+  o.target_faces = 16;
+  const SimplifyResult r = simplify(in, o);
+  EXPECT_LE(r.mesh.face_count(), 40u);
+  EXPECT_EQ(open_edges_welded(r.mesh, true), 0u) << "a crack opened along the colour step";
+  const VertexAttribute& c = r.mesh.attributes[0];
+  for (std::size_t f = 0; f < r.mesh.face_count(); ++f) {
+    // Every face is all red or all blue: its corners are on one side of the step.
+    std::set<double> reds;  // rounded: a moved vertex's colour is refitted, equal to rounding
+    for (int k = 0; k < 3; ++k) reds.insert(std::round(c.values[3 * r.mesh.indices[3 * f + k]] * 1e9));
+    EXPECT_EQ(reds.size(), 1u) << "face " << f << " mixes the colours: " << [&] {
+      std::string text;
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t v = r.mesh.indices[3 * f + k];
+        text += "(" + std::to_string(r.mesh.positions[3 * v]) + "," + std::to_string(r.mesh.positions[3 * v + 1]) +
+                " red " + std::to_string(c.values[3 * v]) + ") ";
+      }
+      return text;
+    }();
+  }
+  for (std::size_t v = 0; v < r.mesh.vertex_count(); ++v) {
+    const double x = r.mesh.positions[3 * v], red = c.values[3 * v];
+    if (x < 0.5) {
+      EXPECT_NEAR(red, 1.0, 1e-9) << "vertex " << v << " at x = " << x;
+    } else if (x > 0.5) {
+      EXPECT_NEAR(red, 0.0, 1e-9) << "vertex " << v << " at x = " << x;
+    }
+  }
+}
+
+TEST(Attributes, MaterialsNeverMergeAndTheirBoundaryStays) {
+  Mesh in = test::height_field(30, [](double x, double y) { return 0.05 * std::sin(6 * x) * std::cos(5 * y); });
+  in.attributes.push_back({"NORMAL", AttributeKind::Normal, 3, std::vector<double>(3 * in.vertex_count(), 0)});
+  for (std::size_t v = 0; v < in.vertex_count(); ++v) in.attributes[0].values[3 * v + 2] = 1;
+  // Material by the face's centre: left or right of x = 0.5 (a grid line), vertices shared.
+  for (std::size_t f = 0; f < in.face_count(); ++f) {
+    double cx = 0;
+    for (int k = 0; k < 3; ++k) cx += in.positions[3 * in.indices[3 * f + k]] / 3;
+    in.face_materials.push_back(cx < 0.5 ? 0 : 1);
+  }
+  SimplifyOptions o;
+  o.target_faces = 60;
+  const SimplifyResult r = simplify(in, o);
+  ASSERT_EQ(r.mesh.face_materials.size(), r.mesh.face_count());
+  std::map<std::array<double, 3>, std::set<std::uint32_t>> materials_at;
+  for (std::size_t f = 0; f < r.mesh.face_count(); ++f) {
+    EXPECT_EQ(r.mesh.face_materials[f], in.face_materials[r.face_source[f]]);
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t v = r.mesh.indices[3 * f + k];
+      materials_at[{r.mesh.positions[3 * v], r.mesh.positions[3 * v + 1], r.mesh.positions[3 * v + 2]}].insert(
+          r.mesh.face_materials[f]);
+    }
+  }
+  for (const auto& [p, m] : materials_at)
+    if (m.size() > 1) {
+      EXPECT_EQ(p[0], 0.5) << "a point of both materials left the boundary";
+    }
+}
+
+TEST(Attributes, ProvenanceFollowsTheWedges) {
+  const Mesh in = uv_sphere(20, 40);
+  SimplifyOptions o;
+  o.target_ratio = 0.2;
+  o.map_input_vertices = true;
+  const SimplifyResult r = simplify(in, o);
+  ASSERT_EQ(r.vertex_source.size(), r.mesh.vertex_count());
+  for (std::uint32_t v = 0; v < r.mesh.vertex_count(); ++v) EXPECT_EQ(r.output_vertex_of_input[r.vertex_source[v]], v);
+  for (std::uint32_t f = 0; f < r.mesh.face_count(); ++f)
+    for (int k = 0; k < 3; ++k)
+      EXPECT_EQ(r.output_vertex_of_input[in.indices[3 * std::size_t(r.face_source[f]) + k]], r.mesh.indices[3 * f + k]);
+}
+
+TEST(Attributes, BadAttributeDataIsRefused) {
+  SimplifyOptions to_ten;
+  to_ten.target_faces = 10;
+  Mesh in = uv_sphere(6, 12);
+  in.attributes[0].values[5] = std::nan("");
+  EXPECT_THROW(simplify(in, to_ten), Error);
+  in = uv_sphere(6, 12);
+  in.attributes[1].values.pop_back();
+  EXPECT_THROW(simplify(in, to_ten), Error);
+  in = uv_sphere(6, 12);
+  in.face_materials = {0, 1};
+  EXPECT_THROW(simplify(in, to_ten), Error);
+}
