@@ -24,6 +24,8 @@ const char* format_name(FileFormat f) {
       return "stl";
     case FileFormat::Off:
       return "off";
+    case FileFormat::Gltf:
+      return "gltf";
     case FileFormat::Auto:
       break;
   }
@@ -108,7 +110,8 @@ void print_report(const std::string& path, const LoadReport& r, const Mesh& mesh
   auto yes = [](bool b) { return b ? "yes" : "no"; };
   std::printf("%s\n", path.c_str());
   std::printf("  loaded as              %s%s\n", format_name(r.format),
-              r.format == FileFormat::Ply || r.format == FileFormat::Stl
+              r.format == FileFormat::Gltf ? (r.binary ? " (binary .glb)" : " (JSON .gltf)")
+              : r.format == FileFormat::Ply || r.format == FileFormat::Stl
                   ? (r.binary ? " (binary)" : " (ascii)")
                   : "");
   std::printf("  polygons triangulated  %zu\n", r.polygons_triangulated);
@@ -161,7 +164,8 @@ struct InfoArgs {
 [[maybe_unused]] const bool registered = register_command(40, [](CLI::App& app) {
   auto args = std::make_shared<InfoArgs>();
   CLI::App* sub = app.add_subcommand("info", "Print a mesh's counts and topological defects");
-  sub->add_option("mesh", args->path, "Mesh file (OBJ, PLY, STL or OFF)")->required();
+  sub->add_option("mesh", args->path, "Mesh file (OBJ, PLY, STL, OFF, or glTF .gltf/.glb: the scene merged)")
+      ->required();
   sub->add_flag("--json", args->json, "Print one JSON object on one line instead of the report");
   sub->add_option("--weld", args->weld, "Merge exactly coincident vertices on load: auto (STL only), on, off")
       ->check(CLI::IsMember({"auto", "on", "off"}))

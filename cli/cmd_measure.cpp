@@ -135,7 +135,7 @@ const bool registered = register_command(30, [](CLI::App& app) -> std::function<
       "Approximation error between an original and a simplified mesh: GH97 6.1 E (mean squared distance "
       "over points sampled uniformly by area on both surfaces), RMS, mean and Hausdorff distance; with "
       "attributes, the UV, normal and colour error at the closest points and the cracks opened along seams");
-  cmd->add_option("original", args->original, "The original mesh (OBJ, PLY, STL, OFF)")->required();
+  cmd->add_option("original", args->original, "The original mesh (OBJ, PLY, STL, OFF, glTF)")->required();
   cmd->add_option("approx", args->approx, "The approximation (simplified mesh)")->required();
   cmd->add_option("--samples", o.samples,
                   "Sample points in total, split between the two surfaces in proportion to their areas")

@@ -35,7 +35,7 @@ const bool registered = register_command(81, [](CLI::App& app) -> std::function<
   view::RenderOptions& o = args->options;
   CLI::App* cmd =
       app.add_subcommand("render", "Draw a mesh to a PNG picture (software rasteriser, no browser)");
-  cmd->add_option("mesh", args->input, "Mesh file (OBJ, PLY, STL, OFF)")->required();
+  cmd->add_option("mesh", args->input, "Mesh file (OBJ, PLY, STL, OFF, glTF)")->required();
   cmd->add_option("out", args->output, "Output PNG file")->required();
   cmd->add_option("--width", o.width, "Picture width in pixels")
       ->capture_default_str()

@@ -153,8 +153,8 @@ const bool registered = register_command(80, [](CLI::App& app) -> std::function<
   CLI::App* cmd =
       app.add_subcommand("view", "Show meshes in a local web page (three.js): LOD slider, compare, heat map");
   cmd->add_option("meshes", args->inputs,
-                  "Mesh files (OBJ, PLY, STL, OFF), or one LOD manifest (.json) listing the levels, or one "
-                  "contraction record (`qem simplify --record`): a slider over its face counts")
+                  "Mesh files (OBJ, PLY, STL, OFF, glTF), or one LOD manifest (.json) listing the levels, or "
+                  "one contraction record (`qem simplify --record`): a slider over its face counts")
       ->required();
   cmd->add_flag(
       "--chain", args->chain,

@@ -67,13 +67,14 @@ inline std::vector<double> corner_values(const Mesh& m) {
   return r;
 }
 
-/// Every way a mesh can be written in `format`: text and binary (PLY, STL), and for PLY float and
-/// double values. The fuzzers' round trips and seeds go through all of them.
+/// Every way a mesh can be written in `format`: text and binary (PLY, STL; glTF .gltf and .glb),
+/// and for PLY float and double values. The fuzzers' round trips and seeds go through all of them.
 inline std::vector<SaveOptions> save_variants(FileFormat format) {
   std::vector<SaveOptions> variants;
   for (bool binary : {false, true})
     for (bool double_precision : {false, true}) {
-      if (binary && format != FileFormat::Ply && format != FileFormat::Stl) continue;
+      if (binary && format != FileFormat::Ply && format != FileFormat::Stl && format != FileFormat::Gltf)
+        continue;
       if (double_precision && format != FileFormat::Ply) continue;
       SaveOptions o;
       o.format = format;

@@ -1,5 +1,5 @@
-// libFuzzer target for one mesh reader, chosen at compile time by QEM_FUZZ_FORMAT (Obj, Ply, Stl or
-// Off; fuzz/CMakeLists.txt builds one executable per format). io.h promises that a reader either
+// libFuzzer target for one mesh reader, chosen at compile time by QEM_FUZZ_FORMAT (Obj, Ply, Stl,
+// Off or Gltf; fuzz/CMakeLists.txt builds one executable per format). io.h promises that a reader either
 // returns a valid mesh or throws qem::Error: anything else (another exception, a crash, a sanitizer
 // report, a hang past -timeout) is a finding.
 #include <cstdint>
@@ -13,7 +13,7 @@
 #include "qem/io.h"
 
 #ifndef QEM_FUZZ_FORMAT
-#error "define QEM_FUZZ_FORMAT to Obj, Ply, Stl or Off"
+#error "define QEM_FUZZ_FORMAT to Obj, Ply, Stl, Off or Gltf"
 #endif
 
 namespace {

@@ -4,8 +4,8 @@
 // negative OBJ indices, PLY extra properties, big-endian data and header lines without a keyword,
 // COFF colours...).
 //
-//   OUTDIR/{obj,ply,stl,off,simplify}/seed_*   one file per seed
-//   OUTDIR/{obj,ply,stl,off}.dict              libFuzzer dictionaries (-dict=)
+//   OUTDIR/{obj,ply,stl,off,gltf,simplify}/seed_*   one file per seed
+//   OUTDIR/{obj,ply,stl,off,gltf}.dict              libFuzzer dictionaries (-dict=)
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -117,7 +117,8 @@ void serialised_seeds(const fs::path& out) {
   const Format formats[] = {{qem::FileFormat::Obj, "obj"},
                             {qem::FileFormat::Ply, "ply"},
                             {qem::FileFormat::Stl, "stl"},
-                            {qem::FileFormat::Off, "off"}};
+                            {qem::FileFormat::Off, "off"},
+                            {qem::FileFormat::Gltf, "gltf"}};
   for (const Format& f : formats)
     for (const Named& m : meshes)
       for (const qem::SaveOptions& o : qem::fuzz::save_variants(f.format)) {
@@ -208,6 +209,21 @@ void handwritten_seeds(const fs::path& out) {
              "COFF\n# colours and a quad\n4 2 0\n0 0 0 255 0 0 255\n1 0 0 0 255 0 255\n"
              "1 1 0 0 0 255 255\n0 1 0 9 9 9 255\n3 0 1 2\n4 0 1 2 3 1 0 0\n");
   write_file(out / "off" / "hand_oneline", "OFF 3 1 0\n0 0 0 1 0 0 0 1 0 3 0 1 2\n");
+  // glTF: a cube with a normal, texture coordinates, a colour and two materials, as .gltf and .glb.
+  qem::Mesh m = cube();
+  qem::VertexAttribute n{"NORMAL", qem::AttributeKind::Normal, 3, {}},
+      uv{"TEXCOORD_0", qem::AttributeKind::TexCoord, 2, {}}, c{"COLOR_0", qem::AttributeKind::Color, 4, {}};
+  for (std::size_t v = 0; v < m.vertex_count(); ++v) {
+    n.values.insert(n.values.end(), {0, 0, 1});
+    uv.values.insert(uv.values.end(), {m.positions[3 * v], m.positions[3 * v + 1]});
+    c.values.insert(c.values.end(), {1, 0.5, 0, 1});
+  }
+  m.attributes = {n, uv, c};
+  m.face_materials.assign(m.face_count(), 0);
+  m.face_materials[0] = 1;
+  m.material_names = {"a", "b"};
+  write_file(out / "gltf" / "hand_attributes.gltf", qem::serialize_mesh(m, qem::FileFormat::Gltf, false));
+  write_file(out / "gltf" / "hand_attributes.glb", qem::serialize_mesh(m, qem::FileFormat::Gltf, true));
 }
 
 void simplify_seeds(const fs::path& out) {
@@ -229,6 +245,31 @@ void dictionaries(const fs::path& out) {
     for (std::size_t i = 0; i < words.size(); ++i) s += "kw" + std::to_string(i) + "=\"" + words[i] + "\"\n";
     write_file(out / name, s);
   };
+  dict("gltf.dict", {"glTF",
+                     "JSON",
+                     "BIN\\x00",
+                     "\\\"accessors\\\"",
+                     "\\\"bufferViews\\\"",
+                     "\\\"buffers\\\"",
+                     "\\\"byteOffset\\\"",
+                     "\\\"byteStride\\\"",
+                     "\\\"count\\\"",
+                     "\\\"sparse\\\"",
+                     "\\\"indices\\\"",
+                     "\\\"componentType\\\"",
+                     "5121",
+                     "5123",
+                     "5125",
+                     "5126",
+                     "\\\"normalized\\\"",
+                     "\\\"mode\\\"",
+                     "\\\"targets\\\"",
+                     "\\\"nodes\\\"",
+                     "\\\"children\\\"",
+                     "\\\"matrix\\\"",
+                     "\\\"VEC3\\\"",
+                     "\\\"SCALAR\\\"",
+                     "data:application/octet-stream;base64,"});
   dict("obj.dict", {"v ", "vt ", "vn ", "f ", "/", "//", "-1", "#", "\\\\\\x0a", "g ", "o ", "usemtl ",
                     "mtllib ", "1e308", "nan", "inf", "\\x0d\\x0a", "/1/", "/-1"});
   dict("ply.dict", {"ply\\x0a",
@@ -283,7 +324,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path out = argv[1];
-  for (const char* dir : {"obj", "ply", "stl", "off", "simplify"}) fs::create_directories(out / dir);
+  for (const char* dir : {"obj", "ply", "stl", "off", "gltf", "simplify"}) fs::create_directories(out / dir);
   serialised_seeds(out);
   handwritten_seeds(out);
   simplify_seeds(out);

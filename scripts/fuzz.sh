@@ -2,7 +2,7 @@
 # Builds the libFuzzer targets with clang (build-fuzz/, QEM_FUZZ=ON), writes the seed corpora, and
 # runs each fuzzer for a bounded time. Usage: scripts/fuzz.sh [SECONDS_PER_FUZZER] (default 60).
 # Environment: JOBS (build parallelism), FUZZ_BUILD_DIR (default build-fuzz), FUZZERS (default
-# "obj ply stl off simplify").
+# "obj ply stl off gltf simplify").
 # Prints, per fuzzer, the executions reached (libFuzzer's final stat::number_of_executed_units).
 # Exits non-zero when any fuzzer finds a crash, leak, timeout or out-of-memory input; the input is
 # kept in $FUZZ_BUILD_DIR/fuzz/findings/<fuzzer>/ and the log beside it. Replay one with
@@ -13,7 +13,7 @@ cd "$(dirname "$0")/.."
 SECONDS_EACH=${1:-60}
 JOBS=${JOBS:-$(nproc)}
 BUILD=${FUZZ_BUILD_DIR:-build-fuzz}
-FUZZERS=${FUZZERS:-"obj ply stl off simplify"}
+FUZZERS=${FUZZERS:-"obj ply stl off gltf simplify"}
 
 CC=${CC:-clang} CXX=${CXX:-clang++} cmake -S . -B "$BUILD" -DQEM_FUZZ=ON -DQEM_BUILD_TESTS=OFF \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null

@@ -1,4 +1,5 @@
-// Reading and writing meshes: OBJ, PLY (ASCII, binary little/big endian), STL (ASCII, binary), OFF.
+// Reading and writing meshes: OBJ, PLY (ASCII, binary little/big endian), STL (ASCII, binary), OFF,
+// glTF 2.0 (.gltf, .glb: the whole scene merged into one mesh; qem/gltf.h keeps the document).
 // Readers triangulate polygons (fan), validate everything (indices, counts, finite coordinates)
 // and throw qem::Error naming the file and the line or element. Writers write to a temporary file
 // beside the target and rename it, so a failed run never leaves a half-written mesh.
@@ -14,7 +15,11 @@
 
 namespace qem {
 
-enum class FileFormat { Auto, Obj, Ply, Stl, Off };
+/// Gltf: .gltf or .glb. load_mesh merges every triangle primitive of the default scene into one
+/// Mesh in world space (GltfDocument::scene_mesh); save_mesh writes a minimal glTF, .glb or .gltf
+/// by extension (serialize_gltf; `binary` chooses for serialize_mesh). Keeping the rest of a glTF
+/// file needs qem/gltf.h.
+enum class FileFormat { Auto, Obj, Ply, Stl, Off, Gltf };
 
 /// The format named by a path's extension (case-insensitive), or Auto if unknown.
 FileFormat format_from_extension(const std::string& path);
@@ -54,7 +59,7 @@ Mesh parse_mesh(std::string_view bytes, FileFormat format, const std::string& na
 
 struct SaveOptions {
   FileFormat format = FileFormat::Auto;  ///< Auto: by extension
-  bool binary = true;                    ///< PLY and STL: binary (little endian) or ASCII
+  bool binary = true;                    ///< PLY, STL: binary (little endian) or ASCII; glTF: .glb
   bool double_precision = false;         ///< PLY: write double coordinates/properties instead of float
 };
 

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "io/io_common.h"
+#include "qem/gltf.h"
 #include "qem/io.h"
 
 namespace qem {
@@ -44,6 +45,7 @@ std::string_view first_word(std::string_view bytes) {
 
 /// Recognises a format by its content, or returns Auto.
 FileFormat sniff(std::string_view bytes) {
+  if (bytes.substr(0, 4) == "glTF") return FileFormat::Gltf;
   if (bytes.size() >= 4 && bytes.substr(0, 3) == "ply" && (bytes[3] == '\n' || bytes[3] == '\r'))
     return FileFormat::Ply;
   if (io::stl_is_binary(bytes)) return FileFormat::Stl;
@@ -53,7 +55,16 @@ FileFormat sniff(std::string_view bytes) {
   static constexpr std::string_view kObj[] = {"v", "vt", "vn",     "vp",     "f", "o",
                                               "g", "s",  "usemtl", "mtllib", "l", "p"};
   if (std::find(std::begin(kObj), std::end(kObj), w) != std::end(kObj)) return FileFormat::Obj;
+  // A glTF JSON document opens with '{' (no other format here does).
+  if (!w.empty() && w[0] == '{') return FileFormat::Gltf;
   return FileFormat::Auto;
+}
+
+Mesh gltf_scene(const GltfDocument& doc, std::string_view bytes, LoadReport& report) {
+  report.format = FileFormat::Gltf;
+  report.binary = bytes.substr(0, 4) == "glTF";
+  report.warnings = doc.notes();
+  return doc.scene_mesh();
 }
 
 Mesh dispatch(std::string_view bytes, FileFormat format, const std::string& name, const LoadOptions& options,
@@ -62,7 +73,7 @@ Mesh dispatch(std::string_view bytes, FileFormat format, const std::string& name
   if (format == FileFormat::Auto) {
     format = sniff(bytes);
     if (format == FileFormat::Auto)
-      io::fail(name, "unknown mesh format (content is not OBJ, PLY, STL or OFF)");
+      io::fail(name, "unknown mesh format (content is not OBJ, PLY, STL, OFF or glTF)");
   }
   try {
     switch (format) {
@@ -74,6 +85,9 @@ Mesh dispatch(std::string_view bytes, FileFormat format, const std::string& name
         return io::parse_stl(bytes, name, options, report);
       case FileFormat::Off:
         return io::parse_off(bytes, name, options, report);
+      case FileFormat::Gltf:
+        // From memory: buffers must be embedded (no file beside `name` is read).
+        return gltf_scene(GltfDocument::parse(bytes, name), bytes, report);
       case FileFormat::Auto:
         break;
     }
@@ -93,6 +107,7 @@ FileFormat format_from_extension(const std::string& path) {
   if (e == "ply") return FileFormat::Ply;
   if (e == "stl") return FileFormat::Stl;
   if (e == "off") return FileFormat::Off;
+  if (e == "gltf" || e == "glb") return FileFormat::Gltf;
   return FileFormat::Auto;
 }
 
@@ -115,7 +130,21 @@ Mesh load_mesh(const std::string& path, const LoadOptions& options, LoadReport* 
     std::string ext = extension_of(path);
     io::fail(path, "unknown mesh format (" +
                        (ext.empty() ? std::string("no extension") : "extension '." + ext + "'") +
-                       ", and the content is not OBJ, PLY, STL or OFF)");
+                       ", and the content is not OBJ, PLY, STL, OFF or glTF)");
+  }
+  if (format == FileFormat::Gltf || (format == FileFormat::Auto && sniff(bytes) == FileFormat::Gltf)) {
+    // From a file: a .gltf's buffers may be files beside it.
+    LoadReport local;
+    LoadReport& r = report ? *report : local;
+    r = LoadReport{};
+    Mesh mesh;
+    try {
+      mesh = gltf_scene(GltfDocument::load(path), bytes, r);
+    } catch (const std::bad_alloc&) {
+      io::fail(path, "out of memory while reading");
+    }
+    if (options.weld == Weld::On) r.vertices_welded = weld_exact(mesh);
+    return mesh;
   }
   return parse_mesh(bytes, format, path, options, report);
 }
@@ -131,6 +160,8 @@ std::string serialize_mesh(const Mesh& mesh, const SaveOptions& options) {
       return io::write_stl(mesh, options.binary);
     case FileFormat::Off:
       return io::write_off(mesh);
+    case FileFormat::Gltf:
+      return serialize_gltf(mesh, options.binary);
     case FileFormat::Auto:
       break;
   }
@@ -148,7 +179,10 @@ void save_mesh(const std::string& path, const Mesh& mesh, const SaveOptions& opt
   SaveOptions o = options;
   if (o.format == FileFormat::Auto) o.format = format_from_extension(path);
   if (o.format == FileFormat::Auto)
-    throw Error(path + ": cannot tell the output format from the extension (use .obj, .ply, .stl or .off)");
+    throw Error(
+        path +
+        ": cannot tell the output format from the extension (use .obj, .ply, .stl, .off, .glb or .gltf)");
+  if (o.format == FileFormat::Gltf) o.binary = extension_of(path) != "gltf";
   std::string bytes;
   try {
     bytes = serialize_mesh(mesh, o);
