@@ -692,7 +692,8 @@ TEST(IoSharedData, EveryMeshLoadsWithTheCatalogueCounts) {
         // The catalogue counts each glTF mesh once; the scene may place one several times
         // (CesiumMilkTruck's two wheel nodes share one mesh).
         vertices = faces = 0;
-        for (const qem::GltfPrimitiveInfo& prim : qem::GltfDocument::load(p.string()).primitives())
+        const qem::GltfDocument document = qem::GltfDocument::load(p.string());  // outlives the loop
+        for (const qem::GltfPrimitiveInfo& prim : document.primitives())
           vertices += static_cast<long>(prim.vertex_count), faces += static_cast<long>(prim.face_count);
       }
       EXPECT_EQ(vertices, it->second.first);
