@@ -14,6 +14,7 @@
 #include "qem/mesh_info.h"
 #include "qem/progressive.h"
 #include "qem/refit.h"
+#include "refit/refit_after_simplify.h"
 
 namespace qem::python {
 namespace {
@@ -138,12 +139,7 @@ py::list lod(py::handle vertices, py::handle faces, SimplifyOptions options, con
     if (n == 0) throw py::value_error("target_faces: every face count must be positive");
   Positions p = positions_from(vertices, "vertices");
   Indices f = indices_from(faces, "faces", p.data.size() / 3);
-  RefitOptions refit;
-  refit.rounds = options.refit_rounds;
-  refit.points_per_vertex = options.refit_points_per_vertex;
-  refit.lock_border = options.lock_border;
-  refit.max_normal_turn_degrees = options.max_normal_turn_degrees;
-  refit.threads = options.threads;
+  const RefitOptions refit = refit_options_for(options);  // as simplify would refit
   options.refit_rounds = 0;
   if (!faces_targets.empty())
     options.target_faces = *std::min_element(faces_targets.begin(), faces_targets.end());
