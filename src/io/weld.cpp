@@ -38,6 +38,28 @@ std::vector<std::uint32_t> wedge_remap(const Mesh& mesh, std::vector<std::uint32
   return remap;
 }
 
+// Keeps vertex first[n] as vertex n (first[] increasing, so compacting in place never overwrites a
+// value still to be read) in every per-vertex array, and renames the faces through remap.
+std::size_t compact_vertices(Mesh& mesh, const std::vector<std::uint32_t>& first, const std::vector<std::uint32_t>& remap,
+                             std::size_t nv) {
+  const std::size_t kept = first.size();
+  for (VertexAttribute& a : mesh.attributes) {
+    if (a.values.size() != std::size_t{a.components} * nv) continue;
+    for (std::size_t n = 0; n < kept; ++n)
+      std::memmove(&a.values[a.components * n], &a.values[a.components * std::size_t{first[n]}],
+                   a.components * sizeof(double));
+    a.values.resize(a.components * kept);
+  }
+  for (VertexProperty& p : mesh.vertex_properties) {
+    if (p.values.size() != nv) continue;
+    for (std::size_t n = 0; n < kept; ++n) p.values[n] = p.values[first[n]];
+    p.values.resize(kept);
+  }
+  for (std::uint32_t& i : mesh.indices)
+    if (i < nv) i = remap[i];
+  return nv - kept;
+}
+
 }  // namespace
 
 std::size_t weld_exact(Mesh& mesh) {
@@ -52,21 +74,7 @@ std::size_t weld_exact(Mesh& mesh) {
     for (std::size_t n = 0; n < kept; ++n)
       std::memmove(&mesh.positions[3 * n], &mesh.positions[3 * std::size_t{first[n]}], 3 * sizeof(double));
     mesh.positions.resize(3 * kept);
-    for (VertexAttribute& a : mesh.attributes) {
-      if (a.values.size() != std::size_t{a.components} * nv) continue;
-      for (std::size_t n = 0; n < kept; ++n)
-        std::memmove(&a.values[a.components * n], &a.values[a.components * std::size_t{first[n]}],
-                     a.components * sizeof(double));
-      a.values.resize(a.components * kept);
-    }
-    for (VertexProperty& p : mesh.vertex_properties) {
-      if (p.values.size() != nv) continue;
-      for (std::size_t n = 0; n < kept; ++n) p.values[n] = p.values[first[n]];
-      p.values.resize(kept);
-    }
-    for (std::uint32_t& i : mesh.indices)
-      if (i < nv) i = remap[i];
-    return nv - kept;
+    return compact_vertices(mesh, first, remap, nv);
   }
   std::vector<double> unique;
   unique.reserve(mesh.positions.size());
@@ -88,15 +96,7 @@ std::size_t weld_exact(Mesh& mesh) {
   if (kept == nv) return 0;
   mesh.positions.swap(unique);
   mesh.positions.shrink_to_fit();
-  for (VertexProperty& p : mesh.vertex_properties) {
-    if (p.values.size() != nv) continue;
-    // first[] is increasing, so compacting in place never overwrites a value still to be read.
-    for (std::size_t n = 0; n < kept; ++n) p.values[n] = p.values[first[n]];
-    p.values.resize(kept);
-  }
-  for (std::uint32_t& i : mesh.indices)
-    if (i < nv) i = remap[i];
-  return nv - kept;
+  return compact_vertices(mesh, first, remap, nv);  // no attributes here: properties and faces
 }
 
 }  // namespace qem
