@@ -99,6 +99,88 @@ TEST(ViewScene, NamesThatAreNotUtf8StillGiveValidJson) {
   EXPECT_EQ(json::parse(scene_files(s)["data/scene.json"])["title"], s.title);
 }
 
+// A quad of two faces with normals, UVs, RGBA colours and two materials, one textured.
+ViewLevel appearance_level() {
+  ViewLevel l;
+  l.name = "quad";
+  l.mesh.positions = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+  l.mesh.indices = {0, 1, 2, 0, 2, 3};
+  l.mesh.attributes.push_back({"NORMAL", AttributeKind::Normal, 3, {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}});
+  l.mesh.attributes.push_back({"TEXCOORD_0", AttributeKind::TexCoord, 2, {0, 0, 1, 0, 1, 1, 0, 1}});
+  l.mesh.attributes.push_back({"COLOR_0", AttributeKind::Color, 4, {1, 0, 0, 1, 0, 1, 0, 1, 0, 0, 1, 1, 1, 1, 1, 0.5}});
+  l.mesh.face_materials = {1, 0};
+  l.mesh.material_names = {"plain", "skin"};
+  ViewMaterial plain{"plain", {0.1, 0.2, 0.3}, 0.5, ""}, skin{"skin", {1, 1, 1}, 1, "tex/skin.png"};
+  l.materials = {plain, skin};
+  l.files["tex/skin.png"] = "PNG";
+  return l;
+}
+
+TEST(ViewScene, ExportsNormalsUvsColoursMaterialsAndTextures) {
+  ViewScene s;
+  s.levels.push_back(appearance_level());
+  auto files = scene_files(s);
+  json doc = json::parse(files["data/scene.json"]);
+  EXPECT_EQ(doc["version"], 2);
+  const json& l = doc["levels"][0];
+  EXPECT_EQ(floats(files.at(l["normals"])), (std::vector<float>{0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}));
+  EXPECT_EQ(floats(files.at(l["uvs"])), (std::vector<float>{0, 0, 1, 0, 1, 1, 0, 1}));
+  EXPECT_EQ(l["color_components"], 4);
+  auto colors = floats(files.at(l["colors"]));
+  ASSERT_EQ(colors.size(), 16u);
+  EXPECT_FLOAT_EQ(colors[15], 0.5f);
+  const std::string& mats = files.at(l["face_materials"]);
+  std::vector<std::uint32_t> ids(mats.size() / 4);
+  std::memcpy(ids.data(), mats.data(), mats.size());
+  EXPECT_EQ(ids, (std::vector<std::uint32_t>{1, 0}));
+  ASSERT_EQ(l["materials"].size(), 2u);
+  EXPECT_EQ(l["materials"][0]["name"], "plain");
+  EXPECT_TRUE(l["materials"][0]["texture"].is_null());
+  EXPECT_DOUBLE_EQ(l["materials"][0]["opacity"].get<double>(), 0.5);
+  EXPECT_DOUBLE_EQ(l["materials"][0]["color"][2].get<double>(), 0.3);
+  // The texture is served beside the level's buffers, under the name the model gave it.
+  EXPECT_EQ(l["materials"][1]["texture"], "data/level0/tex/skin.png");
+  EXPECT_EQ(files.at("data/level0/tex/skin.png"), "PNG");
+}
+
+TEST(ViewScene, GltfLevelsPointAtTheDocumentInsteadOfBuffers) {
+  ViewScene s;
+  s.mode = ViewMode::Compare;
+  ViewLevel g;
+  g.name = "man.glb";
+  g.mesh = test::cube();
+  g.gltf = "man.glb";
+  g.files = {{"man.glb", "glTF..."}, {"textures/skin.jpg", "JPEG"}};
+  s.levels.push_back(g);
+  s.levels.push_back({"simplified.obj", test::cube()});
+  auto files = scene_files(s);
+  json doc = json::parse(files["data/scene.json"]);
+  const json& l0 = doc["levels"][0];
+  EXPECT_EQ(l0["gltf"], "data/level0/man.glb");
+  EXPECT_EQ(l0["faces"], 12);
+  EXPECT_FALSE(l0.contains("positions"));
+  EXPECT_FALSE(files.count("data/level0.pos.f32"));
+  EXPECT_EQ(files.at("data/level0/textures/skin.jpg"), "JPEG");
+  EXPECT_TRUE(doc["levels"][1].contains("positions"));  // mixed formats side by side
+  EXPECT_FALSE(doc["levels"][1].contains("gltf"));
+}
+
+TEST(ViewScene, RejectsInconsistentAppearance) {
+  auto fails = [](auto change) {
+    ViewScene s;
+    s.levels.push_back(appearance_level());
+    change(s.levels[0]);
+    EXPECT_THROW(scene_files(s), Error);
+  };
+  fails([](ViewLevel& l) { l.mesh.attributes[1].values.pop_back(); });       // UVs of the wrong size
+  fails([](ViewLevel& l) { l.mesh.face_materials = {0}; });                  // one material for two faces
+  fails([](ViewLevel& l) { l.mesh.face_materials = {0, 2}; });               // a material that does not exist
+  fails([](ViewLevel& l) { l.materials[1].texture = "tex/missing.png"; });   // a texture not among the files
+  fails([](ViewLevel& l) { l.files["../escape.png"] = "x"; });              // a key leading out of the folder
+  fails([](ViewLevel& l) { l.files["/abs.png"] = "x"; });
+  fails([](ViewLevel& l) { l.gltf = "missing.glb"; });
+}
+
 TEST(ViewScene, IsDeterministic) { EXPECT_EQ(scene_files(chain_scene()), scene_files(chain_scene())); }
 
 TEST(ViewScene, RejectsBadScenes) {
