@@ -423,6 +423,40 @@ test('glTF: CesiumMan simplified by `qem simplify --ratio 0.5` keeps its skin an
   } finally { stopQem(s); rmSync(dir, { recursive: true, force: true }); }
 });
 
+test('mixed formats side by side: CesiumMan.glb beside an OBJ simplified from it, in one frame', async (ctx) => {
+  needCesiumMan();
+  const dir = mkdtempSync(join(tmpdir(), 'qem-mixed-'));
+  let s;
+  try {
+    const obj = join(dir, 'half.obj');
+    const r = spawnSync(QEM, ['simplify', CESIUM_MAN, obj, '--ratio', '0.5'], { encoding: 'utf8' });
+    check(r.status === 0, `qem simplify failed: ${r.stderr}`);
+    s = await startQem([CESIUM_MAN, obj]);
+    const page = await openViewer(ctx.browser, s.url);
+    await page.evaluate(() => window.qemViewer.setPlaying(false));
+    // The panel folds away so that it does not cover the left model.
+    await page.locator('#panel-toggle').click();
+    check(!(await page.locator('#stats').isVisible()), 'the panel did not fold');
+    const img = await shot(page, 'mixed-formats');
+    // Both drawn, at the same height and size: the glTF is placed in qem's frame like the OBJ.
+    const rows = (x0, x1) => {
+      let top = H, bottom = -1;
+      for (let y = 0; y < H - 50; ++y)
+        for (let x = x0; x < x1; ++x) {
+          const o = (y * W + x) * 4;
+          if (Math.abs(img.data[o] - 245) + Math.abs(img.data[o + 1] - 245) + Math.abs(img.data[o + 2] - 245) > 24) { top = Math.min(top, y); bottom = y; break; }
+        }
+      return [top, bottom];
+    };
+    const [t0, b0] = rows(0, W / 2), [t1, b1] = rows(W / 2, W);
+    check(b0 > t0 + 100 && b1 > t1 + 100, `a side is empty (rows ${t0}-${b0} and ${t1}-${b1})`);
+    check(Math.abs((t0 + b0) - (t1 + b1)) / 2 < 0.15 * H, `the two sides are not in one frame (rows ${t0}-${b0} and ${t1}-${b1})`);
+    const [glb, flat] = await inspect(page);
+    check(glb.skinned >= 1 && flat.skinned === 0 && flat.meshes === 1, 'the sides are not the glTF and the OBJ');
+    await page.close();
+  } finally { stopQem(s); rmSync(dir, { recursive: true, force: true }); }
+});
+
 async function run() {
   for (const [bin, what] of [[QEM, 'the qem binary (build it first)'], [CHROMIUM, 'Chromium (scripts/install-web-deps.sh)']])
     if (!existsSync(bin)) { console.log(`not ok - ${what} not found at ${bin}`); console.log('0 passed, 1 failed'); process.exit(1); }

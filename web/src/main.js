@@ -428,6 +428,13 @@ function main(scene) {
   $('seams').addEventListener('change', (e) => { state.seams = e.target.checked; update(); });
   $('uv-checker').addEventListener('change', (e) => { state.uvChecker = e.target.checked; update(); });
   $('play').addEventListener('click', () => setPlaying(!anim.playing));
+  // The panel folds to its title, so that it does not hide the left model in compare mode.
+  $('panel-toggle').addEventListener('click', () => {
+    const folded = $('panel').classList.toggle('collapsed');
+    $('panel-toggle').textContent = folded ? '+' : '–';
+    $('panel-toggle').title = folded ? 'Show the panel' : 'Hide the panel';
+    $('panel-toggle').setAttribute('aria-expanded', String(!folded));
+  });
   $('clip').addEventListener('change', (e) => { anim.clip = e.target.value; chooseClips(); update(); });
   $('anim-time').addEventListener('input', (e) => { setPlaying(false); anim.time = Number(e.target.value); update(); });
   controls.addEventListener('change', render);
