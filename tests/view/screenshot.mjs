@@ -2,7 +2,7 @@
 // the page in headless Chromium, ticks the given panel toggles, waits for the page to settle and
 // saves a PNG. Usage:
 //   node tests/view/screenshot.mjs OUT.png [--width 900 --height 480] [--check seams,uv-checker]
-//        [--pause] -- MESH...
+//        [--pause] [--fold] -- MESH...     (--fold: fold the panel to its title)
 // Env: QEM (default build/qem), CHROMIUM (default /usr/bin/chromium).
 import { spawn } from 'node:child_process';
 import { mkdtempSync, rmSync } from 'node:fs';
@@ -38,6 +38,7 @@ try {
   const error = await page.evaluate(() => window.qemViewer.error);
   if (error) throw new Error(error);
   for (const id of toggles) await page.locator(`#${id}`).check();
+  if (opts.includes('--fold')) await page.locator('#panel-toggle').click();
   if (opts.includes('--pause')) await page.evaluate(() => window.qemViewer.setPlaying(false));
   await page.waitForTimeout(500);
   await page.screenshot({ path: argv[0] });
