@@ -1,8 +1,9 @@
 // Writes the viewer test's meshes into a folder: an icosphere at three subdivision levels (an LOD
 // chain, finest first), a manifest listing them, an ASCII PLY with a per-vertex `distance`
 // property (for the heat map), a textured OBJ (UV sphere, .mtl, a red|blue PNG texture in a
-// subfolder, a plain green material, and a material whose texture lies outside the folder) and a
-// vertex-coloured PLY (red above the equator, blue below). Usage: node make_meshes.mjs OUT_DIR
+// subfolder, a plain green material, and a material whose texture lies outside the folder), a
+// vertex-coloured PLY (red above the equator, blue below), and an OBJ whose texture is not an
+// image. Usage: node make_meshes.mjs OUT_DIR
 import { mkdirSync, writeFileSync } from 'node:fs';
 import { join } from 'node:path';
 import { encodePng } from './png.mjs';
@@ -83,6 +84,10 @@ writeFileSync(join(out, 'sphere_distance.ply'), ply);
   mkdirSync(join(out, 'tex'), { recursive: true });
   writeFileSync(join(out, 'tex', 'red blue.png'), encodePng(64, 64, (x) => (x < 32 ? [230, 20, 20] : [20, 40, 230])));
   writeFileSync(join(out, '..', 'outside.png'), encodePng(4, 4, () => [255, 255, 0]));
+  // A texture the browser cannot decode: the page draws the material plain and says so.
+  writeFileSync(join(out, 'broken.obj'), 'mtllib broken.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl b\nf 1/1 2/2 3/3\n');
+  writeFileSync(join(out, 'broken.mtl'), 'newmtl b\nKd 1 1 1\nmap_Kd broken.png\n');
+  writeFileSync(join(out, 'broken.png'), 'this is not an image');
 }
 // Vertex colours: red above the equator, blue below (PLY uchar red/green/blue).
 {
@@ -93,4 +98,4 @@ writeFileSync(join(out, 'sphere_distance.ply'), ply);
     `element face ${f.length}`, 'property list uchar int vertex_indices', 'end_header',
     ...v.map((p) => `${p.join(' ')} ${col(p)}`), ...f.map((t) => `3 ${t.join(' ')}`)].join('\n') + '\n');
 }
-console.log(`wrote ${levels.length + 8} files to ${out}`);
+console.log(`wrote ${levels.length + 11} files to ${out}`);

@@ -327,6 +327,19 @@ test('textured OBJ: map_Kd texture and Kd colours are drawn, only files inside i
   } finally { stopQem(s); }
 });
 
+test('a texture the browser cannot decode: the model is drawn plain and the panel says why', async (ctx) => {
+  const s = await startQem(['broken.obj']);
+  try {
+    const page = await openViewer(ctx.browser, s.url);
+    check(await page.locator('#notes').isVisible(), 'no note in the panel');
+    const note = await text(page, 'notes');
+    check(note.includes('broken.png') && note.includes('could not be loaded'), `note: ${note}`);
+    const st = canvasStats(await shot(page, 'broken-texture'));
+    check(st.foreground > 1000, 'the model is not drawn');
+    await page.close();
+  } finally { stopQem(s); }
+});
+
 test('vertex colours: a coloured PLY is drawn in its colours', async (ctx) => {
   const s = await startQem(['vcolor.ply']);
   try {

@@ -455,6 +455,11 @@ function main(scene) {
     };
   });
   viewer.setPlaying = setPlaying;
+  // What could not be shown (a texture the browser cannot decode) is said, not hidden.
+  if (viewer.warnings.length) {
+    $('notes').hidden = false;
+    for (const w of viewer.warnings) $('notes').appendChild(Object.assign(document.createElement('li'), { textContent: w }));
+  }
   update();
   setPlaying(clipNames.length > 0);
   viewer.ready = true;
