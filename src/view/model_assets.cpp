@@ -2,6 +2,7 @@
 #include "view/model_assets.h"
 
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -54,7 +55,7 @@ std::string add_reference(ViewLevel& level, const fs::path& folder, const fs::pa
 void add_obj_materials(ViewLevel& level, const fs::path& folder, const std::string& model,
                        std::vector<std::string>* warnings) {
   const Mesh& m = level.mesh;
-  if (m.material_library.empty() && m.material_names.empty()) return;
+  if (m.material_library.empty()) return;
   std::vector<MtlMaterial> library;
   fs::path library_dir;
   if (!m.material_library.empty()) {
@@ -65,13 +66,15 @@ void add_obj_materials(ViewLevel& level, const fs::path& folder, const std::stri
       std::string one;
       if (names >> one) found = resolve_inside(folder, one, nullptr);
     }
-    if (found) {
-      library = parse_mtl(read_file(found->file), found->file.filename().string(), warnings);
-      library_dir = fs::path(found->key).parent_path();
-    } else if (warnings) {
-      warnings->push_back(model + ": material library '" + m.material_library + "' not shown: " + why);
+    if (!found) {
+      // Without its library a material is only a name: the page's default look says more.
+      if (warnings) warnings->push_back(model + ": material library '" + m.material_library + "' not shown: " + why);
+      return;
     }
+    library = parse_mtl(read_file(found->file), found->file.filename().string(), warnings);
+    library_dir = fs::path(found->key).parent_path();
   }
+  if (library.empty()) return;
   std::map<std::string, const MtlMaterial*> by_name;
   for (const MtlMaterial& mm : library) by_name.emplace(mm.name, &mm);
   const std::size_t count = std::max<std::size_t>(m.material_names.size(), 1);
@@ -85,11 +88,31 @@ void add_obj_materials(ViewLevel& level, const fs::path& folder, const std::stri
       vm.opacity = mm.opacity;
       if (!mm.diffuse_map.empty())
         vm.texture = add_reference(level, folder, library_dir, mm.diffuse_map, model, "texture", warnings);
-    } else if (!library.empty() && warnings && !vm.name.empty()) {
-      warnings->push_back(model + ": material '" + vm.name + "' is not in its library; shown plain");
+    } else {
+      for (double& c : vm.color) c = MtlMaterial{}.diffuse[0];  // the MTL default grey
+      if (warnings && !vm.name.empty())
+        warnings->push_back(model + ": material '" + vm.name + "' is not in its library; shown plain");
     }
     level.materials.push_back(std::move(vm));
   }
+}
+
+// PLY face colours, which the reader keeps as materials named "rgb(R,G,B)" (bytes): drawn as
+// their colours. Nothing when any material is named otherwise.
+void add_face_colours(ViewLevel& level) {
+  std::vector<ViewMaterial> out;
+  for (const std::string& name : level.mesh.material_names) {
+    unsigned rgb[3];
+    int used = 0;
+    if (std::sscanf(name.c_str(), "rgb(%u,%u,%u)%n", &rgb[0], &rgb[1], &rgb[2], &used) != 3 ||
+        static_cast<std::size_t>(used) != name.size() || rgb[0] > 255 || rgb[1] > 255 || rgb[2] > 255)
+      return;
+    ViewMaterial vm;
+    vm.name = name;
+    for (int k = 0; k < 3; ++k) vm.color[k] = rgb[k] / 255.0;
+    out.push_back(std::move(vm));
+  }
+  level.materials = std::move(out);
 }
 
 }  // namespace
@@ -133,6 +156,8 @@ ViewLevel load_view_level(const std::string& path, const LoadOptions& options, s
       add_reference(level, folder, fs::path(), percent_decode(uri), path, "glTF resource", warnings);
   } else if (report.format == FileFormat::Obj && options.read_attributes) {
     add_obj_materials(level, folder, path, warnings);
+  } else if (report.format == FileFormat::Ply && options.read_attributes) {
+    add_face_colours(level);
   }
   return level;
 }

@@ -15,6 +15,7 @@ namespace qem::view {
 /// The level for the model at `path`: its mesh (load_mesh with `options`), and
 ///  - for OBJ with `mtllib`: one ViewMaterial per material name, with the .mtl's Kd, d and map_Kd
 ///    (textures resolved relative to the .mtl, as the MTL format says);
+///  - for PLY with face colours (materials named "rgb(R,G,B)"): one ViewMaterial per colour;
 ///  - for glTF (.gltf/.glb): the document's bytes as `gltf`, with every buffer and image that it
 ///    references by a relative URI.
 /// A reference that is missing or lies outside the model's folder is skipped with a note in

@@ -107,6 +107,7 @@ TEST(ViewModelAssets, ObjGetsItsMaterialsAndOnlyTexturesInsideItsFolder) {
   EXPECT_EQ(level.materials[0].texture, "tex/a b.png");
   EXPECT_DOUBLE_EQ(level.materials[0].color[1], 0);
   EXPECT_EQ(level.materials[1].texture, "");  // refused, not served
+  EXPECT_DOUBLE_EQ(level.materials[2].color[0], 0.8);  // not in the library: the MTL default
   EXPECT_EQ(level.files.size(), 1u);
   EXPECT_EQ(level.files.at("tex/a b.png"), "PNG bytes");
   ASSERT_EQ(warnings.size(), 2u);
@@ -121,10 +122,24 @@ TEST(ViewModelAssets, MissingLibraryIsAWarningNotAnError) {
   write(f.model / "m.obj", "mtllib nowhere.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n");
   std::vector<std::string> warnings;
   ViewLevel level = load_view_level((f.model / "m.obj").string(), {}, &warnings);
-  ASSERT_EQ(level.materials.size(), 1u);
+  EXPECT_TRUE(level.materials.empty());  // the page's default look, not white
   EXPECT_TRUE(level.files.empty());
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_NE(warnings[0].find("material library 'nowhere.mtl' not shown: no such file"), std::string::npos);
+}
+
+TEST(ViewModelAssets, PlyFaceColoursBecomeMaterials) {
+  Folders f;
+  write(f.model / "c.ply",
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+        "element face 2\nproperty list uchar int vertex_indices\nproperty uchar red\nproperty uchar green\n"
+        "property uchar blue\nend_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2 255 0 0\n3 0 2 3 0 0 255\n");
+  ViewLevel level = load_view_level((f.model / "c.ply").string(), {}, nullptr);
+  ASSERT_EQ(level.materials.size(), 2u);
+  EXPECT_DOUBLE_EQ(level.materials[0].color[0], 1);
+  EXPECT_DOUBLE_EQ(level.materials[0].color[2], 0);
+  EXPECT_DOUBLE_EQ(level.materials[1].color[2], 1);
+  EXPECT_EQ(level.mesh.face_materials, (std::vector<std::uint32_t>{0, 1}));
 }
 
 TEST(ViewModelAssets, GltfKeepsTheDocumentAndItsRelativeResources) {
