@@ -18,6 +18,8 @@
 #include "command.h"
 #include "io/io_common.h"
 #include "qem/error.h"
+#include "qem/gltf.h"
+#include "qem/gltf_simplify.h"
 #include "qem/io.h"
 #include "qem/progressive.h"
 #include "qem/refit.h"
@@ -28,13 +30,76 @@ namespace qem::cli {
 namespace {
 
 struct LodArgs {
-  std::string input, outdir, format = "ply", name;
+  std::string input, outdir, format, name;  // format "": ply, or glb for a glTF input
   std::vector<double> ratios;
   std::vector<std::size_t> faces;
   AlgorithmArgs algorithm;
   bool ascii = false, json = false, quiet = false;
   bool double_values = false;  // --double
+  bool per_mesh = false;       // --per-mesh (glTF documents)
 };
+
+/// A glTF input written as glTF: one whole document per level (each a .glb / .gltf that any viewer
+/// opens, with the materials, textures, nodes, skins and animations of the input), rather than one
+/// file with MSFT_lod, which few loaders read and which ties every level to one download. Each
+/// level is simplify_document on a fresh copy of the input, so each file is what `qem simplify
+/// INPUT FILE --faces <level target>` writes (ratios are of the simplifiable primitives' faces).
+int run_lod_gltf(const LodArgs& a, const SimplifyOptions& opt) {
+  namespace fs = std::filesystem;
+  Stopwatch total;
+  const double cpu_start = process_cpu_seconds();
+  const GltfDocument input = GltfDocument::load(a.input);  // read once: a bad file fails before any level
+  std::size_t base_faces = 0, base_vertices = 0;
+  for (const GltfPrimitiveInfo& p : input.primitives())
+    if (p.simplifiable) base_faces += p.face_count, base_vertices += p.vertex_count;
+  std::vector<std::size_t> targets = a.faces;
+  for (double r : a.ratios) targets.push_back(std::size_t(std::floor(r * double(base_faces))));
+  std::sort(targets.begin(), targets.end(), std::greater<>());  // finest first, as the manifest lists them
+  targets.erase(std::unique(targets.begin(), targets.end()), targets.end());
+  const std::string bytes = input.serialize(true);  // each level starts from a copy of the document
+  std::error_code ec;
+  fs::create_directories(a.outdir, ec);
+  if (ec) throw Error(a.outdir + ": cannot create the folder: " + ec.message());
+  const std::string stem = a.name.empty() ? fs::path(a.input).stem().string() : a.name;
+  GltfSimplifyOptions gltf_options;
+  gltf_options.per_primitive = a.per_mesh;
+  gltf_options.threads = a.algorithm.threads;
+  std::string manifest = "{\n  \"generator\": \"qem lod\",\n  \"source\": " +
+                         json_string(fs::path(a.input).filename().string()) +
+                         ",\n  \"input_faces\": " + std::to_string(base_faces) +
+                         ",\n  \"input_vertices\": " + std::to_string(base_vertices) + ",\n  \"levels\": [\n";
+  for (std::size_t i = 0; i < targets.size(); ++i) {
+    GltfDocument doc = GltfDocument::parse(bytes, a.input);
+    SimplifyOptions level = opt;
+    level.target_ratio = 0, level.target_faces = std::max<std::size_t>(1, targets[i]);
+    const GltfSimplifyReport r = simplify_document(doc, level, gltf_options);
+    const std::string file = stem + "_lod" + std::to_string(i) + "." + a.format;
+    doc.save((fs::path(a.outdir) / file).string());
+    std::size_t vertices = 0;
+    for (const GltfPrimitiveInfo& p : doc.primitives()) vertices += p.vertex_count;
+    manifest += "    {\"path\": " + json_string(file) + ", \"faces\": " + std::to_string(r.faces_out) +
+                ", \"vertices\": " + std::to_string(vertices) + ", \"error\": " + json_number(r.max_world_error) +
+                ", \"target_faces\": " + std::to_string(targets[i]) + ", \"primitives_simplified\": " +
+                std::to_string(r.simplified) + "}" + (i + 1 < targets.size() ? ",\n" : "\n");
+    if (!a.quiet)
+      std::fprintf(stderr, "qem: level %zu faces (%zu primitives simplified), max error %.4g in world units\n",
+                   r.faces_out, r.simplified, r.max_world_error);
+  }
+  manifest += "  ]\n}\n";
+  io::write_file_atomic((fs::path(a.outdir) / "manifest.json").string(), manifest);
+  for (const std::string& n : input.notes()) std::fprintf(stderr, "qem: note: %s\n", n.c_str());
+  if (a.json)
+    std::printf("{\"tool\":\"qem lod\",\"format\":\"gltf\",\"in_faces\":%zu,\"levels\":%zu,\"cpu_s\":%s,"
+                "\"total_s\":%s,\"peak_rss_mb\":%s}\n",
+                base_faces, targets.size(), json_number(process_cpu_seconds() - cpu_start).c_str(),
+                json_number(total.seconds()).c_str(), json_number(peak_rss_mb()).c_str());
+  if (!a.quiet)
+    std::fprintf(stderr, "qem: %zu glTF levels, each a whole document, %.3f s total\n", targets.size(),
+                 total.seconds());
+  return 0;
+}
+
+int run_lod_mesh(const LodArgs& a);
 
 int run_lod(const LodArgs& a) {
   if (a.ratios.empty() == a.faces.empty()) throw Error("give the levels with either --ratios or --faces");
@@ -42,6 +107,24 @@ int run_lod(const LodArgs& a) {
     if (!(r > 0 && r <= 1)) throw Error("--ratios: every ratio must be in (0, 1], got " + json_number(r));
   for (std::size_t f : a.faces)
     if (f == 0) throw Error("--faces: every face count must be positive");
+  const bool gltf_input = format_from_extension(a.input) == FileFormat::Gltf;
+  LodArgs args = a;
+  if (args.format.empty()) args.format = gltf_input ? "glb" : "ply";
+  const bool gltf_levels = args.format == "glb" || args.format == "gltf";
+  if (gltf_levels && !gltf_input)
+    throw Error("--format " + args.format + ": glTF levels are made from a glTF input (.glb / .gltf), whose "
+                "document they keep; give --format ply, obj, stl or off for this input");
+  if (a.per_mesh && !gltf_levels) throw Error("--per-mesh applies to glTF levels (a .glb / .gltf input)");
+  if (gltf_levels) {
+    SimplifyOptions opt = to_simplify_options(a.algorithm);
+    opt.target_faces = 1;
+    check_options(opt);
+    return run_lod_gltf(args, opt);
+  }
+  return run_lod_mesh(args);
+}
+
+int run_lod_mesh(const LodArgs& a) {
   Stopwatch total;
   const double cpu_start = process_cpu_seconds();
 
@@ -143,7 +226,7 @@ const bool registered = register_command(13, [](CLI::App& app) {
   auto args = std::make_shared<LodArgs>();
   CLI::App* sub = app.add_subcommand(
       "lod", "Write an LOD chain from a single recorded simplification, with a manifest for `qem view`");
-  sub->add_option("input", args->input, "Input mesh (.obj .ply .stl .off)")->required();
+  sub->add_option("input", args->input, "Input mesh (.obj .ply .stl .off .glb .gltf)")->required();
   sub->add_option("outdir", args->outdir, "Folder for the levels and manifest.json (created if needed)")
       ->required();
   auto* ratios =
@@ -153,12 +236,16 @@ const bool registered = register_command(13, [](CLI::App& app) {
   sub->add_option("--faces,-f", args->faces, "Levels as face counts, comma separated (e.g. 50000,10000,1000)")
       ->delimiter(',')
       ->excludes(ratios);
-  sub->add_option("--format", args->format, "File format of the levels")
-      ->check(CLI::IsMember({"ply", "obj", "stl", "off"}))
-      ->capture_default_str();
+  sub->add_option("--format", args->format,
+                  "File format of the levels (default: glb for a .glb / .gltf input, ply otherwise). glTF "
+                  "levels are whole documents, one file per level, each with the input's materials, "
+                  "textures, nodes, skins and animations (docs/attributes.md)")
+      ->check(CLI::IsMember({"ply", "obj", "stl", "off", "glb", "gltf"}));
   sub->add_option("--name", args->name,
                   "File name stem of the levels: <name>_lod<i>.<ext> (default: input's stem)");
   add_algorithm_options(sub, args->algorithm);
+  sub->add_flag("--per-mesh", args->per_mesh,
+                "glTF: apply each level's target to every primitive on its own instead of the scene");
   sub->add_flag("--ascii", args->ascii, "Write PLY / STL as text instead of binary");
   sub->add_flag("--double", args->double_values, kDoubleOutputHelp);
   sub->add_flag("--json", args->json, "Print one JSON line with CPU timings and memory on stdout");

@@ -10,6 +10,8 @@
 #include "cli_util.h"
 #include "command.h"
 #include "qem/error.h"
+#include "qem/gltf.h"
+#include "qem/gltf_simplify.h"
 #include "qem/io.h"
 #include "qem/progressive.h"
 #include "qem/simplify.h"
@@ -25,6 +27,7 @@ struct SimplifyArgs {
   AlgorithmArgs algorithm;
   bool ascii = false, json = false, quiet = false, force = false;
   bool double_values = false;  // --double
+  bool per_mesh = false;       // --per-mesh (glTF documents)
   std::string record;  // --record: the contraction sequence (docs/record-format.md)
 };
 
@@ -45,9 +48,55 @@ class Watcher : public ContractionRecorder {
   bool show_progress_, record_;
 };
 
+/// glTF in and out: the document is kept (qem/gltf_simplify.h) and only its primitives change.
+int run_simplify_gltf(const SimplifyArgs& a, const SimplifyOptions& opt) {
+  Stopwatch total;
+  Stopwatch t_load;
+  GltfDocument doc = GltfDocument::load(a.input);
+  const double load_s = t_load.seconds();
+  Stopwatch t_simplify;
+  GltfSimplifyOptions gltf_options;
+  gltf_options.per_primitive = a.per_mesh;
+  gltf_options.threads = a.algorithm.threads;
+  const GltfSimplifyReport r = simplify_document(doc, opt, gltf_options);
+  const double simplify_s = t_simplify.seconds();
+  Stopwatch t_write;
+  doc.save(a.output);
+  const double write_s = t_write.seconds();
+  // What was kept or dropped (morph-target primitives, TANGENT...): about the input, so not
+  // silenced by --quiet, like the readers' warnings.
+  for (const std::string& n : doc.notes()) std::fprintf(stderr, "qem: note: %s\n", n.c_str());
+  std::size_t out_vertices = 0;
+  for (const GltfPrimitiveInfo& p : doc.primitives()) out_vertices += p.vertex_count;
+  if (a.json)
+    std::printf(
+        "{\"tool\":\"qem\",\"format\":\"gltf\",\"per_mesh\":%s,\"primitives\":%zu,\"simplified\":%zu,"
+        "\"unchanged\":%zu,\"kept\":%zu,\"in_faces\":%zu,\"target_faces\":%zu,\"out_faces\":%zu,"
+        "\"out_vertices\":%zu,\"max_error\":%s,\"world_threshold\":%s,\"load_s\":%s,\"simplify_s\":%s,"
+        "\"write_s\":%s,\"total_s\":%s,\"peak_rss_mb\":%s}\n",
+        a.per_mesh ? "true" : "false", r.primitives.size(), r.simplified, r.unchanged, r.kept, r.faces_in,
+        r.target_faces, r.faces_out, out_vertices, json_number(r.max_world_error).c_str(),
+        json_number(r.world_threshold).c_str(), json_number(load_s).c_str(), json_number(simplify_s).c_str(),
+        json_number(write_s).c_str(), json_number(total.seconds()).c_str(), json_number(peak_rss_mb()).c_str());
+  if (!a.quiet)
+    std::fprintf(stderr,
+                 "qem: %zu -> %zu faces in %zu primitives (%zu simplified, %zu needed no change, %zu kept as "
+                 "they were), max error %.4g in world units, %.3f s; the rest of the document is unchanged\n",
+                 r.faces_in, r.faces_out, r.primitives.size(), r.simplified, r.unchanged, r.kept, r.max_world_error,
+                 total.seconds());
+  return 0;
+}
+
 int run_simplify(const SimplifyArgs& a) {
   refuse_to_overwrite(a.input, a.output, a.force);
   SimplifyOptions opt = to_simplify_options(a.algorithm);
+  const bool gltf_document =
+      format_from_extension(a.input) == FileFormat::Gltf && format_from_extension(a.output) == FileFormat::Gltf;
+  if (a.per_mesh && !gltf_document)
+    throw Error("--per-mesh applies to glTF documents (.glb / .gltf in and out): other formats hold one mesh");
+  if (gltf_document && !a.record.empty())
+    throw Error("--record keeps one mesh's contractions, and a glTF document is simplified primitive by "
+                "primitive: simplify without --record, or write a single mesh (e.g. .ply) to record it");
   // A record replays the contractions, and a refit moves every vertex after them, so `qem replay`
   // could not give back what simplify wrote: with --record there is no refit (not the default's).
   if (!a.record.empty() && a.algorithm.refit_asked())
@@ -62,6 +111,7 @@ int run_simplify(const SimplifyArgs& a) {
   if (a.max_error >= 0) opt.max_error = a.max_error;
   if (a.max_error_rel >= 0) opt.max_error = a.max_error_rel, opt.max_error_is_relative = true;
   check_options(opt);  // before the input is read: a slip in the options is said at once
+  if (gltf_document) return run_simplify_gltf(a, opt);
 
   const bool show_progress = !a.quiet && !a.json && ::isatty(STDERR_FILENO);
 
@@ -130,8 +180,14 @@ int run_simplify(const SimplifyArgs& a) {
 const bool registered = register_command(10, [](CLI::App& app) {
   auto args = std::make_shared<SimplifyArgs>();
   CLI::App* sub = app.add_subcommand("simplify", "Simplify a mesh by quadric-error pair contraction (GH97)");
-  sub->add_option("input", args->input, "Input mesh (.obj .ply .stl .off)")->required();
-  sub->add_option("output", args->output, "Output mesh; format by extension (.obj .ply .stl .off)")->required();
+  sub->add_option("input", args->input, "Input mesh (.obj .ply .stl .off .glb .gltf)")->required();
+  sub->add_option("output", args->output,
+                  "Output mesh; format by extension (.obj .ply .stl .off .glb .gltf). glTF to glTF keeps the "
+                  "document: every triangle primitive is simplified with its attributes, and materials, "
+                  "textures, nodes, skins, animations and extensions pass through; the target is the "
+                  "scene's, every primitive stopping at about the same error in world units (--per-mesh: "
+                  "each primitive's). glTF to another format writes the scene merged into one mesh")
+      ->required();
   auto* g = sub->add_option_group("target", "Stop criteria (any combination; the first reached wins)");
   g->add_option("--faces,-f", args->faces, "Stop at or below this many faces");
   g->add_option("--ratio,-r", args->ratio, "Stop at or below this fraction of the input faces");
@@ -145,6 +201,9 @@ const bool registered = register_command(10, [](CLI::App& app) {
   sub->add_flag("--double", args->double_values, kDoubleOutputHelp);
   sub->add_flag("--json", args->json, "Print one JSON line with counts, timings, memory and error on stdout");
   sub->add_flag("--quiet,-q", args->quiet, "No progress and no summary on stderr");
+  sub->add_flag("--per-mesh", args->per_mesh,
+                "glTF: apply the target to each primitive on its own (--ratio 0.5 halves every one) "
+                "instead of sharing one error budget across the scene");
   sub->add_flag("--force", args->force, "Allow the output to overwrite the input file");
   sub->add_option(
       "--record", args->record,

@@ -38,6 +38,12 @@ struct GltfPrimitiveInfo {
   /// targets' per-vertex offsets cannot be kept consistent with new vertices yet).
   bool simplifiable = false;
   std::string why_not;  ///< why it is not simplifiable ("" when it is)
+  /// The largest factor by which the default scene's nodes that place this primitive's mesh scale
+  /// a length (the largest singular value of their world matrix; with a skin, of each joint's
+  /// world matrix times its inverse bind matrix, the bind pose that glTF 2.0 §3.7.3 draws
+  /// instead of the node's transform). 1 when no node places the mesh. A mesh that several nodes
+  /// instance takes the largest: its errors are measured where they are seen the biggest.
+  double world_scale = 1;
 };
 
 /// A loaded glTF file. Movable, not copyable.
