@@ -156,7 +156,8 @@ int run_view(const ViewArgs& a) {
 const bool registered = register_command(80, [](CLI::App& app) -> std::function<int()> {
   auto args = std::make_shared<ViewArgs>();
   CLI::App* cmd =
-      app.add_subcommand("view", "Show meshes in a local web page (three.js): LOD slider, compare, heat map");
+      app.add_subcommand("view", "Show meshes in a local web page (three.js): textures, colours, glTF skins and animations; LOD "
+                        "slider, side by side, seams, heat map");
   cmd->add_option("meshes", args->inputs,
                   "Mesh files (OBJ, PLY, STL, OFF, glTF), or one LOD manifest (.json) listing the levels, or "
                   "one contraction record (`qem simplify --record`): a slider over its face counts")

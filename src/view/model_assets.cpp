@@ -34,12 +34,15 @@ std::uint32_t get_u32(const std::string& b, std::size_t at) {
   return v;
 }
 
-bool is_glb(const std::string& bytes) { return bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0; }
+bool is_glb(const std::string& bytes) {
+  return bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+}
 
 // Adds the file `ref` (relative to `from`, which must lie in `folder`) to the level's files;
 // returns its key, or "" with a warning when it cannot be served.
-std::string add_reference(ViewLevel& level, const fs::path& folder, const fs::path& from, const std::string& ref,
-                          const std::string& model, const char* what, std::vector<std::string>* warnings) {
+std::string add_reference(ViewLevel& level, const fs::path& folder, const fs::path& from,
+                          const std::string& ref, const std::string& model, const char* what,
+                          std::vector<std::string>* warnings) {
   // Resolved against `from`, then expressed relative to the model's folder.
   std::string rel = (from / fs::path(ref)).generic_string();
   std::string why;
@@ -68,7 +71,8 @@ void add_obj_materials(ViewLevel& level, const fs::path& folder, const std::stri
     }
     if (!found) {
       // Without its library a material is only a name: the page's default look says more.
-      if (warnings) warnings->push_back(model + ": material library '" + m.material_library + "' not shown: " + why);
+      if (warnings)
+        warnings->push_back(model + ": material library '" + m.material_library + "' not shown: " + why);
       return;
     }
     library = parse_mtl(read_file(found->file), found->file.filename().string(), warnings);
@@ -140,7 +144,8 @@ std::vector<std::string> gltf_external_uris(const std::string& bytes, const std:
   return out;
 }
 
-ViewLevel load_view_level(const std::string& path, const LoadOptions& options, std::vector<std::string>* warnings) {
+ViewLevel load_view_level(const std::string& path, const LoadOptions& options,
+                          std::vector<std::string>* warnings) {
   ViewLevel level;
   const fs::path file(path);
   const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");

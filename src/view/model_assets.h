@@ -21,7 +21,8 @@ namespace qem::view {
 /// A reference that is missing or lies outside the model's folder is skipped with a note in
 /// `warnings` (the page then shows the model without it). Throws qem::Error when the model itself
 /// cannot be read.
-ViewLevel load_view_level(const std::string& path, const LoadOptions& options, std::vector<std::string>* warnings);
+ViewLevel load_view_level(const std::string& path, const LoadOptions& options,
+                          std::vector<std::string>* warnings);
 
 /// The URIs of a glTF document's buffers and images that name files (not `data:` URIs), as
 /// written; `bytes` is a .gltf (JSON) or a .glb. Throws qem::Error on a malformed document.

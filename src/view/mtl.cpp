@@ -33,8 +33,8 @@ bool parse_number(std::string_view t, double& out) {
 // The texture options of the MTL format (Wavefront's spec, "Texture map options") with how many
 // arguments each takes; -o, -s and -t take one to three numbers.
 int option_arguments(std::string_view opt) {
-  if (opt == "-blendu" || opt == "-blendv" || opt == "-bm" || opt == "-boost" || opt == "-cc" || opt == "-clamp" ||
-      opt == "-imfchan" || opt == "-texres" || opt == "-type")
+  if (opt == "-blendu" || opt == "-blendv" || opt == "-bm" || opt == "-boost" || opt == "-cc" ||
+      opt == "-clamp" || opt == "-imfchan" || opt == "-texres" || opt == "-type")
     return 1;
   if (opt == "-mm") return 2;
   if (opt == "-o" || opt == "-s" || opt == "-t") return 3;
@@ -65,7 +65,8 @@ std::string map_file(std::string_view rest) {
 
 }  // namespace
 
-std::vector<MtlMaterial> parse_mtl(std::string_view text, const std::string& name, std::vector<std::string>* warnings) {
+std::vector<MtlMaterial> parse_mtl(std::string_view text, const std::string& name,
+                                   std::vector<std::string>* warnings) {
   std::vector<MtlMaterial> out;
   std::size_t line_no = 0;
   auto note = [&](const std::string& what) {

@@ -10,7 +10,7 @@
 namespace qem::view {
 
 struct MtlMaterial {
-  std::string name;                    ///< `newmtl`
+  std::string name;                     ///< `newmtl`
   double diffuse[3] = {0.8, 0.8, 0.8};  ///< `Kd`, sRGB (the .mtl default is 0.8 grey in most tools)
   double opacity = 1;                   ///< `d`, or 1 - `Tr`
   std::string diffuse_map;              ///< `map_Kd` file name as written (options removed), "" when none
@@ -18,6 +18,7 @@ struct MtlMaterial {
 
 /// Parses .mtl text. Lenient like the tools that write it: unknown statements and malformed
 /// numbers are skipped (a note goes to `warnings` as "<name>, line N: ..."), never an error.
-std::vector<MtlMaterial> parse_mtl(std::string_view text, const std::string& name, std::vector<std::string>* warnings);
+std::vector<MtlMaterial> parse_mtl(std::string_view text, const std::string& name,
+                                   std::vector<std::string>* warnings);
 
 }  // namespace qem::view

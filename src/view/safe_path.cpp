@@ -32,7 +32,8 @@ std::optional<ResolvedFile> resolve_inside(const fs::path& folder, const std::st
   if (r.empty()) return fail("an empty file name");
   if (r.find('\0') != std::string::npos) return fail("a file name with a NUL byte");
   const fs::path p(r);
-  if (p.is_absolute() || p.has_root_name() || r.front() == '/') return fail("an absolute path (only files in the model's folder are served)");
+  if (p.is_absolute() || p.has_root_name() || r.front() == '/')
+    return fail("an absolute path (only files in the model's folder are served)");
   const fs::path norm = p.lexically_normal();
   if (leaves(norm) || norm == ".") return fail("a path outside the model's folder");
   std::error_code ec;
@@ -51,7 +52,8 @@ std::string percent_decode(const std::string& uri) {
   out.reserve(uri.size());
   for (std::size_t i = 0; i < uri.size(); ++i) {
     int hi, lo;
-    if (uri[i] == '%' && i + 2 < uri.size() && (hi = hex_value(uri[i + 1])) >= 0 && (lo = hex_value(uri[i + 2])) >= 0) {
+    if (uri[i] == '%' && i + 2 < uri.size() && (hi = hex_value(uri[i + 1])) >= 0 &&
+        (lo = hex_value(uri[i + 2])) >= 0) {
       out += static_cast<char>(hi * 16 + lo);
       i += 2;
     } else {

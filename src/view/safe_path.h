@@ -11,8 +11,8 @@
 namespace qem::view {
 
 struct ResolvedFile {
-  std::string key;              ///< the path relative to the folder, '/' separated, normalised
-  std::filesystem::path file;   ///< where it is on disk
+  std::string key;             ///< the path relative to the folder, '/' separated, normalised
+  std::filesystem::path file;  ///< where it is on disk
 };
 
 /// The regular file `ref` names relative to `folder` (backslashes read as '/'), when it lies

@@ -24,7 +24,8 @@ void write(const fs::path& p, const std::string& text) {
 
 // A model folder inside a parent folder holding a "secret" the model must not reach.
 struct Folders {
-  fs::path root = fs::path(test::temp_dir()) / ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  fs::path root =
+      fs::path(test::temp_dir()) / ::testing::UnitTest::GetInstance()->current_test_info()->name();
   fs::path model = root / "model";
   Folders() {
     fs::remove_all(root);
@@ -106,12 +107,13 @@ TEST(ViewModelAssets, ObjGetsItsMaterialsAndOnlyTexturesInsideItsFolder) {
   EXPECT_EQ(level.materials[0].name, "skin");
   EXPECT_EQ(level.materials[0].texture, "tex/a b.png");
   EXPECT_DOUBLE_EQ(level.materials[0].color[1], 0);
-  EXPECT_EQ(level.materials[1].texture, "");  // refused, not served
+  EXPECT_EQ(level.materials[1].texture, "");           // refused, not served
   EXPECT_DOUBLE_EQ(level.materials[2].color[0], 0.8);  // not in the library: the MTL default
   EXPECT_EQ(level.files.size(), 1u);
   EXPECT_EQ(level.files.at("tex/a b.png"), "PNG bytes");
   ASSERT_EQ(warnings.size(), 2u);
-  EXPECT_NE(warnings[0].find("'../secret.txt' not shown: a path outside the model's folder"), std::string::npos)
+  EXPECT_NE(warnings[0].find("'../secret.txt' not shown: a path outside the model's folder"),
+            std::string::npos)
       << warnings[0];
   EXPECT_NE(warnings[1].find("'unknown' is not in its library"), std::string::npos) << warnings[1];
   EXPECT_TRUE(level.gltf.empty());
@@ -150,8 +152,9 @@ TEST(ViewModelAssets, GltfKeepsTheDocumentAndItsRelativeResources) {
   const std::size_t end = doc.find_last_of('}');
   ASSERT_NE(end, std::string::npos);
   ASSERT_EQ(doc.find("\"images\""), std::string::npos);  // serialize_gltf writes none: add them
-  doc.insert(end, ",\"images\":[{\"uri\":\"tex/a%20b.png\"},{\"uri\":\"../secret.txt\"},"
-                             "{\"uri\":\"data:image/png;base64,AAAA\"}]");
+  doc.insert(end,
+             ",\"images\":[{\"uri\":\"tex/a%20b.png\"},{\"uri\":\"../secret.txt\"},"
+             "{\"uri\":\"data:image/png;base64,AAAA\"}]");
   write(f.model / "m.gltf", doc);
   EXPECT_EQ(gltf_external_uris(doc, "m.gltf"), (std::vector<std::string>{"tex/a%20b.png", "../secret.txt"}));
   std::vector<std::string> warnings;
