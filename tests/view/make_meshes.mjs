@@ -2,8 +2,8 @@
 // chain, finest first), a manifest listing them, an ASCII PLY with a per-vertex `distance`
 // property (for the heat map), a textured OBJ (UV sphere, .mtl, a red|blue PNG texture in a
 // subfolder, a plain green material, and a material whose texture lies outside the folder), a
-// vertex-coloured PLY (red above the equator, blue below), and an OBJ whose texture is not an
-// image. Usage: node make_meshes.mjs OUT_DIR
+// vertex-coloured PLY (red above the equator, blue below), an OBJ whose texture is not an
+// image, and an OBJ with (deliberately constant) file normals. Usage: node make_meshes.mjs OUT_DIR
 import { mkdirSync, writeFileSync } from 'node:fs';
 import { join } from 'node:path';
 import { encodePng } from './png.mjs';
@@ -98,4 +98,11 @@ writeFileSync(join(out, 'sphere_distance.ply'), ply);
     `element face ${f.length}`, 'property list uchar int vertex_indices', 'end_header',
     ...v.map((p) => `${p.join(' ')} ${col(p)}`), ...f.map((t) => `3 ${t.join(' ')}`)].join('\n') + '\n');
 }
-console.log(`wrote ${levels.length + 11} files to ${out}`);
+// File normals: an icosphere whose `vn` all point along +z (not its true normals), so that a
+// page using them shades the whole sphere alike and one computing its own does not.
+{
+  const { v, f } = icosphere(3);
+  writeFileSync(join(out, 'fixed_normals.obj'), [...v.map((p) => `v ${p.join(' ')}`), 'vn 0 0 1',
+    ...f.map((t) => `f ${t.map((i) => `${i + 1}//1`).join(' ')}`)].join('\n') + '\n');
+}
+console.log(`wrote ${levels.length + 12} files to ${out}`);

@@ -340,6 +340,28 @@ test('a texture the browser cannot decode: the model is drawn plain and the pane
   } finally { stopQem(s); }
 });
 
+test('file normals: used with smooth shading, the default when a file has them', async (ctx) => {
+  const s = await startQem(['fixed_normals.obj']);
+  try {
+    const page = await openViewer(ctx.browser, s.url);
+    check(await page.locator('#shading-smooth').isChecked(), 'smooth shading is not the default for a file with normals');
+    // Every normal is +z: every pixel of the sphere gets one shade (up to antialiased edges).
+    const img = await shot(page, 'file-normals');
+    const shades = new Map();
+    for (let y = 0; y < H; ++y)
+      for (let x = PANEL_RIGHT; x < W; ++x) {
+        const o = (y * W + x) * 4, k = (img.data[o] << 16) | (img.data[o + 1] << 8) | img.data[o + 2];
+        if (Math.abs(img.data[o] - 245) + Math.abs(img.data[o + 1] - 245) + Math.abs(img.data[o + 2] - 245) > 24) shades.set(k, (shades.get(k) || 0) + 1);
+      }
+    const total = [...shades.values()].reduce((a, b) => a + b, 0), top = Math.max(...shades.values());
+    check(total > 5000 && top > 0.8 * total, `the file normals are not used: the most common shade covers ${top} of ${total} pixels`);
+    await page.locator('#shading-flat').check();  // flat: by the faces, many shades
+    const flat = await shot(page, 'file-normals-flat');
+    check(canvasStats(flat).distinct > 50, 'flat shading ignores the faces');
+    await page.close();
+  } finally { stopQem(s); }
+});
+
 test('vertex colours: a coloured PLY is drawn in its colours', async (ctx) => {
   const s = await startQem(['vcolor.ply']);
   try {
