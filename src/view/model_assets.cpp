@@ -58,33 +58,30 @@ std::string add_reference(ViewLevel& level, const fs::path& folder, const fs::pa
 void add_obj_materials(ViewLevel& level, const fs::path& folder, const std::string& model,
                        std::vector<std::string>* warnings) {
   const Mesh& m = level.mesh;
-  if (m.material_library.empty()) return;
-  std::vector<MtlMaterial> library;
-  fs::path library_dir;
-  if (!m.material_library.empty()) {
-    std::string why;
-    auto found = resolve_inside(folder, m.material_library, &why);
-    // `mtllib a.mtl b.mtl` names several libraries: the first one that exists is read.
-    for (std::istringstream names(m.material_library); !found && names;) {
-      std::string one;
-      if (names >> one) found = resolve_inside(folder, one, nullptr);
-    }
-    if (!found) {
-      // Without its library a material is only a name: the page's default look says more.
-      if (warnings)
-        warnings->push_back(model + ": material library '" + m.material_library + "' not shown: " + why);
-      return;
-    }
-    library = parse_mtl(read_file(found->file), found->file.filename().string(), warnings);
-    library_dir = fs::path(found->key).parent_path();
+  // No library, or no face names a material: nothing to draw but the default look.
+  if (m.material_library.empty() || m.material_names.empty()) return;
+  std::string why;
+  auto found = resolve_inside(folder, m.material_library, &why);
+  // `mtllib a.mtl b.mtl` names several libraries: the first one that exists is read.
+  for (std::istringstream names(m.material_library); !found && names;) {
+    std::string one;
+    if (names >> one) found = resolve_inside(folder, one, nullptr);
   }
+  if (!found) {
+    // Without its library a material is only a name: the page's default look says more.
+    if (warnings)
+      warnings->push_back(model + ": material library '" + m.material_library + "' not shown: " + why);
+    return;
+  }
+  const std::vector<MtlMaterial> library =
+      parse_mtl(read_file(found->file), found->file.filename().string(), warnings);
+  const fs::path library_dir = fs::path(found->key).parent_path();
   if (library.empty()) return;
   std::map<std::string, const MtlMaterial*> by_name;
   for (const MtlMaterial& mm : library) by_name.emplace(mm.name, &mm);
-  const std::size_t count = std::max<std::size_t>(m.material_names.size(), 1);
-  for (std::size_t i = 0; i < count; ++i) {
+  for (const std::string& name : m.material_names) {
     ViewMaterial vm;
-    vm.name = i < m.material_names.size() ? m.material_names[i] : "";
+    vm.name = name;
     auto it = by_name.find(vm.name);
     if (it != by_name.end()) {
       const MtlMaterial& mm = *it->second;
