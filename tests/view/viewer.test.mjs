@@ -12,7 +12,7 @@
 // (default ../shared/data beside the repository; the CesiumMan tests are skipped without it).
 // Prints one line per check and a final `N passed, M failed`; exits non-zero on any failure.
 import { spawn, spawnSync } from 'node:child_process';
-import { mkdirSync, readFileSync, existsSync, mkdtempSync, rmSync } from 'node:fs';
+import { mkdirSync, readFileSync, existsSync, mkdtempSync, rmSync, writeFileSync } from 'node:fs';
 import { createServer } from 'node:http';
 import { tmpdir } from 'node:os';
 import { dirname, join, normalize, resolve } from 'node:path';
@@ -488,6 +488,44 @@ test('mixed formats side by side: CesiumMan.glb beside an OBJ simplified from it
     check(Math.abs((t0 + b0) - (t1 + b1)) / 2 < 0.15 * H, `the two sides are not in one frame (rows ${t0}-${b0} and ${t1}-${b1})`);
     const [glb, flat] = await inspect(page);
     check(glb.skinned >= 1 && flat.skinned === 0 && flat.meshes === 1, 'the sides are not the glTF and the OBJ');
+    await page.close();
+  } finally { stopQem(s); rmSync(dir, { recursive: true, force: true }); }
+});
+
+/// Splits a .glb into a .gltf with its buffer and images as files beside it (the images in a
+/// subfolder, with a space in their names), as many exporters write them.
+function splitGlb(glb, dir, stem) {
+  const jsonLength = glb.readUInt32LE(12), doc = JSON.parse(glb.subarray(20, 20 + jsonLength).toString('utf8'));
+  const binStart = 20 + jsonLength + 8, bin = glb.subarray(binStart, binStart + glb.readUInt32LE(20 + jsonLength));
+  mkdirSync(join(dir, 'tex'), { recursive: true });
+  (doc.images || []).forEach((img, i) => {
+    const view = doc.bufferViews[img.bufferView], off = view.byteOffset || 0;
+    const name = `skin ${i}.${img.mimeType === 'image/jpeg' ? 'jpg' : 'png'}`;
+    writeFileSync(join(dir, 'tex', name), bin.subarray(off, off + view.byteLength));
+    delete img.bufferView; delete img.mimeType;
+    img.uri = `tex/${encodeURIComponent(name)}`;
+  });
+  writeFileSync(join(dir, `${stem}.bin`), bin);
+  doc.buffers[0].uri = `${stem}.bin`;
+  writeFileSync(join(dir, `${stem}.gltf`), JSON.stringify(doc));
+  return join(dir, `${stem}.gltf`);
+}
+
+test('glTF with external files: a .gltf, its .bin and its images in a subfolder are served and drawn', async (ctx) => {
+  needCesiumMan();
+  const dir = mkdtempSync(join(tmpdir(), 'qem-gltf-'));
+  let s;
+  try {
+    const gltf = splitGlb(readFileSync(CESIUM_MAN), dir, 'CesiumMan');
+    s = await startQem([gltf]);
+    const page = await openViewer(ctx.browser, s.url);
+    const [info] = await inspect(page);
+    check(info.skinned >= 1 && info.textured, `skinned ${info.skinned}, textured ${info.textured}`);
+    const tex = await rawGet(s.url, '/data/level0/tex/skin%200.jpg');
+    const png = await rawGet(s.url, '/data/level0/tex/skin%200.png');
+    check(tex.status === 200 || png.status === 200, 'the image beside the .gltf is not served');
+    check((await rawGet(s.url, '/data/level0/CesiumMan.bin')).status === 200, 'the .bin is not served');
+    await checkPlays(page, 'CesiumMan.gltf');
     await page.close();
   } finally { stopQem(s); rmSync(dir, { recursive: true, force: true }); }
 });
