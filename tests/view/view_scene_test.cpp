@@ -19,13 +19,22 @@ std::vector<float> floats(const std::string& bytes) {
   return out;
 }
 
+// A level without appearance (the aggregate has more fields: -Wmissing-field-initializers).
+ViewLevel level(std::string name, Mesh mesh, double error = std::numeric_limits<double>::quiet_NaN()) {
+  ViewLevel l;
+  l.name = std::move(name);
+  l.mesh = std::move(mesh);
+  l.error = error;
+  return l;
+}
+
 ViewScene chain_scene() {
   ViewScene s;
   s.mode = ViewMode::Chain;
   s.title = "sphere";
   // Far from the origin: the export must centre positions so Float32 keeps their precision.
-  s.levels.push_back({"fine", test::transformed(test::icosphere(2), 1, 1000, 0, 0), 0.0});
-  s.levels.push_back({"coarse", test::transformed(test::icosphere(1), 1, 1000, 0, 0), 0.05});
+  s.levels.push_back(level("fine", test::transformed(test::icosphere(2), 1, 1000, 0, 0), 0.0));
+  s.levels.push_back(level("coarse", test::transformed(test::icosphere(1), 1, 1000, 0, 0), 0.05));
   return s;
 }
 
@@ -57,7 +66,7 @@ TEST(ViewScene, DescribesEveryLevelAndWritesItsBuffers) {
 
 TEST(ViewScene, IndicesAreStoredUnchanged) {
   ViewScene s;
-  s.levels.push_back({"cube", test::cube()});
+  s.levels.push_back(level("cube", test::cube()));
   auto files = scene_files(s);
   const std::string& idx = files.at("data/level0.idx.u32");
   std::vector<std::uint32_t> got(idx.size() / 4);
@@ -74,7 +83,7 @@ TEST(ViewScene, ExportsTheDistancePropertyAndItsRange) {
   VertexProperty d{"distance", {}};
   for (std::size_t v = 0; v < m.vertex_count(); ++v) d.values.push_back(0.5 + m.positions[3 * v + 1]);
   m.vertex_properties.push_back(d);
-  s.levels.push_back({"heat", m});
+  s.levels.push_back(level("heat", m));
   auto files = scene_files(s);
   json doc = json::parse(files["data/scene.json"]);
   const json& range = doc["distance_range"];
@@ -90,7 +99,7 @@ TEST(ViewScene, NamesThatAreNotUtf8StillGiveValidJson) {
   // File names are bytes: a Latin-1 "café.ply" must not break the page's JSON.
   ViewScene s;
   s.title = "caf\xe9";
-  s.levels.push_back({"caf\xe9.ply", test::cube()});
+  s.levels.push_back(level("caf\xe9.ply", test::cube()));
   auto files = scene_files(s);
   json doc = json::parse(files["data/scene.json"]);  // throws on invalid UTF-8
   EXPECT_EQ(doc["title"], "caf\xef\xbf\xbd");        // U+FFFD
@@ -152,7 +161,7 @@ TEST(ViewScene, GltfLevelsPointAtTheDocumentInsteadOfBuffers) {
   g.gltf = "man.glb";
   g.files = {{"man.glb", "glTF..."}, {"textures/skin.jpg", "JPEG"}};
   s.levels.push_back(g);
-  s.levels.push_back({"simplified.obj", test::cube()});
+  s.levels.push_back(level("simplified.obj", test::cube()));
   auto files = scene_files(s);
   json doc = json::parse(files["data/scene.json"]);
   const json& l0 = doc["levels"][0];
@@ -194,7 +203,7 @@ TEST(ViewScene, RejectsBadScenes) {
   ViewScene bad;
   Mesh m = test::tetrahedron();
   m.indices[5] = 99;
-  bad.levels.push_back({"bad", m});
+  bad.levels.push_back(level("bad", m));
   EXPECT_THROW(scene_files(bad), Error);
 }
 
