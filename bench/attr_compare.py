@@ -21,6 +21,7 @@ the same fraction and keep the document.
 """
 import argparse
 import json
+import math
 import os
 import struct
 import subprocess
@@ -266,13 +267,16 @@ def verdict(rows):
         if e is not None and e > 0.9:
             why.append(f'E {e:.2f}x')
         for k in ('uv_rms', 'normal_rms_deg', 'color_rms'):
-            if q.get(k) is not None and m.get(k) is not None and q[k] > m[k]:
+            if q.get(k) is not None and m.get(k) is not None and q[k] > m[k] + 1e-9:  # 1e-9: rounding noise
                 why.append(f'{k} {q[k]:.3g} > {m[k]:.3g}')
         if q.get('seam_cracks'):
             why.append(f"{q['seam_cracks']} cracks")
         if why:
             fails.append(f"{row['asset']} {row['ratio']:g}: " + ', '.join(why))
-    return f'{len(rows) - len(fails)} of {len(rows)} rows meet the goal' + (
+    er = [ratio_of(r.get('qem', {}).get('E'), r.get('meshopt', {}).get('E')) for r in rows]
+    er = [x for x in er if x]
+    gm = math.exp(sum(map(math.log, er)) / len(er)) if er else float('nan')
+    return f'{len(rows) - len(fails)} of {len(rows)} rows meet the goal, geometric mean E q/m {gm:.3f}' + (
         '; not met: ' + '; '.join(fails) if fails else '')
 
 
