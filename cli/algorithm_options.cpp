@@ -43,7 +43,8 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
                   "repeat or separate by commas): a difference of 1/W costs as much as one bounding-box "
                   "diagonal (defaults: normal=" + json_number(AttributeWeights{}.normal) + ", uv=" +
                       json_number(AttributeWeights{}.tex_coord) + ", color=" + json_number(AttributeWeights{}.color) +
-                      ", scalar=" + json_number(AttributeWeights{}.scalar) + ")")
+                      ", scalar=" + json_number(AttributeWeights{}.scalar) + "); seam=W weighs constraint planes along "
+                      "the seams, as --boundary-weight for borders (default " + json_number(AttributeWeights{}.seam) + ")")
       ->delimiter(',');
   sub->add_option("--inversion", a.inversion, "Contractions that flip a face: forbid, penalize, or off (GH97 6)")
       ->check(CLI::IsMember(option_names<InversionPolicy>()))
@@ -113,11 +114,12 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
                      : kind == "uv"   ? &opt.attribute_weights.tex_coord
                      : kind == "color" ? &opt.attribute_weights.color
                      : kind == "scalar" ? &opt.attribute_weights.scalar
+                     : kind == "seam"   ? &opt.attribute_weights.seam
                                         : nullptr;
     char* end = nullptr;
     const double w = eq == std::string::npos ? -1 : std::strtod(item.c_str() + eq + 1, &end);
     if (!weight || eq == std::string::npos || !end || *end != 0 || !(w >= 0) || !std::isfinite(w))
-      throw Error("--attribute-weight: expected KIND=W with KIND normal, uv, color or scalar and W >= 0, got '" +
+      throw Error("--attribute-weight: expected KIND=W with KIND normal, uv, color, scalar or seam and W >= 0, got '" +
                   item + "'");
     *weight = w;
   }

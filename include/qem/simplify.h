@@ -86,12 +86,17 @@ struct ContractionLog {
 /// How much a unit of each attribute counts against a unit of distance, in the normalised frame
 /// (bounding-box diagonal 1): an attribute difference of 1 / weight costs as much as a distance of
 /// one diagonal (Hoppe 1999's attribute quadric, area weighted like the positions). Kinds not
-/// listed (joints, skin weights, tangents) are never interpolated: the survivor's are kept.
+/// listed (joints, skin weights, tangents) are never interpolated: the survivor's are kept. The
+/// defaults were chosen by a sweep against meshoptimizer on textured and coloured assets
+/// (docs/attributes.md, "Weights"; bench/attr_sweep.sh).
 struct AttributeWeights {
-  double normal = 0.03;     ///< a normal turned by ~0.17 rad (10 degrees) ~ 0.5 % of the diagonal
-  double tex_coord = 0.5;   ///< a UV shift of 0.01 ~ 0.5 % of the diagonal
+  double normal = 0.01;     ///< a normal turned by ~0.17 rad (10 degrees) ~ 0.17 % of the diagonal
+  double tex_coord = 0.2;   ///< a UV shift of 0.01 ~ 0.2 % of the diagonal
   double color = 0.1;       ///< a colour change of 0.05 ~ 0.5 % of the diagonal
   double scalar = 0.01;     ///< other per-vertex values
+  /// Constraint planes along the seams (wedge changes: UV seams, creases, material boundaries),
+  /// weighted as the boundary planes (SimplifyOptions::boundary_weight); 0 disables them.
+  double seam = 10;
 };
 
 struct SimplifyOptions {

@@ -11,6 +11,7 @@
 #include "core/parallel_chunks.h"
 #include "core/settings.h"
 #include "core/valid_pairs.h"
+#include "core/seam_planes.h"
 #include "core/wedges.h"
 #include "core/working_mesh.h"
 #include "qem/error.h"
@@ -89,6 +90,7 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
       settings.threads, [&] { quadric = face_quadrics(mesh, settings.weighting); },
       [&] { edges = unique_edges(mesh.tri, mesh.vertex_faces, mesh.vertex_count()); });
   add_boundary_planes(mesh, edges, settings.boundary_weight, settings.weighting, quadric);  // GH97 §6
+  if (wedges) add_seam_planes(mesh, edges, options.attribute_weights.seam, settings.weighting, quadric);
   pairs = select_pairs(mesh, std::move(edges), settings.threshold);                         // GH97 §3.2
   result.virtual_pairs = pairs.virtual_count;
   c.marks.assign(mesh.vertex_count(), 0);
