@@ -216,6 +216,12 @@ TEST(FacesZero, CommandLineReadsZeroAsFarAsTheChecksAllow) {
     const SimplifyResult r = simplify(load_mesh(in), o);
     EXPECT_EQ(load_mesh(out).indices, r.mesh.indices);
   }
+  // qem lod takes a level of 0 faces too: the last level is the mesh as far as the checks allow.
+  EXPECT_EQ(test::run_qem_quietly("lod " + in + " " + dir + "/lod --faces 0,2000 --no-refit"), 0);
+  SimplifyOptions all_the_way;
+  all_the_way.as_far_as_possible = true;
+  const std::size_t last_faces = simplify(load_mesh(in), all_the_way).mesh.face_count();
+  EXPECT_NE(test::slurp(dir + "/lod/manifest.json").find("\"faces\": " + std::to_string(last_faces)), std::string::npos);
   // The summary's JSON line counts the components.
   const std::string cmd = std::string(QEM_CLI_PATH) + " simplify " + in + " " + out + " --faces 0 --json -q --force";
   FILE* pipe = popen(cmd.c_str(), "r");

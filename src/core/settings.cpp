@@ -13,7 +13,7 @@ void validate(const SimplifyOptions& o) {
   const bool any = o.target_faces > 0 || o.target_ratio > 0 || o.target_vertices > 0 || std::isfinite(o.max_error) ||
                    o.as_far_as_possible;
   if (o.target_ratio < 0 || o.target_ratio > 1 || std::isnan(o.target_ratio))
-    throw Error("target ratio must be in (0, 1]");
+    throw Error("target ratio must be in [0, 1] (0: unused)");
   if (std::isfinite(o.max_error) && o.max_error < 0) throw Error("max error must not be negative");
   if (std::isnan(o.max_error)) throw Error("max error must be a number");
   if (!any)
