@@ -35,7 +35,8 @@ Parts hundred_parts(int small_first = 0) {
   const Mesh patch = test::height_field(6, bumps), ball = test::icosphere(2);
   for (int i = 0; i < 100; ++i) {
     const double size = i < small_first ? 0.02 : 0.2 + 0.9 * double((i * 37) % 100) / 99.0;
-    const Mesh part = test::transformed(i % 2 == 0 ? patch : ball, size, 3.0 * (i % 10), 3.0 * (i / 10), 0.1 * i);
+    const Mesh part =
+        test::transformed(i % 2 == 0 ? patch : ball, size, 3.0 * (i % 10), 3.0 * (i / 10), 0.1 * i);
     p.first_face.push_back(p.mesh.face_count());
     p.mesh = i == 0 ? part : test::concatenated(p.mesh, part);
   }
@@ -210,7 +211,9 @@ TEST(FacesZero, CommandLineReadsZeroAsFarAsTheChecksAllow) {
   save_mesh(in, hundred_parts().mesh);
   for (const char* stop : {"--faces 0", "--ratio 0", "--vertices 0"}) {
     SCOPED_TRACE(stop);
-    ASSERT_EQ(test::run_qem_quietly("simplify " + in + " " + out + " " + std::string(stop) + " --no-refit --force"), 0);
+    ASSERT_EQ(
+        test::run_qem_quietly("simplify " + in + " " + out + " " + std::string(stop) + " --no-refit --force"),
+        0);
     SimplifyOptions o;
     o.as_far_as_possible = true;
     const SimplifyResult r = simplify(load_mesh(in), o);
@@ -221,16 +224,19 @@ TEST(FacesZero, CommandLineReadsZeroAsFarAsTheChecksAllow) {
   SimplifyOptions all_the_way;
   all_the_way.as_far_as_possible = true;
   const std::size_t last_faces = simplify(load_mesh(in), all_the_way).mesh.face_count();
-  EXPECT_NE(test::slurp(dir + "/lod/manifest.json").find("\"faces\": " + std::to_string(last_faces)), std::string::npos);
+  EXPECT_NE(test::slurp(dir + "/lod/manifest.json").find("\"faces\": " + std::to_string(last_faces)),
+            std::string::npos);
   // The summary's JSON line counts the components.
-  const std::string cmd = std::string(QEM_CLI_PATH) + " simplify " + in + " " + out + " --faces 0 --json -q --force";
+  const std::string cmd =
+      std::string(QEM_CLI_PATH) + " simplify " + in + " " + out + " --faces 0 --json -q --force";
   FILE* pipe = popen(cmd.c_str(), "r");
   ASSERT_NE(pipe, nullptr);
   std::string json;
   std::array<char, 4096> buf;
   while (std::size_t n = std::fread(buf.data(), 1, buf.size(), pipe)) json.append(buf.data(), n);
   EXPECT_EQ(pclose(pipe), 0);
-  EXPECT_NE(json.find("\"in_components\":100,\"out_components\":100,\"pruned_components\":0"), std::string::npos)
+  EXPECT_NE(json.find("\"in_components\":100,\"out_components\":100,\"pruned_components\":0"),
+            std::string::npos)
       << json;
 }
 

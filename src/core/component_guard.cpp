@@ -60,7 +60,8 @@ std::uint32_t ComponentGuard::root(std::uint32_t v) const {
   return x;
 }
 
-bool ComponentGuard::allows(const WorkingMesh& m, std::uint32_t a, std::uint32_t b, bool may_duplicate) const {
+bool ComponentGuard::allows(const WorkingMesh& m, std::uint32_t a, std::uint32_t b,
+                            bool may_duplicate) const {
   if (label_[a] == kNoVertex || label_[b] == kNoVertex) return true;  // not on a face: nothing to lose
   const std::uint32_t ra = root(a), rb = root(b);
   std::size_t live = live_[ra].load(std::memory_order_relaxed);
@@ -80,7 +81,8 @@ bool ComponentGuard::allows(const WorkingMesh& m, std::uint32_t a, std::uint32_t
       std::uint32_t t[3];
       for (int k = 0; k < 3; ++k) t[k] = m.face(f)[k] == b ? a : m.face(f)[k];
       for (std::uint32_t g : m.vertex_faces[a]) {
-        if (!m.face_alive[g] || m.face_has(g, b) || std::find(gone.begin(), gone.end(), g) != gone.end()) continue;
+        if (!m.face_alive[g] || m.face_has(g, b) || std::find(gone.begin(), gone.end(), g) != gone.end())
+          continue;
         if (!(m.face_has(g, t[0]) && m.face_has(g, t[1]) && m.face_has(g, t[2]))) continue;
         const std::uint32_t* u = m.face(g);
         int k = 0;
@@ -109,8 +111,8 @@ void ComponentGuard::join(std::uint32_t a, std::uint32_t b) {
   floor_[ra] = std::max(floor_[ra], floor_[rb]);
 }
 
-void ComponentGuard::risky(const WorkingMesh& m, const PairSet& ps, const std::uint32_t* band, std::size_t count,
-                           std::vector<std::uint8_t>& out) {
+void ComponentGuard::risky(const WorkingMesh& m, const PairSet& ps, const std::uint32_t* band,
+                           std::size_t count, std::vector<std::uint8_t>& out) {
   out.assign(count, 0);
   const auto stake_of = [&](std::uint32_t a, std::uint32_t b) {
     return m.vertex_faces[a].size() + m.vertex_faces[b].size();
@@ -122,8 +124,10 @@ void ComponentGuard::risky(const WorkingMesh& m, const PairSet& ps, const std::u
       continue;
     }
     const std::uint32_t r = root(a);
-    if (root(b) != r) out[i] = 1;
-    else stake_[r] += stake_of(a, b);
+    if (root(b) != r)
+      out[i] = 1;
+    else
+      stake_[r] += stake_of(a, b);
   }
   for (std::size_t i = 0; i < count; ++i) {
     const std::uint32_t a = ps.pairs[band[i]].v[0];

@@ -198,9 +198,10 @@ bool try_contract(Context& c, Lists& lists, std::uint32_t p, Worker& w) {
     ps.pairs[p].state = kDead;
     return false;
   }
-  if (c.components && !c.components->allows(c.mesh, a, b,
-                                             c.mesh.aggregated[a] || c.mesh.aggregated[b] || ps.pairs[p].is_virtual ||
-                                                 !c.settings.preserve_topology)) {
+  // As in contract(): faces may land on the same three vertices where the link condition did not run.
+  const bool may_duplicate = c.mesh.aggregated[a] || c.mesh.aggregated[b] || ps.pairs[p].is_virtual ||
+                             !c.settings.preserve_topology;
+  if (c.components && !c.components->allows(c.mesh, a, b, may_duplicate)) {
     ++w.blocked_component;  // it would take a connected component below its floor
     ps.block(p);
     return false;

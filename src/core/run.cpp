@@ -65,7 +65,8 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   result.dropped_degenerate_faces = mesh.dropped_degenerate, result.dropped_duplicate_faces = mesh.dropped_duplicate;
   const Settings settings = resolve(options, mesh);  // targets from the input, before any pruning
   result.input_components = count_components(mesh);
-  if (settings.prune_size > 0) result.pruned_components = prune_components(mesh, wedges ? &*wedges : nullptr, settings.prune_size);
+  if (settings.prune_size > 0)
+    result.pruned_components = prune_components(mesh, wedges ? &*wedges : nullptr, settings.prune_size);
   std::optional<ContractionMap> map;
   if (options.map_input_vertices || hooks.map_input_vertices) map.emplace(input.vertex_count(), mesh.source_vertex);
   if (hooks.consumed_indices) {
