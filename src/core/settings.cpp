@@ -17,7 +17,9 @@ void validate(const SimplifyOptions& o) {
   if (std::isfinite(o.max_error) && o.max_error < 0) throw Error("max error must not be negative");
   if (std::isnan(o.max_error)) throw Error("max error must be a number");
   if (!any)
-    throw Error("no stop criterion: give a face, ratio, vertex or error target, or ask to go as far as possible");
+    throw Error(
+        "no stop criterion: give a face, ratio, vertex or error target (a face, ratio or vertex target of 0: as far "
+        "as the checks allow)");
   if (!(o.max_normal_turn_degrees > 0 && o.max_normal_turn_degrees < 90))
     throw Error("the inversion angle limit must be in (0, 90) degrees");
   if (!(o.threshold >= 0)) throw Error("threshold must not be negative");
