@@ -53,6 +53,15 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
       ->capture_default_str();
   sub->add_flag("--allow-non-manifold", a.allow_non_manifold,
                 "Do not check the link condition: edge collapses may create non-manifold edges");
+  sub->add_flag("--allow-vanishing", a.allow_vanishing,
+                "GH97 as published: a connected part may contract to nothing. By default every part keeps at "
+                "least one face, a closed one four (a tetrahedron); parts that --threshold joins count as one");
+  sub->add_option("--prune", a.prune,
+                  "Remove whole the connected parts whose bounding-box diagonal is below this distance (model "
+                  "units) before simplifying; 0 = none")
+      ->check(CLI::NonNegativeNumber);
+  sub->add_option("--prune-rel", a.prune_rel, "As --prune, relative to the whole mesh's bounding-box diagonal")
+      ->check(CLI::NonNegativeNumber);
   sub->add_flag("--weld", a.weld, "Merge exactly coincident vertices on load (default for STL)");
   sub->add_flag("--no-weld", a.no_weld, "Never weld on load, not even STL");
   sub->add_flag("--refit", a.refit,
@@ -107,6 +116,10 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
   opt.max_normal_turn_degrees = a.max_turn;
   opt.lock_border = a.lock_border;
   opt.preserve_topology = !a.allow_non_manifold;
+  opt.keep_components = !a.allow_vanishing;
+  if (a.prune > 0 && a.prune_rel > 0) throw Error("give --prune or --prune-rel, not both");
+  if (a.prune_rel > 0) opt.prune_size = a.prune_rel, opt.prune_size_is_relative = true;
+  else opt.prune_size = a.prune;
   for (const std::string& item : a.attribute_weights) {
     const std::size_t eq = item.find('=');
     const std::string kind = item.substr(0, eq);

@@ -23,6 +23,8 @@ struct AlgorithmArgs {
   double boundary_weight = SimplifyOptions{}.boundary_weight;
   double max_turn = SimplifyOptions{}.max_normal_turn_degrees;
   bool lock_border = false, allow_non_manifold = false;
+  bool allow_vanishing = false;         // --allow-vanishing: components may contract to nothing
+  double prune = 0, prune_rel = 0;      // --prune D, --prune-rel F
   bool weld = false, no_weld = false;
   bool refit = false;         // --refit
   unsigned refit_rounds = 0;  // --refit-rounds (implies --refit); 0 = RefitOptions' default
@@ -44,7 +46,8 @@ inline constexpr unsigned kDefaultRefitRounds = 1;
 inline constexpr double kDefaultRefitSample = 2;
 
 /// Adds --threshold(-rel), --weighting, --placement, --scheme, --greedy-below, --threads,
-/// --boundary-weight, --lock-border, --inversion, --max-turn, --allow-non-manifold, --weld,
+/// --boundary-weight, --lock-border, --inversion, --max-turn, --allow-non-manifold, --allow-vanishing,
+/// --prune, --prune-rel, --weld,
 /// --no-weld, --refit, --refit-rounds, --refit-sample, --no-refit to `sub`.
 void add_algorithm_options(CLI::App* sub, AlgorithmArgs& args);
 

@@ -104,9 +104,7 @@ int run_lod_mesh(const LodArgs& a);
 int run_lod(const LodArgs& a) {
   if (a.ratios.empty() == a.faces.empty()) throw Error("give the levels with either --ratios or --faces");
   for (double r : a.ratios)
-    if (!(r > 0 && r <= 1)) throw Error("--ratios: every ratio must be in (0, 1], got " + json_number(r));
-  for (std::size_t f : a.faces)
-    if (f == 0) throw Error("--faces: every face count must be positive");
+    if (!(r >= 0 && r <= 1)) throw Error("--ratios: every ratio must be in [0, 1], got " + json_number(r));
   const bool gltf_input = format_from_extension(a.input) == FileFormat::Gltf;
   LodArgs args = a;
   if (args.format.empty()) args.format = gltf_input ? "glb" : "ply";
@@ -116,6 +114,12 @@ int run_lod(const LodArgs& a) {
                 "document they keep; give --format ply, obj, stl or off for this input");
   if (a.per_mesh && !gltf_levels) throw Error("--per-mesh applies to glTF levels (a .glb / .gltf input)");
   if (gltf_levels) {
+    // A scene's shared error budget needs a face target to share; 0 ("as far as the checks allow")
+    // is taken per mesh file only.
+    for (double r : a.ratios)
+      if (r == 0) throw Error("--ratios: glTF levels need ratios above 0, got 0");
+    for (std::size_t f : a.faces)
+      if (f == 0) throw Error("--faces: glTF levels need face counts above 0, got 0");
     SimplifyOptions opt = to_simplify_options(a.algorithm);
     opt.target_faces = 1;
     check_options(opt);
@@ -143,6 +147,8 @@ int run_lod_mesh(const LodArgs& a) {
     opt.target_faces = *std::min_element(a.faces.begin(), a.faces.end());
   else
     opt.target_ratio = *std::min_element(a.ratios.begin(), a.ratios.end());
+  // A level of 0 faces (or ratio 0) is the mesh as far as the checks allow.
+  opt.as_far_as_possible = opt.target_faces == 0 && opt.target_ratio == 0;
   // A record replays positions and faces only: with attributes (UVs, normals, colours) each level
   // is a run of its own, which carries them.
   const bool attributes = !mesh.attributes.empty();
@@ -161,7 +167,7 @@ int run_lod_mesh(const LodArgs& a) {
   if (!attributes) levels = replay_levels(record, targets);
   for (std::size_t target : attributes ? targets : std::vector<std::size_t>{}) {
     SimplifyOptions level = opt;
-    level.target_ratio = 0, level.target_faces = target;
+    level.target_ratio = 0, level.target_faces = target, level.as_far_as_possible = target == 0;
     SimplifyResult r = simplify(mesh, level);
     r.mesh.material_names = mesh.material_names, r.mesh.material_library = mesh.material_library;
     levels.push_back({std::move(r.mesh), target, r.contractions, r.max_error});
@@ -231,9 +237,10 @@ const bool registered = register_command(13, [](CLI::App& app) {
       ->required();
   auto* ratios =
       sub->add_option("--ratios", args->ratios,
-                      "Levels as fractions of the input faces, comma separated (e.g. 0.5,0.25,0.1)")
+                      "Levels as fractions of the input faces, comma separated (e.g. 0.5,0.25,0.1); 0 = as far as the "
+                      "checks allow")
           ->delimiter(',');
-  sub->add_option("--faces,-f", args->faces, "Levels as face counts, comma separated (e.g. 50000,10000,1000)")
+  sub->add_option("--faces,-f", args->faces, "Levels as face counts, comma separated (e.g. 50000,10000,1000); 0 = as far as the checks allow")
       ->delimiter(',')
       ->excludes(ratios);
   sub->add_option("--format", args->format,

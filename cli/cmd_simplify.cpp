@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -21,8 +22,8 @@ namespace {
 
 struct SimplifyArgs {
   std::string input, output;
-  std::size_t faces = 0, vertices = 0;
-  double ratio = 0;
+  std::optional<std::size_t> faces, vertices;  // given as 0: as far as the checks allow
+  std::optional<double> ratio;
   double max_error = -1, max_error_rel = -1;
   AlgorithmArgs algorithm;
   bool ascii = false, json = false, quiet = false, force = false;
@@ -105,9 +106,10 @@ int run_simplify(const SimplifyArgs& a) {
         "moves every vertex after them, so `qem replay` could not give back what simplify wrote; "
         "use `qem lod --refit`, or `qem refit` on a replayed level");
   if (!a.record.empty()) opt.refit_rounds = 0;
-  opt.target_faces = a.faces;
-  opt.target_ratio = a.ratio;
-  opt.target_vertices = a.vertices;
+  opt.target_faces = a.faces.value_or(0);
+  opt.target_ratio = a.ratio.value_or(0);
+  opt.target_vertices = a.vertices.value_or(0);
+  opt.as_far_as_possible = a.faces == 0u || a.ratio == 0.0 || a.vertices == 0u;
   if (a.max_error >= 0) opt.max_error = a.max_error;
   if (a.max_error_rel >= 0) opt.max_error = a.max_error_rel, opt.max_error_is_relative = true;
   check_options(opt);  // before the input is read: a slip in the options is said at once
@@ -153,21 +155,26 @@ int run_simplify(const SimplifyArgs& a) {
         "{\"tool\":\"qem\",\"in_faces\":%zu,\"target_faces\":%zu,\"out_faces\":%zu,\"out_vertices\":%zu,"
         "\"load_s\":%s,\"simplify_s\":%s,\"simplify_cpu_s\":%s,\"write_s\":%s,\"total_s\":%s,"
         "\"peak_rss_mb\":%s,\"max_error\":%s,\"max_error_rel\":%s,\"contractions\":%zu,\"virtual_pairs\":%zu,"
-        "\"rejected_topology\":%zu,\"rejected_inversion\":%zu,\"rejected_error\":%zu,\"refit_rounds\":%zu,"
+        "\"rejected_topology\":%zu,\"rejected_inversion\":%zu,\"rejected_error\":%zu,\"rejected_component\":%zu,"
+        "\"in_components\":%zu,\"out_components\":%zu,\"pruned_components\":%zu,\"refit_rounds\":%zu,"
         "\"refit_rms_before\":%s,\"refit_rms_after\":%s,\"dropped_degenerate\":%zu,\"dropped_duplicate\":%zu,"
         "\"stop\":\"%s\"}\n",
-        in_faces, a.faces, r.mesh.face_count(), r.mesh.vertex_count(), json_number(load_s).c_str(),
+        in_faces, a.faces.value_or(0), r.mesh.face_count(), r.mesh.vertex_count(), json_number(load_s).c_str(),
         json_number(simplify_s).c_str(), json_number(simplify_cpu_s).c_str(), json_number(write_s).c_str(),
         json_number(total.seconds()).c_str(), json_number(peak_rss_mb()).c_str(),
         json_number(r.max_error).c_str(), json_number(r.max_error_relative).c_str(), r.contractions,
-        r.virtual_pairs, r.rejected_topology, r.rejected_inversion, r.rejected_error, r.refit_rounds,
+        r.virtual_pairs, r.rejected_topology, r.rejected_inversion, r.rejected_error, r.rejected_component,
+        r.input_components, r.output_components, r.pruned_components, r.refit_rounds,
         json_number(r.refit_rms_before).c_str(), json_number(r.refit_rms_after).c_str(),
         r.dropped_degenerate_faces, r.dropped_duplicate_faces, to_string(r.stop_reason));
   }
   if (!a.quiet)
-    std::fprintf(stderr, "qem: %zu -> %zu faces, %zu vertices, max error %.4g (%.3g of diagonal), %.3f s; %s\n",
-                 r.input_faces, r.mesh.face_count(), r.mesh.vertex_count(), r.max_error, r.max_error_relative,
-                 total.seconds(), r.stop_detail.c_str());
+    std::fprintf(stderr,
+                 "qem: %zu -> %zu faces, %zu vertices, %zu -> %zu components%s, max error %.4g (%.3g of diagonal), "
+                 "%.3f s; %s\n",
+                 r.input_faces, r.mesh.face_count(), r.mesh.vertex_count(), r.input_components, r.output_components,
+                 r.pruned_components > 0 ? (" (" + std::to_string(r.pruned_components) + " pruned)").c_str() : "",
+                 r.max_error, r.max_error_relative, total.seconds(), r.stop_detail.c_str());
   if (!a.quiet && r.dropped_degenerate_faces + r.dropped_duplicate_faces > 0)
     std::fprintf(stderr, "qem: left out %zu degenerate and %zu duplicate input faces\n", r.dropped_degenerate_faces,
                  r.dropped_duplicate_faces);
@@ -189,13 +196,18 @@ const bool registered = register_command(10, [](CLI::App& app) {
                   "each primitive's). glTF to another format writes the scene merged into one mesh")
       ->required();
   auto* g = sub->add_option_group("target", "Stop criteria (any combination; the first reached wins)");
-  g->add_option("--faces,-f", args->faces, "Stop at or below this many faces");
-  g->add_option("--ratio,-r", args->ratio, "Stop at or below this fraction of the input faces");
-  g->add_option("--vertices", args->vertices, "Stop at or below this many vertices");
+  g->add_option("--faces,-f", args->faces,
+                "Stop at or below this many faces; 0 = as far as the checks allow (topology, inversion, "
+                "components, --max-error, locks)");
+  g->add_option("--ratio,-r", args->ratio,
+                "Stop at or below this fraction of the input faces, in [0, 1]; 0 = as far as the checks allow");
+  g->add_option("--vertices", args->vertices, "Stop at or below this many vertices; 0 = as far as the checks allow");
   g->add_option("--max-error", args->max_error,
                 "Never make a contraction whose error exceeds this distance (model units): the error is "
-                "sqrt(Q(v)/weight), the weighted RMS distance of the new vertex to the planes it represents");
-  g->add_option("--max-error-rel", args->max_error_rel, "As --max-error, relative to the bounding-box diagonal");
+                "sqrt(Q(v)/weight), the weighted RMS distance of the new vertex to the planes it represents; "
+                "0 = only contractions without error (flat, straight parts)");
+  g->add_option("--max-error-rel", args->max_error_rel,
+                "As --max-error, relative to the bounding-box diagonal; 0 = only contractions without error");
   add_algorithm_options(sub, args->algorithm);
   sub->add_flag("--ascii", args->ascii, "Write PLY / STL as text instead of binary");
   sub->add_flag("--double", args->double_values, kDoubleOutputHelp);

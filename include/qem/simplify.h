@@ -104,6 +104,11 @@ struct SimplifyOptions {
   std::size_t target_faces = 0;     ///< stop at or below this many faces (0 = no face target)
   double target_ratio = 0;          ///< stop at or below ratio * input faces (0 = unused)
   std::size_t target_vertices = 0;  ///< stop at or below this many vertices (0 = unused)
+  /// A stop criterion of its own: contract as far as the checks allow (topology, inversion,
+  /// components, max_error, locks), as a face target of 0 does on the command line and in
+  /// meshoptimizer, CGAL and libigl. The target fields keep 0 = unused, so existing callers are
+  /// unchanged; the other criteria still apply (the first reached wins).
+  bool as_far_as_possible = false;
   /// Largest allowed contraction error, in distance units: sqrt(Q(v) / weight of Q), i.e. the
   /// weighted RMS distance from the new vertex to the planes it represents. +inf = no limit.
   double max_error = std::numeric_limits<double>::infinity();
@@ -118,6 +123,16 @@ struct SimplifyOptions {
   /// Penalty weight of the boundary constraint planes (GH97 §6); 0 disables them.
   double boundary_weight = 1;
   bool lock_border = false;  ///< boundary vertices never move
+  /// Keep every connected component (vertex-connected, counted on the welded working mesh): a
+  /// contraction that would leave a component with fewer than its floor of faces (a closed one 4,
+  /// an open one 1, or as many as it has if fewer) is refused. Components that a threshold pair
+  /// joins are one from then on. false = GH97 as published: a small part may contract to nothing.
+  bool keep_components = true;
+  /// Prune rule: components whose bounding-box diagonal is below this distance are removed whole
+  /// before the first contraction (0 = none). A size rule rather than one tied to the running
+  /// error, so what is removed does not depend on the target or the order of contractions.
+  double prune_size = 0;
+  bool prune_size_is_relative = false;  ///< prune_size is a fraction of the bounding-box diagonal
   /// Per input vertex (empty: none), nonzero = locked: it never moves and is never removed (the
   /// other end of a contraction comes to it). With attributes, a position is locked when any of
   /// its vertices is. The caller's buffer must outlive the call.
@@ -161,6 +176,12 @@ struct SimplifyResult {
   std::size_t virtual_pairs = 0;    ///< non-edge pairs found with the threshold t
   /// Candidate contractions popped from the heap and refused (each may be retried later).
   std::size_t rejected_topology = 0, rejected_inversion = 0, rejected_error = 0;
+  /// ... and refused because a connected component would have dropped below its floor
+  /// (SimplifyOptions::keep_components).
+  std::size_t rejected_component = 0;
+  /// Connected components (vertex-connected, of the welded working mesh) of the input and of the
+  /// output, and how many the prune rule removed (SimplifyOptions::prune_size).
+  std::size_t input_components = 0, output_components = 0, pruned_components = 0;
   double max_error = 0;             ///< largest contraction error performed (distance units)
   double max_error_relative = 0;    ///< the same over the bounding-box diagonal
   StopReason stop_reason = StopReason::TargetReached;

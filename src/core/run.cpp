@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <optional>
 
+#include "core/component_guard.h"
 #include "core/context.h"
 #include "core/fundamental_quadrics.h"
 #include "core/order_greedy.h"
@@ -63,6 +64,10 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   if (!options.vertex_lock.empty()) lock_vertices(options.vertex_lock, input, wedges ? &*wedges : nullptr, mesh);
   result.input_faces = mesh.faces_alive, result.input_vertices = mesh.vertices_alive;
   result.dropped_degenerate_faces = mesh.dropped_degenerate, result.dropped_duplicate_faces = mesh.dropped_duplicate;
+  const Settings settings = resolve(options, mesh);  // targets from the input, before any pruning
+  result.input_components = count_components(mesh);
+  if (settings.prune_size > 0)
+    result.pruned_components = prune_components(mesh, wedges ? &*wedges : nullptr, settings.prune_size);
   std::optional<ContractionMap> map;
   if (options.map_input_vertices || hooks.map_input_vertices) map.emplace(input.vertex_count(), mesh.source_vertex);
   if (hooks.consumed_indices) {
@@ -70,7 +75,6 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
     input.indices = {};
     std::vector<std::uint32_t>().swap(*hooks.consumed_indices);
   }
-  const Settings settings = resolve(options, mesh);
   if (hooks.observer) hooks.observer->on_start(mesh.face_source);
 
   std::vector<Quadric> quadric;
@@ -81,6 +85,7 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   if (c.done()) {
     result.stop_reason = StopReason::AlreadyBelowTarget;
     result.stop_detail = stop_detail(result.stop_reason, result, settings.lock_border);
+    result.output_components = count_components(mesh);
     finish(c, map, input, result);
     return result;
   }
@@ -94,6 +99,8 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   pairs = select_pairs(mesh, std::move(edges), settings.threshold);                         // GH97 §3.2
   result.virtual_pairs = pairs.virtual_count;
   c.marks.assign(mesh.vertex_count(), 0);
+  std::optional<ComponentGuard> components;  // after add_boundary_planes: it tells closed from open
+  if (settings.keep_components) c.components = &components.emplace(mesh);
 
   result.stop_reason = StopReason::TargetReached;  // GH97 §4: contract until a stop criterion holds
   if (settings.scheme == Scheme::Passes) {
@@ -107,6 +114,7 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   result.max_error_relative = c.max_error;
   result.max_error = c.max_error * mesh.frame.scale;
   result.stop_detail = stop_detail(result.stop_reason, result, settings.lock_border);
+  result.output_components = count_components(mesh);
   finish(c, map, input, result);
   return result;
 }
