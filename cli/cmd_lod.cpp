@@ -4,7 +4,8 @@
 // byte-identical to `qem simplify INPUT FILE --faces <level target>` with the same options
 // (with a refit, the default's light one or --refit's, each level is refitted to the input after
 // it is rebuilt, as simplify refits its output).
-// Writes the levels and a manifest.json that `qem view` shows as a chain with a slider.
+// Writes the levels and a manifest.json that `qem view` shows as a chain with a slider. A glTF
+// input gives glTF levels by default: one whole document per level (run_lod_gltf says why).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -82,8 +83,9 @@ int run_lod_gltf(const LodArgs& a, const SimplifyOptions& opt) {
                 ", \"target_faces\": " + std::to_string(targets[i]) + ", \"primitives_simplified\": " +
                 std::to_string(r.simplified) + "}" + (i + 1 < targets.size() ? ",\n" : "\n");
     if (!a.quiet)
-      std::fprintf(stderr, "qem: level %zu faces (%zu primitives simplified), max error %.4g in world units\n",
-                   r.faces_out, r.simplified, r.max_world_error);
+      std::fprintf(stderr,
+                   "qem: level %zu faces (target %zu; %zu primitives simplified), max error %.4g in world units\n",
+                   r.faces_out, targets[i], r.simplified, r.max_world_error);
   }
   manifest += "  ]\n}\n";
   io::write_file_atomic((fs::path(a.outdir) / "manifest.json").string(), manifest);
@@ -225,13 +227,16 @@ int run_lod_mesh(const LodArgs& a) {
 const bool registered = register_command(13, [](CLI::App& app) {
   auto args = std::make_shared<LodArgs>();
   CLI::App* sub = app.add_subcommand(
-      "lod", "Write an LOD chain from a single recorded simplification, with a manifest for `qem view`");
+      "lod",
+      "Write an LOD chain from a single recorded simplification, with a manifest for `qem view`; a glTF "
+      "input gives one whole glTF document per level");
   sub->add_option("input", args->input, "Input mesh (.obj .ply .stl .off .glb .gltf)")->required();
   sub->add_option("outdir", args->outdir, "Folder for the levels and manifest.json (created if needed)")
       ->required();
   auto* ratios =
       sub->add_option("--ratios", args->ratios,
-                      "Levels as fractions of the input faces, comma separated (e.g. 0.5,0.25,0.1)")
+                      "Levels as fractions of the input faces (glTF: of its simplifiable primitives' faces), comma "
+                      "separated (e.g. 0.5,0.25,0.1)")
           ->delimiter(',');
   sub->add_option("--faces,-f", args->faces, "Levels as face counts, comma separated (e.g. 50000,10000,1000)")
       ->delimiter(',')

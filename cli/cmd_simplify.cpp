@@ -68,13 +68,18 @@ int run_simplify_gltf(const SimplifyArgs& a, const SimplifyOptions& opt) {
   for (const std::string& n : doc.notes()) std::fprintf(stderr, "qem: note: %s\n", n.c_str());
   std::size_t out_vertices = 0;
   for (const GltfPrimitiveInfo& p : doc.primitives()) out_vertices += p.vertex_count;
+  // Primitives that ran out of allowed contractions (locked borders, topology, inversion) before
+  // their target: the scene's target may then be missed, which the summary says.
+  std::size_t stopped_early = 0;
+  for (const GltfPrimitiveOutcome& o : r.primitives)
+    stopped_early += o.status == GltfPrimitiveOutcome::Status::Simplified && o.stop_reason == StopReason::NoValidPair;
   if (a.json)
     std::printf(
         "{\"tool\":\"qem\",\"format\":\"gltf\",\"per_mesh\":%s,\"primitives\":%zu,\"simplified\":%zu,"
-        "\"unchanged\":%zu,\"kept\":%zu,\"in_faces\":%zu,\"target_faces\":%zu,\"out_faces\":%zu,"
+        "\"unchanged\":%zu,\"kept\":%zu,\"stopped_early\":%zu,\"in_faces\":%zu,\"target_faces\":%zu,\"out_faces\":%zu,"
         "\"out_vertices\":%zu,\"max_error\":%s,\"world_threshold\":%s,\"load_s\":%s,\"simplify_s\":%s,"
         "\"write_s\":%s,\"total_s\":%s,\"peak_rss_mb\":%s}\n",
-        a.per_mesh ? "true" : "false", r.primitives.size(), r.simplified, r.unchanged, r.kept, r.faces_in,
+        a.per_mesh ? "true" : "false", r.primitives.size(), r.simplified, r.unchanged, r.kept, stopped_early, r.faces_in,
         r.target_faces, r.faces_out, out_vertices, json_number(r.max_world_error).c_str(),
         json_number(r.world_threshold).c_str(), json_number(load_s).c_str(), json_number(simplify_s).c_str(),
         json_number(write_s).c_str(), json_number(total.seconds()).c_str(), json_number(peak_rss_mb()).c_str());
@@ -84,6 +89,11 @@ int run_simplify_gltf(const SimplifyArgs& a, const SimplifyOptions& opt) {
                  "they were), max error %.4g in world units, %.3f s; the rest of the document is unchanged\n",
                  r.faces_in, r.faces_out, r.primitives.size(), r.simplified, r.unchanged, r.kept, r.max_world_error,
                  total.seconds());
+  if (!a.quiet && stopped_early > 0)
+    std::fprintf(stderr,
+                 "qem: %zu primitive%s stopped before %s target: no contraction left that keeps the topology, "
+                 "the borders and the face orientations\n",
+                 stopped_early, stopped_early == 1 ? "" : "s", a.per_mesh ? "its" : "the scene's");
   return 0;
 }
 
@@ -193,8 +203,9 @@ const bool registered = register_command(10, [](CLI::App& app) {
   g->add_option("--ratio,-r", args->ratio, "Stop at or below this fraction of the input faces");
   g->add_option("--vertices", args->vertices, "Stop at or below this many vertices");
   g->add_option("--max-error", args->max_error,
-                "Never make a contraction whose error exceeds this distance (model units): the error is "
-                "sqrt(Q(v)/weight), the weighted RMS distance of the new vertex to the planes it represents");
+                "Never make a contraction whose error exceeds this distance (model units; world units for a glTF "
+                "document): the error is sqrt(Q(v)/weight), the weighted RMS distance of the new vertex to "
+                "the planes it represents");
   g->add_option("--max-error-rel", args->max_error_rel, "As --max-error, relative to the bounding-box diagonal");
   add_algorithm_options(sub, args->algorithm);
   sub->add_flag("--ascii", args->ascii, "Write PLY / STL as text instead of binary");

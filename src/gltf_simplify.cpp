@@ -67,6 +67,7 @@ class ErrorCurve : public SimplifyObserver {
 
   std::size_t initial = 0;
   std::vector<double> errors, running_max;
+  StopReason stop_reason = StopReason::TargetReached;  // of the watched run
   std::vector<std::size_t> faces;
 
  private:
@@ -142,17 +143,31 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
     // 1. Watched runs down to a floor: a quarter of the scene's ratio on every primitive, so that
     // any threshold the target needs lies on every curve unless a primitive cannot go further.
     const double floor_ratio = face_target && total_faces > 0 ? 0.25 * double(target) / double(total_faces) : 0;
-    for (std::size_t j = 0; j < jobs.size(); ++j) curves.emplace_back(info[jobs[j]].world_scale);
-    for_each_job(jobs.size(), threads, [&](std::size_t j) {
+    auto watch = [&](std::size_t j, std::size_t floor_faces) {
+      curves[j] = ErrorCurve(info[jobs[j]].world_scale);
       SimplifyOptions o = options;
       o.target_ratio = 0, o.target_vertices = 0;
-      o.target_faces = std::max<std::size_t>(1, static_cast<std::size_t>(floor_ratio * double(info[jobs[j]].face_count)));
+      o.target_faces = std::max<std::size_t>(1, floor_faces);
       o.max_error = local_error(world_max_error, info[jobs[j]].world_scale);
       o.max_error_is_relative = false;
       o.refit_rounds = 0;  // the curve is the contractions'; the final run refits
       o.threads = inner_threads;
-      simplify(meshes[j], o, &curves[j]);
+      curves[j].stop_reason = simplify(meshes[j], o, &curves[j]).stop_reason;
+    };
+    for (std::size_t j = 0; j < jobs.size(); ++j) curves.emplace_back(info[jobs[j]].world_scale);
+    for_each_job(jobs.size(), threads, [&](std::size_t j) {
+      watch(j, static_cast<std::size_t>(floor_ratio * double(info[jobs[j]].face_count)));
     });
+    // When primitives that can go no further keep the scene above its target, those that stopped at
+    // the floor are watched again to the end, so that they take the rest of the reduction.
+    std::size_t at_floor = 0;
+    for (const ErrorCurve& c : curves) at_floor += c.faces.empty() ? c.initial : c.faces.back();
+    if (face_target && at_floor > target) {
+      std::vector<std::size_t> again;
+      for (std::size_t j = 0; j < jobs.size(); ++j)
+        if (curves[j].stop_reason == StopReason::TargetReached) again.push_back(j);
+      for_each_job(again.size(), threads, [&](std::size_t k) { watch(again[k], 1); });
+    }
 
     // 2. The smallest world threshold at which the primitives together meet the face target
     // (their faces only fall as it grows); without a face target, the error limit itself.
@@ -232,6 +247,11 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
     o.world_error = r.max_error * o.world_scale;
     o.stop_reason = r.stop_reason;
     if (!curves.empty() && r.contractions < curves[j].errors.size()) o.next_world_error = curves[j].errors[r.contractions];
+    // A final run that made every contraction of its watched run met its face target there, but
+    // it stopped because no contraction was left when the watched run did.
+    if (!curves.empty() && r.contractions >= curves[j].errors.size() &&
+        curves[j].stop_reason == StopReason::NoValidPair)
+      o.stop_reason = StopReason::NoValidPair;
     doc.replace(jobs[j], std::move(r.mesh));
   }
   report.faces_out = 0;
