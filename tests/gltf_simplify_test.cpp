@@ -285,6 +285,23 @@ TEST(GltfSimplifyCli, KeepsTheDocumentAndNotesKeptPrimitives) {
   EXPECT_EQ(doc.primitives()[0].face_count, 5120u);
   EXPECT_LE(doc.primitives()[1].face_count, 1024u);
   EXPECT_FALSE(doc.primitives()[0].simplifiable);
+  // --json: the counts, and each primitive.
+  const std::string out_json = dir + "/out.json";
+  ASSERT_EQ(std::system((std::string(QEM_CLI_PATH) + " simplify '" + in + "' '" + out +
+                         "' --ratio 0.2 --json -q > '" + out_json + "' 2> /dev/null")
+                            .c_str()),
+            0);
+  const json report = json::parse(qem::test::slurp(out_json));
+  EXPECT_EQ(report["format"], "gltf");
+  EXPECT_EQ(report["simplified"], 1);
+  EXPECT_EQ(report["kept"], 1);
+  EXPECT_EQ(report["in_faces"], 10240);
+  EXPECT_EQ(report["out_faces"].get<std::size_t>(), 5120 + doc.primitives()[1].face_count);
+  ASSERT_EQ(report["each"].size(), 2u);
+  EXPECT_EQ(report["each"][0]["status"], "kept");
+  EXPECT_EQ(report["each"][1]["status"], "simplified");
+  EXPECT_EQ(report["each"][1]["out_faces"].get<std::size_t>(), doc.primitives()[1].face_count);
+  EXPECT_NEAR(report["each"][1]["world_scale"].get<double>(), 100, 1e-9);
   // --per-mesh on a non-glTF output is refused.
   EXPECT_NE(run_qem("simplify '" + in + "' '" + dir + "/x.ply' --ratio 0.5 --per-mesh", &err), 0);
   EXPECT_NE(err.find("--per-mesh"), std::string::npos) << err;
