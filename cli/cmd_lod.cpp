@@ -4,7 +4,8 @@
 // byte-identical to `qem simplify INPUT FILE --faces <level target>` with the same options
 // (with a refit, the default's light one or --refit's, each level is refitted to the input after
 // it is rebuilt, as simplify refits its output).
-// Writes the levels and a manifest.json that `qem view` shows as a chain with a slider.
+// Writes the levels and a manifest.json that `qem view` shows as a chain with a slider. A glTF
+// input gives glTF levels by default: one whole document per level (run_lod_gltf says why).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -78,21 +79,26 @@ int run_lod_gltf(const LodArgs& a, const SimplifyOptions& opt) {
     std::size_t vertices = 0;
     for (const GltfPrimitiveInfo& p : doc.primitives()) vertices += p.vertex_count;
     manifest += "    {\"path\": " + json_string(file) + ", \"faces\": " + std::to_string(r.faces_out) +
-                ", \"vertices\": " + std::to_string(vertices) + ", \"error\": " + json_number(r.max_world_error) +
-                ", \"target_faces\": " + std::to_string(targets[i]) + ", \"primitives_simplified\": " +
-                std::to_string(r.simplified) + "}" + (i + 1 < targets.size() ? ",\n" : "\n");
+                ", \"vertices\": " + std::to_string(vertices) +
+                ", \"error\": " + json_number(r.max_world_error) +
+                ", \"target_faces\": " + std::to_string(targets[i]) +
+                ", \"primitives_simplified\": " + std::to_string(r.simplified) + "}" +
+                (i + 1 < targets.size() ? ",\n" : "\n");
     if (!a.quiet)
-      std::fprintf(stderr, "qem: level %zu faces (%zu primitives simplified), max error %.4g in world units\n",
-                   r.faces_out, r.simplified, r.max_world_error);
+      std::fprintf(
+          stderr,
+          "qem: level %zu faces (target %zu; %zu primitives simplified), max error %.4g in world units\n",
+          r.faces_out, targets[i], r.simplified, r.max_world_error);
   }
   manifest += "  ]\n}\n";
   io::write_file_atomic((fs::path(a.outdir) / "manifest.json").string(), manifest);
   for (const std::string& n : input.notes()) std::fprintf(stderr, "qem: note: %s\n", n.c_str());
   if (a.json)
-    std::printf("{\"tool\":\"qem lod\",\"format\":\"gltf\",\"in_faces\":%zu,\"levels\":%zu,\"cpu_s\":%s,"
-                "\"total_s\":%s,\"peak_rss_mb\":%s}\n",
-                base_faces, targets.size(), json_number(process_cpu_seconds() - cpu_start).c_str(),
-                json_number(total.seconds()).c_str(), json_number(peak_rss_mb()).c_str());
+    std::printf(
+        "{\"tool\":\"qem lod\",\"format\":\"gltf\",\"in_faces\":%zu,\"levels\":%zu,\"cpu_s\":%s,"
+        "\"total_s\":%s,\"peak_rss_mb\":%s}\n",
+        base_faces, targets.size(), json_number(process_cpu_seconds() - cpu_start).c_str(),
+        json_number(total.seconds()).c_str(), json_number(peak_rss_mb()).c_str());
   if (!a.quiet)
     std::fprintf(stderr, "qem: %zu glTF levels, each a whole document, %.3f s total\n", targets.size(),
                  total.seconds());
@@ -110,7 +116,8 @@ int run_lod(const LodArgs& a) {
   if (args.format.empty()) args.format = gltf_input ? "glb" : "ply";
   const bool gltf_levels = args.format == "glb" || args.format == "gltf";
   if (gltf_levels && !gltf_input)
-    throw Error("--format " + args.format + ": glTF levels are made from a glTF input (.glb / .gltf), whose "
+    throw Error("--format " + args.format +
+                ": glTF levels are made from a glTF input (.glb / .gltf), whose "
                 "document they keep; give --format ply, obj, stl or off for this input");
   if (a.per_mesh && !gltf_levels) throw Error("--per-mesh applies to glTF levels (a .glb / .gltf input)");
   if (gltf_levels) {
@@ -192,8 +199,7 @@ int run_lod_mesh(const LodArgs& a) {
   std::string manifest = "{\n  \"generator\": \"qem lod\",\n  \"source\": " +
                          json_string(fs::path(a.input).filename().string()) +
                          ",\n  \"input_faces\": " + std::to_string(base_faces) +
-                         ",\n  \"input_vertices\": " + std::to_string(base_vertices) +
-                         ",\n  \"levels\": [\n";
+                         ",\n  \"input_vertices\": " + std::to_string(base_vertices) + ",\n  \"levels\": [\n";
   for (std::size_t i = 0; i < levels.size(); ++i) {
     const ReplayLevel& l = levels[i];
     const std::string file = stem + "_lod" + std::to_string(i) + "." + a.format;
@@ -213,10 +219,9 @@ int run_lod_mesh(const LodArgs& a) {
     std::printf(
         "{\"tool\":\"qem lod\",\"in_faces\":%zu,\"levels\":%zu,\"simplify_cpu_s\":%s,\"replay_cpu_s\":%s,"
         "\"write_cpu_s\":%s,\"cpu_s\":%s,\"total_s\":%s,\"peak_rss_mb\":%s}\n",
-        base_faces, levels.size(), json_number(simplify_cpu).c_str(),
-        json_number(replay_cpu).c_str(), json_number(write_cpu).c_str(),
-        json_number(process_cpu_seconds() - cpu_start).c_str(), json_number(total.seconds()).c_str(),
-        json_number(peak_rss_mb()).c_str());
+        base_faces, levels.size(), json_number(simplify_cpu).c_str(), json_number(replay_cpu).c_str(),
+        json_number(write_cpu).c_str(), json_number(process_cpu_seconds() - cpu_start).c_str(),
+        json_number(total.seconds()).c_str(), json_number(peak_rss_mb()).c_str());
   if (!a.quiet) {
     for (const ReplayLevel& l : levels)
       std::fprintf(stderr, "qem: level %zu faces, %zu vertices, max error %.4g\n", l.mesh.face_count(),
@@ -231,14 +236,16 @@ int run_lod_mesh(const LodArgs& a) {
 const bool registered = register_command(13, [](CLI::App& app) {
   auto args = std::make_shared<LodArgs>();
   CLI::App* sub = app.add_subcommand(
-      "lod", "Write an LOD chain from a single recorded simplification, with a manifest for `qem view`");
+      "lod",
+      "Write an LOD chain from a single recorded simplification, with a manifest for `qem view`; a glTF "
+      "input gives one whole glTF document per level");
   sub->add_option("input", args->input, "Input mesh (.obj .ply .stl .off .glb .gltf)")->required();
   sub->add_option("outdir", args->outdir, "Folder for the levels and manifest.json (created if needed)")
       ->required();
   auto* ratios =
       sub->add_option("--ratios", args->ratios,
-                      "Levels as fractions of the input faces, comma separated (e.g. 0.5,0.25,0.1); 0 = as far as the "
-                      "checks allow")
+                      "Levels as fractions of the input faces (glTF: of its simplifiable primitives' faces), comma "
+                      "separated (e.g. 0.5,0.25,0.1); 0 = as far as the checks allow (not for glTF levels)")
           ->delimiter(',');
   sub->add_option("--faces,-f", args->faces, "Levels as face counts, comma separated (e.g. 50000,10000,1000); 0 = as far as the checks allow")
       ->delimiter(',')

@@ -29,7 +29,7 @@ struct SimplifyArgs {
   bool ascii = false, json = false, quiet = false, force = false;
   bool double_values = false;  // --double
   bool per_mesh = false;       // --per-mesh (glTF documents)
-  std::string record;  // --record: the contraction sequence (docs/record-format.md)
+  std::string record;          // --record: the contraction sequence (docs/record-format.md)
 };
 
 // Shows the progress on a terminal and, with --record, keeps the contractions.
@@ -56,11 +56,13 @@ int run_simplify_gltf(const SimplifyArgs& a, const SimplifyOptions& opt) {
   GltfDocument doc = GltfDocument::load(a.input);
   const double load_s = t_load.seconds();
   Stopwatch t_simplify;
+  const double cpu0 = process_cpu_seconds();
   GltfSimplifyOptions gltf_options;
   gltf_options.per_primitive = a.per_mesh;
   gltf_options.threads = a.algorithm.threads;
   const GltfSimplifyReport r = simplify_document(doc, opt, gltf_options);
   const double simplify_s = t_simplify.seconds();
+  const double simplify_cpu_s = process_cpu_seconds() - cpu0;
   Stopwatch t_write;
   doc.save(a.output);
   const double write_s = t_write.seconds();
@@ -69,35 +71,67 @@ int run_simplify_gltf(const SimplifyArgs& a, const SimplifyOptions& opt) {
   for (const std::string& n : doc.notes()) std::fprintf(stderr, "qem: note: %s\n", n.c_str());
   std::size_t out_vertices = 0;
   for (const GltfPrimitiveInfo& p : doc.primitives()) out_vertices += p.vertex_count;
-  if (a.json)
+  // Primitives that ran out of allowed contractions (locked borders, topology, inversion) before
+  // their target: the scene's target may then be missed, which the summary says.
+  std::size_t stopped_early = 0;
+  for (const GltfPrimitiveOutcome& o : r.primitives)
+    stopped_early +=
+        o.status == GltfPrimitiveOutcome::Status::Simplified && o.stop_reason == StopReason::NoValidPair;
+  if (a.json) {
+    // Each primitive: where it is in the document, what happened to it, its error in world units.
+    std::string each;
+    for (const GltfPrimitiveOutcome& o : r.primitives) {
+      const GltfPrimitiveInfo& p = doc.primitives()[o.primitive];
+      const char* status = o.status == GltfPrimitiveOutcome::Status::Simplified  ? "simplified"
+                           : o.status == GltfPrimitiveOutcome::Status::Unchanged ? "unchanged"
+                                                                                 : "kept";
+      each += std::string(each.empty() ? "" : ",") + "{\"mesh\":" + std::to_string(p.mesh) +
+              ",\"primitive\":" + std::to_string(p.primitive) + ",\"status\":\"" + status +
+              "\",\"in_faces\":" + std::to_string(o.faces_in) +
+              ",\"out_faces\":" + std::to_string(o.faces_out) +
+              ",\"world_scale\":" + json_number(o.world_scale) +
+              ",\"world_error\":" + json_number(o.world_error) + ",\"stop\":\"" +
+              (o.status == GltfPrimitiveOutcome::Status::Simplified ? to_string(o.stop_reason) : "") + "\"}";
+    }
     std::printf(
         "{\"tool\":\"qem\",\"format\":\"gltf\",\"per_mesh\":%s,\"primitives\":%zu,\"simplified\":%zu,"
-        "\"unchanged\":%zu,\"kept\":%zu,\"in_faces\":%zu,\"target_faces\":%zu,\"out_faces\":%zu,"
+        "\"unchanged\":%zu,\"kept\":%zu,\"stopped_early\":%zu,\"in_faces\":%zu,\"target_faces\":%zu,"
+        "\"out_faces\":%zu,"
         "\"out_vertices\":%zu,\"max_error\":%s,\"world_threshold\":%s,\"load_s\":%s,\"simplify_s\":%s,"
-        "\"write_s\":%s,\"total_s\":%s,\"peak_rss_mb\":%s}\n",
-        a.per_mesh ? "true" : "false", r.primitives.size(), r.simplified, r.unchanged, r.kept, r.faces_in,
-        r.target_faces, r.faces_out, out_vertices, json_number(r.max_world_error).c_str(),
+        "\"simplify_cpu_s\":%s,\"write_s\":%s,\"total_s\":%s,\"peak_rss_mb\":%s,\"each\":[%s]}\n",
+        a.per_mesh ? "true" : "false", r.primitives.size(), r.simplified, r.unchanged, r.kept, stopped_early,
+        r.faces_in, r.target_faces, r.faces_out, out_vertices, json_number(r.max_world_error).c_str(),
         json_number(r.world_threshold).c_str(), json_number(load_s).c_str(), json_number(simplify_s).c_str(),
-        json_number(write_s).c_str(), json_number(total.seconds()).c_str(), json_number(peak_rss_mb()).c_str());
+        json_number(simplify_cpu_s).c_str(), json_number(write_s).c_str(),
+        json_number(total.seconds()).c_str(), json_number(peak_rss_mb()).c_str(), each.c_str());
+  }
   if (!a.quiet)
     std::fprintf(stderr,
                  "qem: %zu -> %zu faces in %zu primitives (%zu simplified, %zu needed no change, %zu kept as "
                  "they were), max error %.4g in world units, %.3f s; the rest of the document is unchanged\n",
-                 r.faces_in, r.faces_out, r.primitives.size(), r.simplified, r.unchanged, r.kept, r.max_world_error,
-                 total.seconds());
+                 r.faces_in, r.faces_out, r.primitives.size(), r.simplified, r.unchanged, r.kept,
+                 r.max_world_error, total.seconds());
+  if (!a.quiet && stopped_early > 0)
+    std::fprintf(
+        stderr,
+        "qem: %zu primitive%s stopped before %s target: no contraction left that keeps the topology, "
+        "the borders and the face orientations\n",
+        stopped_early, stopped_early == 1 ? "" : "s", a.per_mesh ? "its" : "the scene's");
   return 0;
 }
 
 int run_simplify(const SimplifyArgs& a) {
   refuse_to_overwrite(a.input, a.output, a.force);
   SimplifyOptions opt = to_simplify_options(a.algorithm);
-  const bool gltf_document =
-      format_from_extension(a.input) == FileFormat::Gltf && format_from_extension(a.output) == FileFormat::Gltf;
+  const bool gltf_document = format_from_extension(a.input) == FileFormat::Gltf &&
+                             format_from_extension(a.output) == FileFormat::Gltf;
   if (a.per_mesh && !gltf_document)
-    throw Error("--per-mesh applies to glTF documents (.glb / .gltf in and out): other formats hold one mesh");
+    throw Error(
+        "--per-mesh applies to glTF documents (.glb / .gltf in and out): other formats hold one mesh");
   if (gltf_document && !a.record.empty())
-    throw Error("--record keeps one mesh's contractions, and a glTF document is simplified primitive by "
-                "primitive: simplify without --record, or write a single mesh (e.g. .ply) to record it");
+    throw Error(
+        "--record keeps one mesh's contractions, and a glTF document is simplified primitive by "
+        "primitive: simplify without --record, or write a single mesh (e.g. .ply) to record it");
   // A record replays the contractions, and a refit moves every vertex after them, so `qem replay`
   // could not give back what simplify wrote: with --record there is no refit (not the default's).
   if (!a.record.empty() && a.algorithm.refit_asked())
@@ -125,7 +159,8 @@ int run_simplify(const SimplifyArgs& a) {
   const double load_s = t_load.seconds();
   if (!a.record.empty() && !mesh.attributes.empty())
     throw Error(a.input + ": --record keeps positions and faces only, and this mesh has attributes (" +
-                mesh.attributes.front().name + ", ...) that a replay would lose; simplify without --record, or " +
+                mesh.attributes.front().name +
+                ", ...) that a replay would lose; simplify without --record, or " +
                 "use `qem lod`, which makes each level with its attributes");
 
   Stopwatch t_simplify;
@@ -133,7 +168,8 @@ int run_simplify(const SimplifyArgs& a) {
   Watcher watcher(show_progress, !a.record.empty());
   const std::size_t in_faces = mesh.face_count();
   // Without a record the input's faces are not needed afterwards: let the simplifier free them.
-  SimplifyResult r = a.record.empty() ? simplify(std::move(mesh), opt, &watcher) : simplify(mesh, opt, &watcher);
+  SimplifyResult r =
+      a.record.empty() ? simplify(std::move(mesh), opt, &watcher) : simplify(mesh, opt, &watcher);
   const double simplify_s = t_simplify.seconds();
   const double simplify_cpu_s = process_cpu_seconds() - cpu0;
   if (show_progress) std::fprintf(stderr, "\n");
@@ -176,8 +212,8 @@ int run_simplify(const SimplifyArgs& a) {
                  r.pruned_components > 0 ? (" (" + std::to_string(r.pruned_components) + " pruned)").c_str() : "",
                  r.max_error, r.max_error_relative, total.seconds(), r.stop_detail.c_str());
   if (!a.quiet && r.dropped_degenerate_faces + r.dropped_duplicate_faces > 0)
-    std::fprintf(stderr, "qem: left out %zu degenerate and %zu duplicate input faces\n", r.dropped_degenerate_faces,
-                 r.dropped_duplicate_faces);
+    std::fprintf(stderr, "qem: left out %zu degenerate and %zu duplicate input faces\n",
+                 r.dropped_degenerate_faces, r.dropped_duplicate_faces);
   if (!a.quiet && opt.refit_rounds > 0)
     std::fprintf(stderr, "qem: refit in %zu round%s: RMS distance of the input's vertices %.4g -> %.4g\n",
                  r.refit_rounds, r.refit_rounds == 1 ? "" : "s", r.refit_rms_before, r.refit_rms_after);
@@ -203,7 +239,7 @@ const bool registered = register_command(10, [](CLI::App& app) {
                 "Stop at or below this fraction of the input faces, in [0, 1]; 0 = as far as the checks allow");
   g->add_option("--vertices", args->vertices, "Stop at or below this many vertices; 0 = as far as the checks allow");
   g->add_option("--max-error", args->max_error,
-                "Never make a contraction whose error exceeds this distance (model units): the error is "
+                "Never make a contraction whose error exceeds this distance (model units; world units for a glTF document): the error is "
                 "sqrt(Q(v)/weight), the weighted RMS distance of the new vertex to the planes it represents; "
                 "0 = only contractions without error (flat, straight parts)");
   g->add_option("--max-error-rel", args->max_error_rel,
@@ -211,7 +247,9 @@ const bool registered = register_command(10, [](CLI::App& app) {
   add_algorithm_options(sub, args->algorithm);
   sub->add_flag("--ascii", args->ascii, "Write PLY / STL as text instead of binary");
   sub->add_flag("--double", args->double_values, kDoubleOutputHelp);
-  sub->add_flag("--json", args->json, "Print one JSON line with counts, timings, memory and error on stdout");
+  sub->add_flag("--json", args->json,
+                "Print one JSON line with counts, timings, memory and error on stdout (glTF documents: also "
+                "\"each\", one entry per primitive)");
   sub->add_flag("--quiet,-q", args->quiet, "No progress and no summary on stderr");
   sub->add_flag("--per-mesh", args->per_mesh,
                 "glTF: apply the target to each primitive on its own (--ratio 0.5 halves every one) "

@@ -67,6 +67,7 @@ class ErrorCurve : public SimplifyObserver {
 
   std::size_t initial = 0;
   std::vector<double> errors, running_max;
+  StopReason stop_reason = StopReason::TargetReached;  // of the watched run
   std::vector<std::size_t> faces;
 
  private:
@@ -131,89 +132,118 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
     std::size_t target = std::numeric_limits<std::size_t>::max();
     if (options.target_faces > 0) target = std::min(target, options.target_faces);
     if (options.target_ratio > 0)
-      target = std::min(target, static_cast<std::size_t>(std::floor(options.target_ratio * double(total_faces))));
+      target =
+          std::min(target, static_cast<std::size_t>(std::floor(options.target_ratio * double(total_faces))));
     if (options.target_vertices > 0 && total_vertices > 0)
-      target = std::min(target, static_cast<std::size_t>(std::floor(double(total_faces) *
-                                                                    double(options.target_vertices) /
-                                                                    double(total_vertices))));
+      target = std::min(
+          target, static_cast<std::size_t>(std::floor(double(total_faces) * double(options.target_vertices) /
+                                                      double(total_vertices))));
     const bool face_target = target != std::numeric_limits<std::size_t>::max();
     report.target_faces = face_target ? target : total_faces;
 
-    // 1. Watched runs down to a floor: a quarter of the scene's ratio on every primitive, so that
-    // any threshold the target needs lies on every curve unless a primitive cannot go further.
-    const double floor_ratio = face_target && total_faces > 0 ? 0.25 * double(target) / double(total_faces) : 0;
-    for (std::size_t j = 0; j < jobs.size(); ++j) curves.emplace_back(info[jobs[j]].world_scale);
-    for_each_job(jobs.size(), threads, [&](std::size_t j) {
+    if (jobs.size() == 1) {
+      // One primitive: the scene's target is its own, and there is nothing to share.
       SimplifyOptions o = options;
       o.target_ratio = 0, o.target_vertices = 0;
-      o.target_faces = std::max<std::size_t>(1, static_cast<std::size_t>(floor_ratio * double(info[jobs[j]].face_count)));
-      o.max_error = local_error(world_max_error, info[jobs[j]].world_scale);
+      o.target_faces = face_target ? std::max<std::size_t>(1, target) : 0;
+      o.max_error = local_error(world_max_error, info[jobs[0]].world_scale);
       o.max_error_is_relative = false;
-      o.refit_rounds = 0;  // the curve is the contractions'; the final run refits
       o.threads = inner_threads;
-      simplify(meshes[j], o, &curves[j]);
-    });
+      final_options[0] = o;
+    } else {
+      // 1. Watched runs down to a floor: a quarter of the scene's ratio on every primitive, so that
+      // any threshold the target needs lies on every curve unless a primitive cannot go further.
+      const double floor_ratio =
+          face_target && total_faces > 0 ? 0.25 * double(target) / double(total_faces) : 0;
+      auto watch = [&](std::size_t j, std::size_t floor_faces) {
+        curves[j] = ErrorCurve(info[jobs[j]].world_scale);
+        SimplifyOptions o = options;
+        o.target_ratio = 0, o.target_vertices = 0;
+        o.target_faces = std::max<std::size_t>(1, floor_faces);
+        o.max_error = local_error(world_max_error, info[jobs[j]].world_scale);
+        o.max_error_is_relative = false;
+        o.refit_rounds = 0;  // the curve is the contractions'; the final run refits
+        o.threads = inner_threads;
+        curves[j].stop_reason = simplify(meshes[j], o, &curves[j]).stop_reason;
+      };
+      for (std::size_t j = 0; j < jobs.size(); ++j) curves.emplace_back(info[jobs[j]].world_scale);
+      for_each_job(jobs.size(), threads, [&](std::size_t j) {
+        watch(j, static_cast<std::size_t>(floor_ratio * double(info[jobs[j]].face_count)));
+      });
+      // When primitives that can go no further keep the scene above its target, those that stopped at
+      // the floor are watched again to the end, so that they take the rest of the reduction.
+      std::size_t at_floor = 0;
+      for (const ErrorCurve& c : curves) at_floor += c.faces.empty() ? c.initial : c.faces.back();
+      if (face_target && at_floor > target) {
+        std::vector<std::size_t> again;
+        for (std::size_t j = 0; j < jobs.size(); ++j)
+          if (curves[j].stop_reason == StopReason::TargetReached) again.push_back(j);
+        for_each_job(again.size(), threads, [&](std::size_t k) { watch(again[k], 1); });
+      }
 
-    // 2. The smallest world threshold at which the primitives together meet the face target
-    // (their faces only fall as it grows); without a face target, the error limit itself.
-    std::vector<double> candidates{0.0};
-    for (const ErrorCurve& c : curves)
-      for (double e : c.running_max)
-        if (e <= world_max_error) candidates.push_back(e);
-    std::sort(candidates.begin(), candidates.end());
-    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
-    auto faces_at = [&](double t) {
-      std::size_t sum = 0;
-      for (const ErrorCurve& c : curves) sum += c.faces_within(t);
-      return sum;
-    };
-    std::size_t at = candidates.size() - 1;
-    if (face_target) {
-      auto it = std::partition_point(candidates.begin(), candidates.end(),
-                                     [&](double t) { return faces_at(t) > target; });
-      if (it != candidates.end()) at = static_cast<std::size_t>(it - candidates.begin());
-    }
-    const double threshold = candidates[at];
-    report.world_threshold = threshold;
-    std::vector<std::size_t> faces(jobs.size());
-    for (std::size_t j = 0; j < jobs.size(); ++j) faces[j] = curves[j].faces_within(threshold);
-    // The running maximum has plateaus: the contraction that reaches the threshold is followed by
-    // cheaper ones, all within it. The primitives that step at the threshold may stop anywhere on
-    // that step at the same error, so the faces the whole step would remove beyond the target are
-    // given back to them (in proportion, in document order): the total meets the target closely.
-    if (face_target && at > 0 && faces_at(threshold) < target) {
-      std::vector<std::size_t> step(jobs.size());
-      std::size_t steps = 0;
+      // 2. The smallest world threshold at which the primitives together meet the face target
+      // (their faces only fall as it grows); without a face target, the error limit itself.
+      std::vector<double> candidates{0.0};
+      for (const ErrorCurve& c : curves)
+        for (double e : c.running_max)
+          if (e <= world_max_error) candidates.push_back(e);
+      std::sort(candidates.begin(), candidates.end());
+      candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+      auto faces_at = [&](double t) {
+        std::size_t sum = 0;
+        for (const ErrorCurve& c : curves) sum += c.faces_within(t);
+        return sum;
+      };
+      std::size_t at = candidates.size() - 1;
+      if (face_target) {
+        auto it = std::partition_point(candidates.begin(), candidates.end(),
+                                       [&](double t) { return faces_at(t) > target; });
+        if (it != candidates.end()) at = static_cast<std::size_t>(it - candidates.begin());
+      }
+      const double threshold = candidates[at];
+      report.world_threshold = threshold;
+      std::vector<std::size_t> faces(jobs.size());
+      for (std::size_t j = 0; j < jobs.size(); ++j) faces[j] = curves[j].faces_within(threshold);
+      // The running maximum has plateaus: the contraction that reaches the threshold is followed by
+      // cheaper ones, all within it. The primitives that step at the threshold may stop anywhere on
+      // that step at the same error, so the faces the whole step would remove beyond the target are
+      // given back to them (in proportion, in document order): the total meets the target closely.
+      if (face_target && at > 0 && faces_at(threshold) < target) {
+        std::vector<std::size_t> step(jobs.size());
+        std::size_t steps = 0;
+        for (std::size_t j = 0; j < jobs.size(); ++j) {
+          const std::size_t before = curves[j].faces_within(candidates[at - 1]);
+          // Up to the faces just before the threshold's contraction, less one so that it is made.
+          step[j] = before > faces[j] ? before - faces[j] - 1 : 0;
+          steps += step[j];
+        }
+        const std::size_t slack = target - faces_at(threshold);
+        std::size_t given = 0;
+        for (std::size_t j = 0; j < jobs.size() && steps > 0; ++j) {
+          const std::size_t share =
+              std::min(step[j], static_cast<std::size_t>(double(slack) * double(step[j]) / double(steps)));
+          faces[j] += share, given += share;
+        }
+        for (std::size_t j = 0; j < jobs.size() && given < slack; ++j) {  // what rounding left over
+          const std::size_t more = std::min(
+              slack - given, step[j] - std::min(step[j], faces[j] - curves[j].faces_within(threshold)));
+          faces[j] += more, given += more;
+        }
+      }
+
+      // 3. Each primitive's final run stops at the faces found for it. It makes the same contractions
+      // as its watched run (the order depends on neither the face target nor the observer), with the
+      // same error limit, which blocks the same pairs.
       for (std::size_t j = 0; j < jobs.size(); ++j) {
-        const std::size_t before = curves[j].faces_within(candidates[at - 1]);
-        // Up to the faces just before the threshold's contraction, less one so that it is made.
-        step[j] = before > faces[j] ? before - faces[j] - 1 : 0;
-        steps += step[j];
+        if (faces[j] >= curves[j].initial) continue;  // nothing to do: left as it is
+        SimplifyOptions o = options;
+        o.target_ratio = 0, o.target_vertices = 0;
+        o.target_faces = std::max<std::size_t>(1, faces[j]);
+        o.max_error = local_error(world_max_error, info[jobs[j]].world_scale);
+        o.max_error_is_relative = false;
+        o.threads = inner_threads;
+        final_options[j] = o;
       }
-      const std::size_t slack = target - faces_at(threshold);
-      std::size_t given = 0;
-      for (std::size_t j = 0; j < jobs.size() && steps > 0; ++j) {
-        const std::size_t share = std::min(step[j], static_cast<std::size_t>(double(slack) * double(step[j]) / double(steps)));
-        faces[j] += share, given += share;
-      }
-      for (std::size_t j = 0; j < jobs.size() && given < slack; ++j) {  // what rounding left over
-        const std::size_t more = std::min(slack - given, step[j] - std::min(step[j], faces[j] - curves[j].faces_within(threshold)));
-        faces[j] += more, given += more;
-      }
-    }
-
-    // 3. Each primitive's final run stops at the faces found for it. It makes the same contractions
-    // as its watched run (the order depends on neither the face target nor the observer), with the
-    // same error limit, which blocks the same pairs.
-    for (std::size_t j = 0; j < jobs.size(); ++j) {
-      if (faces[j] >= curves[j].initial) continue;  // nothing to do: left as it is
-      SimplifyOptions o = options;
-      o.target_ratio = 0, o.target_vertices = 0;
-      o.target_faces = std::max<std::size_t>(1, faces[j]);
-      o.max_error = local_error(world_max_error, info[jobs[j]].world_scale);
-      o.max_error_is_relative = false;
-      o.threads = inner_threads;
-      final_options[j] = o;
     }
   }
 
@@ -231,9 +261,17 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
     o.max_error = r.max_error;
     o.world_error = r.max_error * o.world_scale;
     o.stop_reason = r.stop_reason;
-    if (!curves.empty() && r.contractions < curves[j].errors.size()) o.next_world_error = curves[j].errors[r.contractions];
+    if (!curves.empty() && r.contractions < curves[j].errors.size())
+      o.next_world_error = curves[j].errors[r.contractions];
+    // A final run that made every contraction of its watched run met its face target there, but
+    // it stopped because no contraction was left when the watched run did.
+    if (!curves.empty() && r.contractions >= curves[j].errors.size() &&
+        curves[j].stop_reason == StopReason::NoValidPair)
+      o.stop_reason = StopReason::NoValidPair;
     doc.replace(jobs[j], std::move(r.mesh));
   }
+  if (!gltf_options.per_primitive && jobs.size() == 1)
+    report.world_threshold = report.primitives[jobs[0]].world_error;
   report.faces_out = 0;
   for (const GltfPrimitiveOutcome& o : report.primitives) {
     report.faces_out += o.faces_out;

@@ -44,10 +44,13 @@ Glb split_glb(const std::string& bytes) {
 std::size_t component_size(int type) {
   switch (type) {
     case 5120:
-    case 5121: return 1;
+    case 5121:
+      return 1;
     case 5122:
-    case 5123: return 2;
-    default: return 4;
+    case 5123:
+      return 2;
+    default:
+      return 4;
   }
 }
 
@@ -136,7 +139,8 @@ json without_layout(json j) {
     erase_default(m, "doubleSided", false);
     for (const char* t : {"normalTexture", "occlusionTexture", "emissiveTexture"})
       if (m.contains(t))
-        erase_default(m[t], "texCoord", 0), erase_default(m[t], "scale", 1), erase_default(m[t], "strength", 1);
+        erase_default(m[t], "texCoord", 0), erase_default(m[t], "scale", 1),
+            erase_default(m[t], "strength", 1);
     if (m.contains("pbrMetallicRoughness")) {
       json& pbr = m["pbrMetallicRoughness"];
       erase_default(pbr, "baseColorFactor", json::array({1.0, 1.0, 1.0, 1.0}));
@@ -215,12 +219,14 @@ TEST_P(GltfCorpus, SimplifiedKeepsEverythingButThePrimitives) {
     if (s.contains("inverseBindMatrices")) kept_accessors.insert(s["inverseBindMatrices"].get<std::size_t>());
   for (const json& an : a.doc.value("animations", json::array()))
     for (const json& s : an["samplers"])
-      kept_accessors.insert(s["input"].get<std::size_t>()), kept_accessors.insert(s["output"].get<std::size_t>());
+      kept_accessors.insert(s["input"].get<std::size_t>()),
+          kept_accessors.insert(s["output"].get<std::size_t>());
   for (std::size_t m = 0; m < a.doc["meshes"].size(); ++m)
     for (std::size_t k = 0; k < a.doc["meshes"][m]["primitives"].size(); ++k) {
       if (replaced.count({m, k})) continue;
       const json& p = a.doc["meshes"][m]["primitives"][k];
-      for (const auto& [semantic, index] : p["attributes"].items()) kept_accessors.insert(index.get<std::size_t>());
+      for (const auto& [semantic, index] : p["attributes"].items())
+        kept_accessors.insert(index.get<std::size_t>());
       if (p.contains("indices")) kept_accessors.insert(p["indices"].get<std::size_t>());
     }
   for (std::size_t k : kept_accessors) {
@@ -238,9 +244,12 @@ TEST_P(GltfCorpus, SimplifiedKeepsEverythingButThePrimitives) {
     for (std::size_t k = 0; k < b.doc["meshes"][m]["primitives"].size(); ++k) {
       const json& attributes = b.doc["meshes"][m]["primitives"][k]["attributes"];
       ASSERT_TRUE(attributes.contains("JOINTS_0") && attributes.contains("WEIGHTS_0"));
-      const std::vector<double> j = numbers(b, attributes["JOINTS_0"]), w = numbers(b, attributes["WEIGHTS_0"]);
+      const std::vector<double> j = numbers(b, attributes["JOINTS_0"]),
+                                w = numbers(b, attributes["WEIGHTS_0"]);
       ASSERT_EQ(j.size(), w.size());
-      ASSERT_EQ(w.size(), 4 * b.doc["accessors"][attributes["POSITION"].get<std::size_t>()]["count"].get<std::size_t>());
+      ASSERT_EQ(
+          w.size(),
+          4 * b.doc["accessors"][attributes["POSITION"].get<std::size_t>()]["count"].get<std::size_t>());
       for (std::size_t v = 0; v < w.size(); v += 4) {
         EXPECT_NEAR(w[v] + w[v + 1] + w[v + 2] + w[v + 3], 1, 1e-3) << "vertex " << v / 4;
         for (int c = 0; c < 4; ++c) EXPECT_LT(j[v + c], double(joints)) << "vertex " << v / 4;

@@ -52,7 +52,9 @@ struct Scene {
     const std::size_t offset = bin.size();
     bin.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(float));
     doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", values.size() * 4}});
-    json a = {{"bufferView", doc["bufferViews"].size() - 1}, {"componentType", 5126}, {"count", count},
+    json a = {{"bufferView", doc["bufferViews"].size() - 1},
+              {"componentType", 5126},
+              {"count", count},
               {"type", type}};
     if (bounds) {
       std::vector<float> lo(3, 1e30f), hi(3, -1e30f);
@@ -197,6 +199,37 @@ TEST(GltfSimplify, WorldErrorLimitIsSharedToo) {
   }
 }
 
+TEST(GltfSimplify, VertexTargetIsTheSameFractionOfTheFaces) {
+  qem::GltfDocument doc = qem::GltfDocument::parse(two_spheres().text(), "two.gltf");
+  const std::size_t vertices = doc.primitives()[0].vertex_count + doc.primitives()[1].vertex_count;
+  qem::SimplifyOptions opt;
+  opt.target_vertices = vertices / 5;
+  const qem::GltfSimplifyReport r = qem::simplify_document(doc, opt);
+  EXPECT_EQ(r.target_faces, std::size_t(10240.0 * double(vertices / 5) / double(vertices)));
+  EXPECT_LE(r.faces_out, r.target_faces);
+  EXPECT_GT(r.faces_out, r.target_faces * 9 / 10);
+}
+
+TEST(GltfSimplify, PrimitivesAtADeadEndLeaveTheReductionToTheOthers) {
+  // 200 separate tetrahedra: no contraction keeps their topology, so their 800 faces stay; the
+  // sphere must then go below the watched run's floor (a quarter of the scene's ratio) to come
+  // as close to the target as it can.
+  Scene s;
+  qem::Mesh tetras;
+  for (int k = 0; k < 200; ++k)
+    tetras = qem::test::concatenated(
+        tetras, qem::test::transformed(qem::test::tetrahedron(), 0.05, k % 20, k / 20.0, 0));
+  s.node(s.mesh(tetras, false), 1);
+  s.node(s.mesh(qem::test::icosphere(4)), 1);
+  qem::GltfDocument doc = qem::GltfDocument::parse(s.text(), "dead_end.gltf");
+  qem::SimplifyOptions opt;
+  opt.target_ratio = 0.1;  // 592 of 5920 faces
+  const qem::GltfSimplifyReport r = qem::simplify_document(doc, opt);
+  EXPECT_EQ(r.primitives[0].faces_out, 800u);
+  EXPECT_LT(r.primitives[1].faces_out, 128u);  // 0.25 x 0.1 x 5120, the first floor
+  EXPECT_EQ(r.primitives[1].stop_reason, qem::StopReason::NoValidPair);
+}
+
 TEST(GltfSimplify, MorphTargetPrimitiveIsKeptUnchanged) {
   Scene s = two_spheres();
   // Mesh 0 gets a morph target (its normals' accessor serves as the offsets).
@@ -232,7 +265,8 @@ std::string write(const std::string& path, const std::string& bytes) {
 /// Runs `qem ARGS`, stderr to a file; gives the exit status and the stderr text.
 int run_qem(const std::string& args, std::string* err) {
   const std::string log = qem::test::temp_dir() + "/stderr.txt";
-  const int status = std::system((std::string(QEM_CLI_PATH) + " " + args + " > /dev/null 2> '" + log + "'").c_str());
+  const int status =
+      std::system((std::string(QEM_CLI_PATH) + " " + args + " > /dev/null 2> '" + log + "'").c_str());
   *err = qem::test::slurp(log);
   return status;
 }
@@ -251,6 +285,23 @@ TEST(GltfSimplifyCli, KeepsTheDocumentAndNotesKeptPrimitives) {
   EXPECT_EQ(doc.primitives()[0].face_count, 5120u);
   EXPECT_LE(doc.primitives()[1].face_count, 1024u);
   EXPECT_FALSE(doc.primitives()[0].simplifiable);
+  // --json: the counts, and each primitive.
+  const std::string out_json = dir + "/out.json";
+  ASSERT_EQ(std::system((std::string(QEM_CLI_PATH) + " simplify '" + in + "' '" + out +
+                         "' --ratio 0.2 --json -q > '" + out_json + "' 2> /dev/null")
+                            .c_str()),
+            0);
+  const json report = json::parse(qem::test::slurp(out_json));
+  EXPECT_EQ(report["format"], "gltf");
+  EXPECT_EQ(report["simplified"], 1);
+  EXPECT_EQ(report["kept"], 1);
+  EXPECT_EQ(report["in_faces"], 10240);
+  EXPECT_EQ(report["out_faces"].get<std::size_t>(), 5120 + doc.primitives()[1].face_count);
+  ASSERT_EQ(report["each"].size(), 2u);
+  EXPECT_EQ(report["each"][0]["status"], "kept");
+  EXPECT_EQ(report["each"][1]["status"], "simplified");
+  EXPECT_EQ(report["each"][1]["out_faces"].get<std::size_t>(), doc.primitives()[1].face_count);
+  EXPECT_NEAR(report["each"][1]["world_scale"].get<double>(), 100, 1e-9);
   // --per-mesh on a non-glTF output is refused.
   EXPECT_NE(run_qem("simplify '" + in + "' '" + dir + "/x.ply' --ratio 0.5 --per-mesh", &err), 0);
   EXPECT_NE(err.find("--per-mesh"), std::string::npos) << err;
@@ -266,8 +317,10 @@ TEST(GltfSimplifyCli, CompressedGeometryIsRefusedWithNoOutput) {
   const std::string in = write(dir + "/draco.gltf", s.text()), out = dir + "/draco_out.glb";
   std::string err;
   EXPECT_NE(run_qem("simplify '" + in + "' '" + out + "' --ratio 0.5", &err), 0);
-  EXPECT_NE(err.find("draco.gltf: uses KHR_draco_mesh_compression (compressed geometry), which qem does not decode"),
-            std::string::npos)
+  EXPECT_NE(
+      err.find(
+          "draco.gltf: uses KHR_draco_mesh_compression (compressed geometry), which qem does not decode"),
+      std::string::npos)
       << err;
   EXPECT_FALSE(std::filesystem::exists(out));
 }

@@ -10,7 +10,9 @@
 //     if (doc.primitives()[i].simplifiable) doc.replace(i, my_simplify(doc.mesh(i)));
 //   doc.save("out.glb");
 //
-// load_mesh (qem/io.h) on a .gltf/.glb gives the whole scene merged into one Mesh instead.
+// simplify_document (qem/gltf_simplify.h) does this with qem's simplifier and one error budget
+// shared by the scene in world units. load_mesh (qem/io.h) on a .gltf/.glb gives the whole scene
+// merged into one Mesh instead.
 #pragma once
 
 #include <cstddef>

@@ -47,9 +47,9 @@ struct GltfPrimitiveOutcome {
   std::size_t primitive = 0;  ///< index in GltfDocument::primitives()
   Status status = Status::Kept;
   std::size_t faces_in = 0, faces_out = 0;
-  double world_scale = 1;   ///< GltfPrimitiveInfo::world_scale
-  double max_error = 0;     ///< largest contraction error made, the primitive's own units
-  double world_error = 0;   ///< the same times world_scale
+  double world_scale = 1;  ///< GltfPrimitiveInfo::world_scale
+  double max_error = 0;    ///< largest contraction error made, the primitive's own units
+  double world_error = 0;  ///< the same times world_scale
   /// Shared budget: the world error of the first contraction the primitive did not make (from its
   /// watched run), +inf when that run had none left. It exceeds the threshold unless the
   /// primitive stopped on the step that reaches it (world_error is then the threshold).

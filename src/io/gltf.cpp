@@ -296,7 +296,8 @@ void GltfDocument::Impl::measure_world_scales() {
   std::vector<Mat4> world(m.nodes.size(), identity());
   std::vector<char> reached(m.nodes.size(), 0), on_path(m.nodes.size(), 0);
   auto visit = [&](auto&& self, int node, const Mat4& parent) -> void {
-    if (node < 0 || static_cast<std::size_t>(node) >= m.nodes.size() || on_path[static_cast<std::size_t>(node)])
+    if (node < 0 || static_cast<std::size_t>(node) >= m.nodes.size() ||
+        on_path[static_cast<std::size_t>(node)])
       return;
     const auto n = static_cast<std::size_t>(node);
     on_path[n] = 1;
@@ -318,7 +319,8 @@ void GltfDocument::Impl::measure_world_scales() {
       std::uint32_t components = 0;
       if (skin.inverseBindMatrices >= 0)
         ibm = read_accessor(m, skin.inverseBindMatrices,
-                            name + ": skin " + std::to_string(node.skin) + " (inverseBindMatrices)", &components);
+                            name + ": skin " + std::to_string(node.skin) + " (inverseBindMatrices)",
+                            &components);
       if (!ibm.empty() && (components != 16 || ibm.size() < 16 * skin.joints.size()))
         throw Error(name + ": skin " + std::to_string(node.skin) +
                     ": inverseBindMatrices is not one MAT4 per joint");
@@ -327,7 +329,8 @@ void GltfDocument::Impl::measure_world_scales() {
         if (joint < 0 || static_cast<std::size_t>(joint) >= m.nodes.size()) continue;
         Mat4 inverse_bind = identity();
         if (!ibm.empty()) std::copy(ibm.begin() + 16 * j, ibm.begin() + 16 * (j + 1), inverse_bind.begin());
-        scale = std::max(scale, largest_scale(multiply(world[static_cast<std::size_t>(joint)], inverse_bind)));
+        scale =
+            std::max(scale, largest_scale(multiply(world[static_cast<std::size_t>(joint)], inverse_bind)));
       }
     } else {
       scale = largest_scale(world[n]);
