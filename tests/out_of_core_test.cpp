@@ -2,8 +2,13 @@
 // on a generated mesh: face target met, no crack, E close to the in-core run's; and what a failed
 // run leaves behind (nothing). Also the streamed generator against the in-memory one.
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
+#include <chrono>
+#include <thread>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -100,6 +105,8 @@ TEST(OutOfCore, ForcedRunMeetsTargetWithoutCracksAndNearInCoreError) {
   mo.seed = 7;
   const double e_ooc = measure(input, r.mesh, mo).E, e_in = measure(input, in_core.mesh, mo).E;
   EXPECT_LE(e_ooc, 1.5 * e_in) << "out of core E " << e_ooc << " vs in core " << e_in;
+  std::printf("out of core: %llu clustered faces, E %.4g = %.3fx the in-core run's\n",
+              static_cast<unsigned long long>(report.clustered_faces), e_ooc, e_ooc / e_in);
 }
 
 TEST(OutOfCore, FullDiskMidwayLeavesNoTemporaryFile) {
@@ -225,6 +232,35 @@ TEST(OutOfCoreCli, FailedRunLeavesNoOutput) {
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.out.find("temporary folder"), std::string::npos) << r.out;
   EXPECT_EQ(entries(dir), 0u);
+}
+
+TEST(OutOfCoreCli, TerminatedRunLeavesNothing) {
+  const std::string dir = fresh_dir("cli_term"), temp = dir + "/temp", out = dir + "/out.ply";
+  fs::create_directories(temp);
+  const std::string input = big_sphere();
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    execl(QEM_CLI_PATH, "qem", "simplify", input.c_str(), out.c_str(), "--faces", "3000", "--memory-limit", "16M",
+          "--temp-dir", temp.c_str(), "--quiet", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  // SIGTERM once the clustered faces' temporary file exists: mid-way through phase 1.
+  bool seen = false;
+  for (int i = 0; i < 60000 && !seen; ++i) {
+    for (const auto& e : fs::directory_iterator(temp))
+      if (e.path().filename().string().find(".qem-faces") != std::string::npos) seen = true;
+    if (!seen) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  ASSERT_TRUE(seen);
+  kill(pid, SIGTERM);
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) GTEST_SKIP() << "the run finished before the signal";
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) << status;
+  EXPECT_EQ(entries(temp), 0u);
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_EQ(entries(dir), 1u);  // the temporary folder, empty
 }
 
 }  // namespace

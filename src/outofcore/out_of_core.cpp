@@ -39,9 +39,12 @@ using outofcore::TempFile;
 /// measured for issue 20; the decision in-core / out-of-core uses it.
 constexpr double kInCoreBytesPerFace = 180;
 /// Phase 1 per occupied cell: its quadric and corner sum (15 doubles) and its hash slot (at most
-/// half full); phase 2 per cell: about two faces of the in-core path.
+/// half full). Phase 2 per cell: about 1.6 faces (measured on the spheres), each taking the
+/// in-core path's bytes plus the clustered mesh handed to it and the pairing of its faces; 2 GB
+/// held 8 million clustered faces at 1.99 GB peak with 2 faces a cell and 180 bytes a face, hence
+/// the margin.
 constexpr double kClusterBytesPerCell = 160;
-constexpr double kPhase2BytesPerCell = 2 * kInCoreBytesPerFace + 40;
+constexpr double kPhase2BytesPerCell = 520;
 /// The finest grid: 2^20 cells along the longest side (keys hold 21 bits an axis).
 constexpr double kFinestResolution = double(1 << 20);
 
@@ -187,31 +190,58 @@ struct Grid {
 
 /// Picks the finest grid whose occupied cells stay within `max_cells` (Lindstrom 2000 sizes the
 /// grid by hand; here it follows the budget). Four families of grids, their cell sizes a quarter
-/// octave apart, each coarsened by halves while its cells exceed the budget (cells of half the
-/// resolution are unions of eight, so the count stays exact): one pass over the positions, and
-/// the chosen grid is within 2^(1/4) of the finest that fits.
-Grid choose_grid(const float* xyz, std::uint64_t n, const double lo[3], double extent, std::uint64_t max_cells) {
+/// octave apart, each coarsened by halves while its cells exceed the budget (cells of twice the
+/// side are unions of eight, so the count stays exact): one pass over the positions, and the
+/// chosen grid is within 2^(1/4) of the finest that fits.
+class GridChooser {
+ public:
+  GridChooser(const double lo[3], double start_size, std::uint64_t max_cells) : max_cells_(max_cells) {
+    std::copy(lo, lo + 3, grid_.lo);
+    for (int f = 0; f < 4; ++f) families_.push_back({CellSet(max_cells), start_size * std::pow(2.0, f / 4.0)});
+  }
+  void add(double x, double y, double z) {
+    for (Family& fam : families_) {
+      grid_.size = fam.size;
+      fam.set.insert(grid_.key(x, y, z));
+      while (fam.set.size() > max_cells_) fam.set.coarsen(), fam.size *= 2;
+    }
+  }
+  Grid best() const {
+    Grid g = grid_;
+    g.size = std::numeric_limits<double>::infinity();
+    for (const Family& fam : families_) g.size = std::min(g.size, fam.size);
+    return g;
+  }
+
+ private:
   struct Family {
     CellSet set;
     double size;
   };
-  std::vector<Family> families;
-  for (int f = 0; f < 4; ++f)
-    families.push_back({CellSet(max_cells), extent / (kFinestResolution * std::pow(2.0, -f / 4.0))});
-  for (std::uint64_t v = 0; v < n; ++v) {
-    const double p[3] = {xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]};
-    for (Family& fam : families) {
-      Grid g{{lo[0], lo[1], lo[2]}, fam.size};
-      fam.set.insert(g.key(p[0], p[1], p[2]));
-      while (fam.set.size() > max_cells) {
-        fam.set.coarsen();
-        fam.size *= 2;
-      }
-    }
+  std::uint64_t max_cells_;
+  Grid grid_;
+  std::vector<Family> families_;
+};
+
+/// Where GridChooser starts: every coarsening rebuilds a table of the budget's size, so starting
+/// at the finest grid costs a dozen rebuilds a family. A sample of the points counts the occupied
+/// cells at coarse grids, where each cell holds many samples and the count is close to the
+/// input's; a surface's count grows with the square of the resolution, which extrapolates it to
+/// the budget. Starting 2x finer than that leaves room for a surface that is rougher than the
+/// sample shows; a grid too fine only costs rebuilds.
+double starting_cell_size(const std::vector<float>& sample, const double lo[3], double extent,
+                          std::uint64_t max_cells) {
+  const std::size_t n = sample.size() / 3;
+  double resolution = 1, cells = 1;
+  for (double r = 2; r <= kFinestResolution; r *= 2) {
+    CellSet set(n);
+    const Grid g{{lo[0], lo[1], lo[2]}, extent / r};
+    for (std::size_t i = 0; i < n; ++i) set.insert(g.key(sample[3 * i], sample[3 * i + 1], sample[3 * i + 2]));
+    if (double(set.size()) > double(n) / 16) break;  // too few samples a cell to count them all
+    resolution = r, cells = double(set.size());
   }
-  Grid best{{lo[0], lo[1], lo[2]}, std::numeric_limits<double>::infinity()};
-  for (const Family& fam : families) best.size = std::min(best.size, fam.size);
-  return best;
+  const double estimate = resolution * std::sqrt(double(max_cells) / cells);
+  return extent / std::min(kFinestResolution, 2 * estimate);
 }
 
 /// Clustering maps the closed input surface onto a surface that is closed in the mod-2 sense:
@@ -329,18 +359,32 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
   const std::uint64_t nv = in.vertex_count();
   const bool positions_in_memory = !soup && 12.0 * double(nv) <= budget / 3;
 
+  const double phase1_room = budget - (positions_in_memory ? 12.0 * double(nv) : 0.0);
+  std::uint64_t max_cells = std::uint64_t(std::max(0.0, std::min(phase1_room / kClusterBytesPerCell,
+                                                                  budget / kPhase2BytesPerCell)));
+  // Never fewer cells than the target's vertices, or phase 2 would have nothing to choose from.
+  max_cells = std::max<std::uint64_t>({max_cells, options.target_faces, options.target_vertices * 2, 1024});
+
   // --- pass 1: bounds (and, for a PLY, the positions) ---------------------------------------------
   progress.phase("bounds", 1);
   double lo[3] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
                   std::numeric_limits<double>::infinity()};
   double hi[3] = {-lo[0], -lo[1], -lo[2]};
+  // Every sample_step-th point, up to a million, for starting_cell_size.
+  const std::uint64_t points = soup ? 3 * report.input_faces : nv;
+  // Within the budget: a sample point takes less than a cell.
+  const std::uint64_t sample_step = std::max<std::uint64_t>(1, points / std::min<std::uint64_t>(1000000, max_cells));
+  std::vector<float> sample;
+  std::uint64_t seen = 0;
   auto grow = [&](const double* xyz, std::size_t n) {
-    for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t i = 0; i < n; ++i, ++seen) {
       for (int a = 0; a < 3; ++a) {
         // As float, the precision the positions are kept in (and every cell is computed from).
         const double v = static_cast<float>(xyz[3 * i + a]);
         lo[a] = std::min(lo[a], v), hi[a] = std::max(hi[a], v);
       }
+      if (seen % sample_step == 0) sample.insert(sample.end(), {float(xyz[3 * i]), float(xyz[3 * i + 1]), float(xyz[3 * i + 2])});
+    }
     progress.read(in.bytes_read());
   };
   std::unique_ptr<PositionStore> store;
@@ -361,37 +405,18 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
 
   // --- the grid: as fine as the budget allows -----------------------------------------------------
   progress.phase("grid", 2);
-  const double phase1_room = budget - (positions_in_memory ? 12.0 * double(nv) : 0.0);
-  std::uint64_t max_cells = std::uint64_t(std::max(0.0, std::min(phase1_room / kClusterBytesPerCell,
-                                                                  budget / kPhase2BytesPerCell)));
-  // Never fewer cells than the target's vertices, or phase 2 would have nothing to choose from.
-  max_cells = std::max<std::uint64_t>({max_cells, options.target_faces, options.target_vertices * 2, 1024});
-  Grid grid;
+  GridChooser chooser(lo, starting_cell_size(sample, lo, extent, max_cells), max_cells);
+  std::vector<float>().swap(sample);
   if (soup) {
     // The positions are not kept: the grid's pass reads the file again.
-    std::vector<float> corners;
-    Grid g{{lo[0], lo[1], lo[2]}, 0};
-    struct Family {
-      CellSet set;
-      double size;
-    };
-    std::vector<Family> families;
-    for (int f = 0; f < 4; ++f)
-      families.push_back({CellSet(max_cells), extent / (kFinestResolution * std::pow(2.0, -f / 4.0))});
     in.read_soup([&](const double* xyz, std::size_t n) {
-      for (std::size_t i = 0; i < 3 * n; ++i)
-        for (Family& fam : families) {
-          g.size = fam.size;
-          fam.set.insert(g.key(float(xyz[3 * i]), float(xyz[3 * i + 1]), float(xyz[3 * i + 2])));
-          while (fam.set.size() > max_cells) fam.set.coarsen(), fam.size *= 2;
-        }
+      for (std::size_t i = 0; i < 3 * n; ++i) chooser.add(float(xyz[3 * i]), float(xyz[3 * i + 1]), float(xyz[3 * i + 2]));
       progress.read(in.bytes_read());
     });
-    grid = {{lo[0], lo[1], lo[2]}, std::numeric_limits<double>::infinity()};
-    for (const Family& fam : families) grid.size = std::min(grid.size, fam.size);
   } else {
-    grid = choose_grid(positions, nv, lo, extent, max_cells);
+    for (std::uint64_t v = 0; v < nv; ++v) chooser.add(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]);
   }
+  const Grid grid = chooser.best();
   report.grid_resolution = std::uint64_t(std::ceil(extent / grid.size));
   lap("grid");
 
