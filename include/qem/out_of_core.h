@@ -69,8 +69,8 @@ std::uint64_t parse_memory_size(const std::string& text);
 bool fits_in_memory(const std::string& path, std::uint64_t memory_limit);
 
 /// Simplifies the mesh file `path` in the two phases, whatever its size, under the options'
-/// budget. `options` are those of qem::simplify and apply to phase 2 (a face or vertex target
-/// is needed; its quadrics are recomputed from the clustered faces). Throws qem::Error on a
+/// budget. `options` are those of qem::simplify and apply to phase 2 (its quadrics are recomputed
+/// from the clustered faces); target_ratio counts the input's faces; vertex_lock is refused. Throws qem::Error on a
 /// malformed input, an unwritable or full temporary folder, or a cancel; temporary files are
 /// removed in every case (and on SIGINT/SIGTERM).
 SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptions& options,

@@ -335,8 +335,10 @@ bool fits_in_memory(const std::string& path, std::uint64_t memory_limit) {
   return double(bytes) + kInCoreBytesPerFace * double(faces) <= double(limit);
 }
 
-SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptions& options,
+SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptions& input_options,
                                     const OutOfCoreOptions& ooc, OutOfCoreReport* report_out) {
+  if (!input_options.vertex_lock.empty())
+    throw Error("per-vertex locks are not supported out of core (the clustering merges the input's vertices)");
   OutOfCoreReport report;
   report.memory_limit = ooc.memory_limit ? ooc.memory_limit : default_memory_limit();
   const std::string temp_dir = ooc.temp_dir.empty() ? default_temp_dir() : ooc.temp_dir;
@@ -345,6 +347,13 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
   report.input_faces = in.face_count();
   report.input_vertices = in.vertex_count();
   const bool soup = !in.indexed();
+  // A ratio is of the input's faces, not of the clustered mesh phase 2 starts from.
+  SimplifyOptions options = input_options;
+  if (options.target_ratio > 0) {
+    const auto by_ratio = std::size_t(std::floor(options.target_ratio * double(report.input_faces)));
+    options.target_faces = options.target_faces ? std::min(options.target_faces, by_ratio) : by_ratio;
+    options.target_ratio = 0;
+  }
   Progress progress(ooc, 4);
   // The passes over the file: PLY once (vertices, then faces), STL three times (bounds, grid, clusters).
   progress.set_total(soup ? 3 * in.file_size() : in.file_size());
