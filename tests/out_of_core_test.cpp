@@ -109,6 +109,23 @@ TEST(OutOfCore, ForcedRunMeetsTargetWithoutCracksAndNearInCoreError) {
               static_cast<unsigned long long>(report.clustered_faces), e_ooc, e_ooc / e_in);
 }
 
+TEST(OutOfCore, PositionsBeyondTheBudgetAreMappedFromATemporaryFile) {
+  const std::string dir = fresh_dir("mapped");
+  SimplifyOptions opt;
+  opt.target_faces = 3000;
+  OutOfCoreOptions ooc;
+  ooc.memory_limit = std::uint64_t(4) << 20;  // the 163,842 positions (1.9 MB) exceed a third of it
+  ooc.temp_dir = dir;
+  OutOfCoreReport report;
+  SimplifyResult r = simplify_out_of_core(big_sphere(), opt, ooc, &report);
+  EXPECT_GE(report.temp_bytes_written, 163842u * 12 + 12 * report.clustered_faces);
+  EXPECT_LE(r.mesh.face_count(), 3000u);
+  Mesh welded = r.mesh;
+  weld_exact(welded);
+  EXPECT_EQ(test::boundary_edges(welded), 0u);
+  EXPECT_EQ(entries(dir), 0u);
+}
+
 TEST(OutOfCore, FullDiskMidwayLeavesNoTemporaryFile) {
   const std::string dir = fresh_dir("full_disk");
   SimplifyOptions opt;
