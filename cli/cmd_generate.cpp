@@ -32,15 +32,17 @@ const bool registered = register_command(5, [](CLI::App& app) {
   return [args] {
     const bool sphere = args->kind == "sphere";
     if (format_from_extension(args->output) == FileFormat::Ply) {
-      const outofcore::GeneratedCounts n = sphere ? outofcore::write_bumpy_sphere_ply(args->output, args->faces)
-                                                  : outofcore::write_torus_ply(args->output, args->faces);
+      const outofcore::GeneratedCounts n = sphere
+                                               ? outofcore::write_bumpy_sphere_ply(args->output, args->faces)
+                                               : outofcore::write_torus_ply(args->output, args->faces);
       std::fprintf(stderr, "qem: wrote %s: %llu vertices, %llu faces\n", args->output.c_str(),
                    static_cast<unsigned long long>(n.vertices), static_cast<unsigned long long>(n.faces));
       return 0;
     }
     if (args->faces > 200000000)
-      throw Error("--faces is too large for a mesh built in memory (at most 200000000); write a .ply, "
-                  "which is streamed");
+      throw Error(
+          "--faces is too large for a mesh built in memory (at most 200000000); write a .ply, "
+          "which is streamed");
     Mesh m = sphere ? outofcore::bumpy_sphere(args->faces) : outofcore::torus(args->faces);
     save_mesh(args->output, m);
     std::fprintf(stderr, "qem: wrote %s: %zu vertices, %zu faces\n", args->output.c_str(), m.vertex_count(),

@@ -66,7 +66,8 @@ int run_simplify(const SimplifyArgs& a) {
   check_options(opt);  // before the input is read: a slip in the options is said at once
   // An input too large for memory goes the out-of-core way (qem/out_of_core.h); others as before.
   if (a.record.empty() && wants_out_of_core(a.input, a.out_of_core))
-    return run_out_of_core(a.input, a.output, opt, a.out_of_core, {a.ascii, a.json, a.quiet, a.double_values, a.faces});
+    return run_out_of_core(a.input, a.output, opt, a.out_of_core,
+                           {a.ascii, a.json, a.quiet, a.double_values, a.faces});
 
   const bool show_progress = !a.quiet && !a.json && ::isatty(STDERR_FILENO);
 

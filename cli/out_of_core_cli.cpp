@@ -42,9 +42,9 @@ int run_out_of_core(const std::string& input, const std::string& output, const S
     ooc.progress = [tty](const OutOfCoreProgress& p) {
       char left[32] = "";
       if (p.seconds_left >= 0) std::snprintf(left, sizeof left, ", about %.0f s left", p.seconds_left);
-      std::fprintf(stderr, "%sqem: out of core, phase %d/%d %s: %.2f of %.2f GB read, %.0f s%s%s", tty ? "\r" : "",
-                   p.phase_index, p.phase_count, p.phase, double(p.bytes_read) / 1e9, double(p.bytes_total) / 1e9,
-                   p.seconds, left, tty ? "\x1b[K" : "\n");
+      std::fprintf(stderr, "%sqem: out of core, phase %d/%d %s: %.2f of %.2f GB read, %.0f s%s%s",
+                   tty ? "\r" : "", p.phase_index, p.phase_count, p.phase, double(p.bytes_read) / 1e9,
+                   double(p.bytes_total) / 1e9, p.seconds, left, tty ? "\x1b[K" : "\n");
       std::fflush(stderr);
       return true;
     };
@@ -69,7 +69,8 @@ int run_out_of_core(const std::string& input, const std::string& output, const S
         "\"max_error\":%s,\"max_error_rel\":%s,\"stop\":\"%s\",\"phases\":%s}\n",
         static_cast<unsigned long long>(report.input_faces), out.target_faces, r.mesh.face_count(),
         r.mesh.vertex_count(), static_cast<unsigned long long>(report.clustered_faces),
-        static_cast<unsigned long long>(report.grid_resolution), static_cast<unsigned long long>(report.memory_limit),
+        static_cast<unsigned long long>(report.grid_resolution),
+        static_cast<unsigned long long>(report.memory_limit),
         static_cast<unsigned long long>(report.peak_memory_bytes),
         static_cast<unsigned long long>(report.temp_bytes_written), json_number(total.seconds()).c_str(),
         json_number(peak_rss_mb()).c_str(), json_number(r.max_error).c_str(),

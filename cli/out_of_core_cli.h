@@ -2,9 +2,8 @@
 // progress display and the JSON summary. Kept apart from cmd_simplify.cpp, which only calls it.
 #pragma once
 
-#include <string>
-
 #include <CLI/CLI.hpp>
+#include <string>
 
 #include "qem/simplify.h"
 

@@ -1,6 +1,8 @@
 // The out-of-core path (qem/out_of_core.h, docs/out-of-core.md) forced with a tiny memory limit
 // on a generated mesh: face target met, no crack, E close to the in-core run's; and what a failed
 // run leaves behind (nothing). Also the streamed generator against the in-memory one.
+#include "qem/out_of_core.h"
+
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -8,18 +10,17 @@
 
 #include <array>
 #include <chrono>
-#include <thread>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include "mesh_checks.h"
 #include "outofcore/mesh_generator.h"
 #include "outofcore/temp_file.h"
 #include "qem/io.h"
 #include "qem/measure.h"
-#include "qem/out_of_core.h"
 #include "qem/simplify.h"
 #include "test_meshes.h"
 
@@ -228,8 +229,8 @@ CliRun run(const std::string& args) {
 TEST(OutOfCoreCli, MemoryLimitSendsALargeInputOutOfCore) {
   const std::string dir = fresh_dir("cli");
   const std::string out = dir + "/out.ply";
-  CliRun r = run("simplify " + big_sphere() + " " + out + " --faces 3000 --memory-limit 16M --temp-dir " + dir +
-                 " --json --quiet");
+  CliRun r = run("simplify " + big_sphere() + " " + out + " --faces 3000 --memory-limit 16M --temp-dir " +
+                 dir + " --json --quiet");
   ASSERT_EQ(r.exit_code, 0) << r.out;
   for (const char* field : {"\"out_of_core\":true", "\"out_faces\":", "\"peak_memory_bytes\":",
                             "\"temp_bytes_written\":", "\"phases\":[{\"name\":\"bounds\""})
@@ -245,8 +246,8 @@ TEST(OutOfCoreCli, MemoryLimitSendsALargeInputOutOfCore) {
 TEST(OutOfCoreCli, FailedRunLeavesNoOutput) {
   const std::string dir = fresh_dir("cli_fail");
   const std::string out = dir + "/out.ply";
-  CliRun r = run("simplify " + big_sphere() + " " + out + " --faces 3000 --memory-limit 16M --temp-dir " + dir +
-                 "/missing");
+  CliRun r = run("simplify " + big_sphere() + " " + out + " --faces 3000 --memory-limit 16M --temp-dir " +
+                 dir + "/missing");
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.out.find("temporary folder"), std::string::npos) << r.out;
   EXPECT_EQ(entries(dir), 0u);
@@ -259,8 +260,8 @@ TEST(OutOfCoreCli, TerminatedRunLeavesNothing) {
   const pid_t pid = fork();
   ASSERT_GE(pid, 0);
   if (pid == 0) {
-    execl(QEM_CLI_PATH, "qem", "simplify", input.c_str(), out.c_str(), "--faces", "3000", "--memory-limit", "16M",
-          "--temp-dir", temp.c_str(), "--quiet", static_cast<char*>(nullptr));
+    execl(QEM_CLI_PATH, "qem", "simplify", input.c_str(), out.c_str(), "--faces", "3000", "--memory-limit",
+          "16M", "--temp-dir", temp.c_str(), "--quiet", static_cast<char*>(nullptr));
     _exit(127);
   }
   // SIGTERM once the clustered faces' temporary file exists: mid-way through phase 1.

@@ -19,13 +19,13 @@ namespace qem {
 
 /// What a long out-of-core run is doing, for a progress display.
 struct OutOfCoreProgress {
-  const char* phase = "";          ///< "bounds", "grid", "clustering", "reading clusters", "simplifying"
-  int phase_index = 0;             ///< 1-based, of phase_count
+  const char* phase = "";  ///< "bounds", "grid", "clustering", "reading clusters", "simplifying"
+  int phase_index = 0;     ///< 1-based, of phase_count
   int phase_count = 0;
-  std::uint64_t bytes_read = 0;    ///< of the input, all passes so far
-  std::uint64_t bytes_total = 0;   ///< input bytes all passes will read
-  double seconds = 0;              ///< since the run started
-  double seconds_left = -1;        ///< estimated from the read rate; -1 when unknown
+  std::uint64_t bytes_read = 0;   ///< of the input, all passes so far
+  std::uint64_t bytes_total = 0;  ///< input bytes all passes will read
+  double seconds = 0;             ///< since the run started
+  double seconds_left = -1;       ///< estimated from the read rate; -1 when unknown
 };
 
 struct OutOfCoreOptions {
@@ -46,12 +46,12 @@ struct OutOfCorePhase {
 
 struct OutOfCoreReport {
   std::uint64_t input_faces = 0, input_vertices = 0;
-  std::uint64_t memory_limit = 0;         ///< the budget used (after the default)
-  std::uint64_t grid_resolution = 0;      ///< cells along the bounding box's longest side
-  std::uint64_t clustered_vertices = 0;   ///< occupied cells
-  std::uint64_t clustered_faces = 0;      ///< faces handed to phase 2 (after dropping duplicates)
+  std::uint64_t memory_limit = 0;        ///< the budget used (after the default)
+  std::uint64_t grid_resolution = 0;     ///< cells along the bounding box's longest side
+  std::uint64_t clustered_vertices = 0;  ///< occupied cells
+  std::uint64_t clustered_faces = 0;     ///< faces handed to phase 2 (after dropping duplicates)
   std::uint64_t temp_bytes_written = 0;
-  std::uint64_t peak_memory_bytes = 0;    ///< peak resident set of the process (VmHWM)
+  std::uint64_t peak_memory_bytes = 0;  ///< peak resident set of the process (VmHWM)
   std::vector<OutOfCorePhase> phases;
 };
 
@@ -70,8 +70,8 @@ bool fits_in_memory(const std::string& path, std::uint64_t memory_limit);
 
 /// Simplifies the mesh file `path` in the two phases, whatever its size, under the options'
 /// budget. `options` are those of qem::simplify and apply to phase 2 (its quadrics are recomputed
-/// from the clustered faces); target_ratio counts the input's faces; vertex_lock is refused. Throws qem::Error on a
-/// malformed input, an unwritable or full temporary folder, or a cancel; temporary files are
+/// from the clustered faces); target_ratio counts the input's faces; vertex_lock is refused. Throws
+/// qem::Error on a malformed input, an unwritable or full temporary folder, or a cancel; temporary files are
 /// removed in every case (and on SIGINT/SIGTERM).
 SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptions& options,
                                     const OutOfCoreOptions& ooc = {}, OutOfCoreReport* report = nullptr);

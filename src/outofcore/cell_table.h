@@ -14,7 +14,9 @@ namespace qem::outofcore {
 /// A cell (i, j, k), 21 bits an axis, plus one so that 0 marks an empty slot.
 using CellKey = std::uint64_t;
 
-inline CellKey pack_cell(std::uint64_t i, std::uint64_t j, std::uint64_t k) { return ((i << 42) | (j << 21) | k) + 1; }
+inline CellKey pack_cell(std::uint64_t i, std::uint64_t j, std::uint64_t k) {
+  return ((i << 42) | (j << 21) | k) + 1;
+}
 inline void unpack_cell(CellKey key, std::uint64_t out[3]) {
   key -= 1;
   out[0] = key >> 42, out[1] = (key >> 21) & 0x1fffff, out[2] = key & 0x1fffff;

@@ -1,8 +1,8 @@
 #include "outofcore/mesh_generator.h"
 
 #include <array>
-#include <cstring>
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <unordered_map>
 #include <vector>
@@ -14,13 +14,12 @@ namespace qem::outofcore {
 namespace {
 
 const double kGolden = (1.0 + std::sqrt(5.0)) / 2.0;
-const double kIcosahedron[36] = {-1, kGolden, 0, 1, kGolden, 0, -1, -kGolden, 0, 1, -kGolden, 0,
-                                 0, -1, kGolden, 0, 1, kGolden, 0, -1, -kGolden, 0, 1, -kGolden,
-                                 kGolden, 0, -1, kGolden, 0, 1, -kGolden, 0, -1, -kGolden, 0, 1};
-const std::uint32_t kIcosahedronFaces[60] = {0, 11, 5, 0, 5,  1,  0,  1,  7,  0,  7,  10, 0, 10, 11,
-                                             1, 5,  9, 5, 11, 4,  11, 10, 2,  10, 7,  6,  7, 1,  8,
-                                             3, 9,  4, 3, 4,  2,  3,  2,  6,  3,  6,  8,  3, 8,  9,
-                                             4, 9,  5, 2, 4,  11, 6,  2,  10, 8,  6,  7,  9, 8,  1};
+const double kIcosahedron[36] = {-1, kGolden, 0, 1, kGolden,  0, -1, -kGolden, 0, 1, -kGolden, 0,       0,
+                                 -1, kGolden, 0, 1, kGolden,  0, -1, -kGolden, 0, 1, -kGolden, kGolden, 0,
+                                 -1, kGolden, 0, 1, -kGolden, 0, -1, -kGolden, 0, 1};
+const std::uint32_t kIcosahedronFaces[60] = {
+    0, 11, 5, 0, 5, 1, 0, 1, 7, 0, 7, 10, 0, 10, 11, 1, 5, 9, 5, 11, 4,  11, 10, 2,  10, 7, 6, 7, 1, 8,
+    3, 9,  4, 3, 4, 2, 3, 2, 6, 3, 6, 8,  3, 8,  9,  4, 9, 5, 2, 4,  11, 6,  2,  10, 8,  6, 7, 9, 8, 1};
 
 /// Subdivision levels of the sphere with at least `faces` faces.
 int sphere_levels(std::uint64_t faces) {
@@ -57,8 +56,8 @@ void torus_point(std::size_t i, std::size_t j, std::size_t n, std::size_t m_ring
 void write_header(BufferedWriter& out, std::uint64_t vertices, std::uint64_t faces) {
   std::string h = "ply\nformat binary_little_endian 1.0\ncomment written by qem\nelement vertex " +
                   std::to_string(vertices) +
-                  "\nproperty float x\nproperty float y\nproperty float z\nelement face " + std::to_string(faces) +
-                  "\nproperty list uchar int vertex_indices\nend_header\n";
+                  "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
+                  std::to_string(faces) + "\nproperty list uchar int vertex_indices\nend_header\n";
   out.write(h.data(), h.size());
 }
 
@@ -121,7 +120,8 @@ class SphereWalk {
   Corner midpoint(int level, const Corner& a, const Corner& b) {
     Corner m;
     for (int k = 0; k < 3; ++k) m.p[k] = (a.p[k] + b.p[k]) / 2;  // as bumpy_sphere (a + b == b + a)
-    const std::uint64_t key = a.id < b.id ? (std::uint64_t(a.id) << 32 | b.id) : (std::uint64_t(b.id) << 32 | a.id);
+    const std::uint64_t key =
+        a.id < b.id ? (std::uint64_t(a.id) << 32 | b.id) : (std::uint64_t(b.id) << 32 | a.id);
     auto& table = pending_[level];
     if (auto it = table.find(key); it != table.end()) {
       m.id = it->second;
@@ -139,7 +139,8 @@ class SphereWalk {
       if (!emit_vertices_) write_face(out_, a.id, b.id, c.id);
       return;
     }
-    const Corner ab = midpoint(level + 1, a, b), bc = midpoint(level + 1, b, c), ca = midpoint(level + 1, c, a);
+    const Corner ab = midpoint(level + 1, a, b), bc = midpoint(level + 1, b, c),
+                 ca = midpoint(level + 1, c, a);
     visit(level + 1, a, ab, ca);
     visit(level + 1, b, bc, ab);
     visit(level + 1, c, ca, bc);
@@ -166,7 +167,8 @@ Mesh bumpy_sphere(std::size_t faces) {
       auto it = mid.find(key);
       if (it != mid.end()) return it->second;
       auto v = std::uint32_t(m.vertex_count());
-      for (int k = 0; k < 3; ++k) m.positions.push_back((m.positions[3 * a + k] + m.positions[3 * b + k]) / 2);
+      for (int k = 0; k < 3; ++k)
+        m.positions.push_back((m.positions[3 * a + k] + m.positions[3 * b + k]) / 2);
       mid.emplace(key, v);
       return v;
     };
@@ -218,7 +220,8 @@ GeneratedCounts torus_counts(std::uint64_t faces) {
 
 GeneratedCounts write_bumpy_sphere_ply(const std::string& path, std::uint64_t faces) {
   if (faces > kMaxStreamedSphereFaces)
-    throw Error("--faces is too large for a sphere (at most " + std::to_string(kMaxStreamedSphereFaces) + ")");
+    throw Error("--faces is too large for a sphere (at most " + std::to_string(kMaxStreamedSphereFaces) +
+                ")");
   const int levels = sphere_levels(faces);
   const GeneratedCounts counts = bumpy_sphere_counts(faces);
   AtomicOutput out(path);

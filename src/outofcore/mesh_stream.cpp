@@ -73,14 +73,40 @@ double load(const unsigned char* p, Type t, bool swap) {
   std::memcpy(b, p, n);
   if (swap) std::reverse(b, b + n);
   switch (t) {
-    case Type::I8: return double(std::int8_t(b[0]));
-    case Type::U8: return double(b[0]);
-    case Type::I16: { std::int16_t v; std::memcpy(&v, b, 2); return v; }
-    case Type::U16: { std::uint16_t v; std::memcpy(&v, b, 2); return v; }
-    case Type::I32: { std::int32_t v; std::memcpy(&v, b, 4); return v; }
-    case Type::U32: { std::uint32_t v; std::memcpy(&v, b, 4); return v; }
-    case Type::F32: { float v; std::memcpy(&v, b, 4); return v; }
-    case Type::F64: { double v; std::memcpy(&v, b, 8); return v; }
+    case Type::I8:
+      return double(std::int8_t(b[0]));
+    case Type::U8:
+      return double(b[0]);
+    case Type::I16: {
+      std::int16_t v;
+      std::memcpy(&v, b, 2);
+      return v;
+    }
+    case Type::U16: {
+      std::uint16_t v;
+      std::memcpy(&v, b, 2);
+      return v;
+    }
+    case Type::I32: {
+      std::int32_t v;
+      std::memcpy(&v, b, 4);
+      return v;
+    }
+    case Type::U32: {
+      std::uint32_t v;
+      std::memcpy(&v, b, 4);
+      return v;
+    }
+    case Type::F32: {
+      float v;
+      std::memcpy(&v, b, 4);
+      return v;
+    }
+    case Type::F64: {
+      double v;
+      std::memcpy(&v, b, 8);
+      return v;
+    }
   }
   return 0;
 }
@@ -174,8 +200,9 @@ struct MeshStream::Impl {
         else if (f == "binary_big_endian")
           swap = true;
         else if (f == "ascii")
-          fail("an ASCII PLY is not read in chunks; convert it to binary (qem simplify IN OUT.ply --faces "
-               "<its face count>) or give it enough --memory-limit to be read whole");
+          fail(
+              "an ASCII PLY is not read in chunks; convert it to binary (qem simplify IN OUT.ply --faces "
+              "<its face count>) or give it enough --memory-limit to be read whole");
         else
           bad("unknown PLY format '" + f + "'");
         have_format = true;
@@ -226,7 +253,8 @@ struct MeshStream::Impl {
         if (f.props[k].is_list && (f.props[k].name == "vertex_indices" || f.props[k].name == "vertex_index"))
           face_list = int(k);
       if (face_list < 0) fail("element 'face' has no vertex_indices list property");
-      if (f.props[std::size_t(face_list)].type == Type::F32 || f.props[std::size_t(face_list)].type == Type::F64)
+      if (f.props[std::size_t(face_list)].type == Type::F32 ||
+          f.props[std::size_t(face_list)].type == Type::F64)
         fail("vertex_indices must be an integer type");
     }
     if (v.count > 0xffffffffull) fail("more than 2^32 vertices: not supported");
@@ -272,7 +300,7 @@ MeshStream::MeshStream(const std::string& path) : impl_(std::make_unique<Impl>()
   if (!streamable_extension(path)) m.fail("only binary PLY and binary STL are read in chunks");
   m.fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (m.fd < 0) m.fail(std::string("cannot open: ") + std::strerror(errno));
-  struct stat st{};
+  struct stat st {};
   if (::fstat(m.fd, &st) != 0) m.fail(std::string("cannot read: ") + std::strerror(errno));
   m.size = std::uint64_t(st.st_size);
   std::string ext = path.substr(path.size() - 4);
@@ -287,8 +315,9 @@ MeshStream::MeshStream(const std::string& path) : impl_(std::make_unique<Impl>()
   std::uint32_t count;
   std::memcpy(&count, head + 80, 4);
   if (84 + 50ull * count != m.size)
-    m.fail("not a binary STL (its size does not match its triangle count); an ASCII STL is not read in "
-           "chunks: give it enough --memory-limit to be read whole");
+    m.fail(
+        "not a binary STL (its size does not match its triangle count); an ASCII STL is not read in "
+        "chunks: give it enough --memory-limit to be read whole");
   m.stl_triangles = count;
 }
 
@@ -381,8 +410,9 @@ void MeshStream::read_triangles(const std::function<void(const std::uint32_t*, s
       for (std::size_t c = 0; c < corners; ++c) {
         const double v = load(&m.buf[m.cur + c * is], p.type, m.swap);
         if (v < 0 || v >= double(nv))
-          m.fail_at(e, i, "vertex index " + std::to_string(static_cast<long long>(v)) + " out of range (" +
-                              std::to_string(nv) + " vertices)");
+          m.fail_at(e, i,
+                    "vertex index " + std::to_string(static_cast<long long>(v)) + " out of range (" +
+                        std::to_string(nv) + " vertices)");
         poly.push_back(std::uint32_t(v));
       }
       m.cur += corners * is;

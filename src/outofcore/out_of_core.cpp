@@ -9,7 +9,6 @@
 #include <algorithm>
 #include <array>
 #include <cerrno>
-#include <memory>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -17,6 +16,7 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <sstream>
 
 #include "cluster/cluster_quadric.h"
@@ -197,7 +197,8 @@ class GridChooser {
  public:
   GridChooser(const double lo[3], double start_size, std::uint64_t max_cells) : max_cells_(max_cells) {
     std::copy(lo, lo + 3, grid_.lo);
-    for (int f = 0; f < 4; ++f) families_.push_back({CellSet(max_cells), start_size * std::pow(2.0, f / 4.0)});
+    for (int f = 0; f < 4; ++f)
+      families_.push_back({CellSet(max_cells), start_size * std::pow(2.0, f / 4.0)});
   }
   void add(double x, double y, double z) {
     for (Family& fam : families_) {
@@ -236,7 +237,8 @@ double starting_cell_size(const std::vector<float>& sample, const double lo[3], 
   for (double r = 2; r <= kFinestResolution; r *= 2) {
     CellSet set(n);
     const Grid g{{lo[0], lo[1], lo[2]}, extent / r};
-    for (std::size_t i = 0; i < n; ++i) set.insert(g.key(sample[3 * i], sample[3 * i + 1], sample[3 * i + 2]));
+    for (std::size_t i = 0; i < n; ++i)
+      set.insert(g.key(sample[3 * i], sample[3 * i + 1], sample[3 * i + 2]));
     if (double(set.size()) > double(n) / 16) break;  // too few samples a cell to count them all
     resolution = r, cells = double(set.size());
   }
@@ -295,7 +297,8 @@ std::uint64_t default_memory_limit() {
 
 std::uint64_t parse_memory_size(const std::string& text) {
   const auto bad = [&] {
-    return Error("memory size '" + text + "': expected a number of bytes with an optional K, M, G or T suffix");
+    return Error("memory size '" + text +
+                 "': expected a number of bytes with an optional K, M, G or T suffix");
   };
   std::size_t used = 0;
   double v = 0;
@@ -338,7 +341,8 @@ bool fits_in_memory(const std::string& path, std::uint64_t memory_limit) {
 SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptions& input_options,
                                     const OutOfCoreOptions& ooc, OutOfCoreReport* report_out) {
   if (!input_options.vertex_lock.empty())
-    throw Error("per-vertex locks are not supported out of core (the clustering merges the input's vertices)");
+    throw Error(
+        "per-vertex locks are not supported out of core (the clustering merges the input's vertices)");
   OutOfCoreReport report;
   report.memory_limit = ooc.memory_limit ? ooc.memory_limit : default_memory_limit();
   const std::string temp_dir = ooc.temp_dir.empty() ? default_temp_dir() : ooc.temp_dir;
@@ -369,8 +373,8 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
   const bool positions_in_memory = !soup && 12.0 * double(nv) <= budget / 3;
 
   const double phase1_room = budget - (positions_in_memory ? 12.0 * double(nv) : 0.0);
-  std::uint64_t max_cells = std::uint64_t(std::max(0.0, std::min(phase1_room / kClusterBytesPerCell,
-                                                                  budget / kPhase2BytesPerCell)));
+  std::uint64_t max_cells = std::uint64_t(
+      std::max(0.0, std::min(phase1_room / kClusterBytesPerCell, budget / kPhase2BytesPerCell)));
   // Never fewer cells than the target's vertices, or phase 2 would have nothing to choose from.
   max_cells = std::max<std::uint64_t>({max_cells, options.target_faces, options.target_vertices * 2, 1024});
 
@@ -382,7 +386,8 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
   // Every sample_step-th point, up to a million, for starting_cell_size.
   const std::uint64_t points = soup ? 3 * report.input_faces : nv;
   // Within the budget: a sample point takes less than a cell.
-  const std::uint64_t sample_step = std::max<std::uint64_t>(1, points / std::min<std::uint64_t>(1000000, max_cells));
+  const std::uint64_t sample_step =
+      std::max<std::uint64_t>(1, points / std::min<std::uint64_t>(1000000, max_cells));
   std::vector<float> sample;
   std::uint64_t seen = 0;
   auto grow = [&](const double* xyz, std::size_t n) {
@@ -392,7 +397,8 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
         const double v = static_cast<float>(xyz[3 * i + a]);
         lo[a] = std::min(lo[a], v), hi[a] = std::max(hi[a], v);
       }
-      if (seen % sample_step == 0) sample.insert(sample.end(), {float(xyz[3 * i]), float(xyz[3 * i + 1]), float(xyz[3 * i + 2])});
+      if (seen % sample_step == 0)
+        sample.insert(sample.end(), {float(xyz[3 * i]), float(xyz[3 * i + 1]), float(xyz[3 * i + 2])});
     }
     progress.read(in.bytes_read());
   };
@@ -419,11 +425,13 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
   if (soup) {
     // The positions are not kept: the grid's pass reads the file again.
     in.read_soup([&](const double* xyz, std::size_t n) {
-      for (std::size_t i = 0; i < 3 * n; ++i) chooser.add(float(xyz[3 * i]), float(xyz[3 * i + 1]), float(xyz[3 * i + 2]));
+      for (std::size_t i = 0; i < 3 * n; ++i)
+        chooser.add(float(xyz[3 * i]), float(xyz[3 * i + 1]), float(xyz[3 * i + 2]));
       progress.read(in.bytes_read());
     });
   } else {
-    for (std::uint64_t v = 0; v < nv; ++v) chooser.add(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]);
+    for (std::uint64_t v = 0; v < nv; ++v)
+      chooser.add(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]);
   }
   const Grid grid = chooser.best();
   report.grid_resolution = std::uint64_t(std::ceil(extent / grid.size));
@@ -491,7 +499,8 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
   clustered_mesh.positions.resize(3 * cells.size());
   for (std::uint32_t i = 0; i < cells.size(); ++i) {
     const auto& cell = cells.cell(i);
-    const double mean[3] = {cell.sum[0] / cell.corners, cell.sum[1] / cell.corners, cell.sum[2] / cell.corners};
+    const double mean[3] = {cell.sum[0] / cell.corners, cell.sum[1] / cell.corners,
+                            cell.sum[2] / cell.corners};
     double x[3];
     cluster_detail::minimize_around(cell.quadric, mean, x);
     std::uint64_t k[3];

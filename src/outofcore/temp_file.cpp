@@ -41,7 +41,7 @@ extern "C" void remove_temp_files_and_reraise(int sig) {
 
 int register_path(const std::string& path) {
   std::call_once(g_install_once, [] {
-    struct sigaction sa{};
+    struct sigaction sa {};
     sa.sa_handler = remove_temp_files_and_reraise;
     sigemptyset(&sa.sa_mask);
     ::sigaction(SIGINT, &sa, &g_previous[0]);
@@ -130,10 +130,12 @@ void BufferedWriter::flush() {
 // --- TempFile -------------------------------------------------------------------------------------
 
 TempFile::TempFile(const std::string& folder, const std::string& stem) {
-  struct stat st{};
+  struct stat st {};
   if (::stat(folder.c_str(), &st) != 0)
-    throw Error("temporary folder " + folder + ": " + std::strerror(errno) + " (choose another with --temp-dir)");
-  if (!S_ISDIR(st.st_mode)) throw Error("temporary folder " + folder + ": not a folder (choose another with --temp-dir)");
+    throw Error("temporary folder " + folder + ": " + std::strerror(errno) +
+                " (choose another with --temp-dir)");
+  if (!S_ISDIR(st.st_mode))
+    throw Error("temporary folder " + folder + ": not a folder (choose another with --temp-dir)");
   const std::string path = unique_name(folder, stem);
   is_temp_ = true;
   slot_ = register_path(path);  // before creating it: an interrupt in between unlinks nothing harmful
@@ -175,7 +177,8 @@ AtomicOutput::AtomicOutput(const std::string& path) : target_(path) {
   if (path.empty()) throw Error("cannot write: empty file name");
   std::string dir = ".";
   if (auto slash = path.find_last_of('/'); slash != std::string::npos) dir = path.substr(0, slash + 1);
-  std::string base = path.substr(path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1);
+  std::string base =
+      path.substr(path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1);
   const std::string tmp = unique_name(dir, base + ".tmp");
   slot_ = register_path(tmp);
   try {
