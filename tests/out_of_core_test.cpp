@@ -196,6 +196,43 @@ TEST(OutOfCore, StlSoupAndRatioOfTheInput) {
   EXPECT_EQ(entries(dir), 1u);  // the input only
 }
 
+TEST(OutOfCore, TruncatedOrBrokenInputIsAClearError) {
+  const std::string dir = fresh_dir("broken");
+  const std::string bytes = slurp(big_sphere());
+  SimplifyOptions opt;
+  opt.target_faces = 5000;
+  OutOfCoreOptions ooc;
+  ooc.memory_limit = kTinyLimit;
+  ooc.temp_dir = dir;
+  auto error_of = [&](const std::string& contents) {
+    const std::string p = dir + "/broken.ply";
+    std::ofstream(p, std::ios::binary) << contents;
+    try {
+      simplify_out_of_core(p, opt, ooc);
+    } catch (const Error& e) {
+      fs::remove(p);
+      return std::string(e.what());
+    }
+    fs::remove(p);
+    return std::string("no error");
+  };
+  // Cut inside the faces: the last face is incomplete.
+  EXPECT_NE(
+      error_of(bytes.substr(0, bytes.size() - 5)).find("broken.ply, face 327679: the file ends inside it"),
+      std::string::npos);
+  // A face's first index made 2^31 - 1.
+  std::string bad = bytes;
+  const std::size_t first_face = bytes.size() - 327680 * 13;
+  bad[first_face + 1] = '\xff', bad[first_face + 2] = '\xff', bad[first_face + 3] = '\xff',
+                   bad[first_face + 4] = 0x7f;
+  EXPECT_NE(error_of(bad).find("broken.ply, face 0: vertex index 2147483647 out of range (163842 vertices)"),
+            std::string::npos)
+      << error_of(bad);
+  EXPECT_NE(error_of("ply\nformat ascii 1.0\nelement vertex 0\nend_header\n").find("ASCII PLY"),
+            std::string::npos);
+  EXPECT_EQ(entries(dir), 0u);
+}
+
 TEST(OutOfCore, MemorySizes) {
   EXPECT_EQ(parse_memory_size("2G"), std::uint64_t(2) << 30);
   EXPECT_EQ(parse_memory_size("512M"), std::uint64_t(512) << 20);
