@@ -1,5 +1,6 @@
 // `qem generate KIND OUTPUT`: synthetic meshes of any size, so that the README's first command
-// (and a benchmark) needs no downloaded model.
+// (and a benchmark) needs no downloaded model. A .ply is streamed to disk (bounded memory, up to
+// a billion faces and more); other formats, and meshes with --attributes, are built in memory.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -7,72 +8,12 @@
 #include <string>
 
 #include "command.h"
+#include "outofcore/mesh_generator.h"
 #include "qem/error.h"
 #include "qem/io.h"
 
 namespace qem::cli {
 namespace {
-
-// Icosphere subdivided until it has at least `faces` faces, radially displaced by a few waves so
-// that it has features worth keeping (as the bench's noisy sphere).
-Mesh bumpy_sphere(std::size_t faces) {
-  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-  Mesh m;
-  m.positions = {-1, t, 0, 1, t, 0, -1, -t, 0, 1, -t, 0, 0, -1, t, 0, 1, t,
-                 0, -1, -t, 0, 1, -t, t, 0, -1, t, 0, 1, -t, 0, -1, -t, 0, 1};
-  m.indices = {0, 11, 5, 0, 5, 1, 0, 1, 7, 0, 7, 10, 0, 10, 11, 1, 5, 9, 5, 11, 4, 11, 10, 2, 10, 7, 6, 7, 1, 8,
-               3, 9, 4, 3, 4, 2, 3, 2, 6, 3, 6, 8, 3, 8, 9, 4, 9, 5, 2, 4, 11, 6, 2, 10, 8, 6, 7, 9, 8, 1};
-  while (m.face_count() < faces) {
-    std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> mid;
-    auto midpoint = [&](std::uint32_t a, std::uint32_t b) {
-      auto key = a < b ? std::make_pair(a, b) : std::make_pair(b, a);
-      auto it = mid.find(key);
-      if (it != mid.end()) return it->second;
-      auto v = std::uint32_t(m.vertex_count());
-      for (int k = 0; k < 3; ++k) m.positions.push_back((m.positions[3 * a + k] + m.positions[3 * b + k]) / 2);
-      mid.emplace(key, v);
-      return v;
-    };
-    std::vector<std::uint32_t> next;
-    next.reserve(4 * m.indices.size());
-    for (std::size_t f = 0; f < m.indices.size(); f += 3) {
-      std::uint32_t a = m.indices[f], b = m.indices[f + 1], c = m.indices[f + 2];
-      std::uint32_t ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
-      next.insert(next.end(), {a, ab, ca, b, bc, ab, c, ca, bc, ab, bc, ca});
-    }
-    m.indices.swap(next);
-  }
-  for (std::size_t v = 0; v < m.vertex_count(); ++v) {
-    double* p = &m.positions[3 * v];
-    double len = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-    double x = p[0] / len, y = p[1] / len, z = p[2] / len;
-    double r = 1 + 0.08 * std::sin(7 * x + 1) * std::sin(6 * y) + 0.04 * std::cos(13 * z + 2 * x) +
-               0.02 * std::sin(23 * y + 17 * z);
-    p[0] = x * r, p[1] = y * r, p[2] = z * r;
-  }
-  return m;
-}
-
-// Torus with major radius 1 and minor radius 0.35 on an n x (n/2) grid.
-Mesh torus(std::size_t faces) {
-  std::size_t n = 8;
-  while (n * (n / 2) * 2 < faces) n += 2;
-  const std::size_t m_ring = n / 2;
-  Mesh m;
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t j = 0; j < m_ring; ++j) {
-      double u = 2 * M_PI * double(i) / double(n), v = 2 * M_PI * double(j) / double(m_ring);
-      double r = 1 + 0.35 * std::cos(v);
-      m.positions.insert(m.positions.end(), {r * std::cos(u), r * std::sin(u), 0.35 * std::sin(v)});
-    }
-  auto id = [&](std::size_t i, std::size_t j) { return std::uint32_t((i % n) * m_ring + (j % m_ring)); };
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t j = 0; j < m_ring; ++j) {
-      m.indices.insert(m.indices.end(), {id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-      m.indices.insert(m.indices.end(), {id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-    }
-  return m;
-}
 
 // Adds smooth normals (area-weighted face normals per position) and a latitude/longitude UV map
 // to a closed mesh centred at the origin, splitting vertices where the map is discontinuous: along
@@ -146,14 +87,29 @@ const bool registered = register_command(5, [](CLI::App& app) {
       ->required()
       ->check(CLI::IsMember({"sphere", "torus"}));
   sub->add_option("output", args->output, "Output mesh (.obj .ply .stl .off; .obj, .ply or .glb for --attributes)")->required();
-  sub->add_option("--faces", args->faces, "At least this many faces (sphere: next power-of-4 level)")
+  sub->add_option("--faces", args->faces,
+                  "At least this many faces (sphere: next 20 * 4^level). A .ply without --attributes is streamed "
+                  "to disk in bounded memory (up to 1342177280 sphere or 2000000000 torus faces); other "
+                  "outputs are built in memory (up to 200000000)")
       ->capture_default_str();
   sub->add_flag("--attributes", args->attributes,
                 "Add smooth normals and a latitude/longitude UV map (TEXCOORD_0) with its seam: the positions "
                 "where the map is discontinuous are split into several vertices, as in a textured asset");
   return [args] {
-    if (args->faces > 200000000) throw Error("--faces is too large (at most 200000000)");
-    Mesh m = args->kind == "sphere" ? bumpy_sphere(args->faces) : torus(args->faces);
+    const bool sphere = args->kind == "sphere";
+    if (format_from_extension(args->output) == FileFormat::Ply && !args->attributes) {
+      const outofcore::GeneratedCounts n = sphere
+                                               ? outofcore::write_bumpy_sphere_ply(args->output, args->faces)
+                                               : outofcore::write_torus_ply(args->output, args->faces);
+      std::fprintf(stderr, "qem: wrote %s: %llu vertices, %llu faces\n", args->output.c_str(),
+                   static_cast<unsigned long long>(n.vertices), static_cast<unsigned long long>(n.faces));
+      return 0;
+    }
+    if (args->faces > 200000000)
+      throw Error(
+          "--faces is too large for a mesh built in memory (at most 200000000); write a .ply without "
+          "--attributes, which is streamed");
+    Mesh m = sphere ? outofcore::bumpy_sphere(args->faces) : outofcore::torus(args->faces);
     if (args->attributes) m = with_uv_and_normals(m);
     save_mesh(args->output, m);
     std::fprintf(stderr, "qem: wrote %s: %zu vertices, %zu faces\n", args->output.c_str(), m.vertex_count(),

@@ -10,6 +10,7 @@
 #include "algorithm_options.h"
 #include "cli_util.h"
 #include "command.h"
+#include "out_of_core_cli.h"
 #include "qem/error.h"
 #include "qem/gltf.h"
 #include "qem/gltf_simplify.h"
@@ -30,6 +31,7 @@ struct SimplifyArgs {
   bool double_values = false;  // --double
   bool per_mesh = false;       // --per-mesh (glTF documents)
   std::string record;          // --record: the contraction sequence (docs/record-format.md)
+  OutOfCoreArgs out_of_core;   // --memory-limit, --temp-dir
 };
 
 // Shows the progress on a terminal and, with --record, keeps the contractions.
@@ -148,6 +150,10 @@ int run_simplify(const SimplifyArgs& a) {
   if (a.max_error_rel >= 0) opt.max_error = a.max_error_rel, opt.max_error_is_relative = true;
   check_options(opt);  // before the input is read: a slip in the options is said at once
   if (gltf_document) return run_simplify_gltf(a, opt);
+  // An input too large for memory goes the out-of-core way (qem/out_of_core.h); others as before.
+  if (a.record.empty() && wants_out_of_core(a.input, a.out_of_core))
+    return run_out_of_core(a.input, a.output, opt, a.out_of_core,
+                           {a.ascii, a.json, a.quiet, a.double_values, a.faces});
 
   const bool show_progress = !a.quiet && !a.json && ::isatty(STDERR_FILENO);
 
@@ -259,6 +265,7 @@ const bool registered = register_command(10, [](CLI::App& app) {
       "--record", args->record,
       "Also write the contraction sequence to this file, so `qem replay` / `qem lod` can rebuild "
       "any face count between the output's and the input's (docs/record-format.md); no default refit then");
+  add_out_of_core_options(sub, args->out_of_core);
   return [args] { return run_simplify(*args); };
 });
 
