@@ -78,7 +78,8 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
                     "(--refit-rounds " +
                     std::to_string(kDefaultRefitRounds) + " --refit-sample " +
                     std::to_string(int(kDefaultRefitSample)) +
-                    ") when --placement is optimal; see --no-refit");
+                    ") when --placement is optimal and the mesh has no attributes (with attributes only when "
+                    "asked: it holds the seams; docs/attributes.md); see --no-refit");
   sub->add_option("--refit-rounds", a.refit_rounds,
                   "Project-and-solve rounds of --refit (implies it; default " +
                       std::to_string(RefitOptions{}.rounds) + ")")
@@ -161,6 +162,10 @@ LoadOptions to_load_options(const AlgorithmArgs& a) {
   if (a.no_weld) load.weld = Weld::Off;
   if (!a.lock_property.empty()) load.keep_vertex_properties = true;
   return load;
+}
+
+unsigned attribute_refit_rounds(const AlgorithmArgs& a, const SimplifyOptions& options) {
+  return a.refit_asked() ? options.refit_rounds : 0;
 }
 
 void apply_lock_property(const AlgorithmArgs& a, const std::string& file, const Mesh& mesh,

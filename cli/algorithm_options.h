@@ -58,6 +58,13 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& args);
 
 LoadOptions to_load_options(const AlgorithmArgs& args);
 
+/// The refit rounds for a mesh with attributes: those of --refit / --refit-rounds / --refit-sample,
+/// but not the default's light refit. With attributes the refit holds every seam (no crack, UVs in
+/// their charts) and lowered E by 5-27 % on the shared textured OBJs at 10 %, but raised their UV
+/// error by up to 0.8 % (docs/attributes.md, "Seams, locks and the refit"): a trade a user asks
+/// for, not a default.
+unsigned attribute_refit_rounds(const AlgorithmArgs& args, const SimplifyOptions& options);
+
 /// --lock-property NAME: `lock` gets one flag per vertex of `mesh`, set where the PLY vertex
 /// property or scalar attribute NAME is non-zero, and `options.vertex_lock` points at it (so
 /// `lock` must outlive the run). Nothing without the option. Throws qem::Error naming the file if
