@@ -46,7 +46,8 @@ Mesh uv_sphere(int rings, int segments) {
       const double theta = kPi * i / rings, phi = 2 * kPi * (j % segments) / segments;
       double p[3] = {std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)};
       if (i == 0 || i == rings) p[0] = p[1] = 0;
-      const double r = 1 + 0.05 * std::sin(5 * theta) * std::cos(3 * phi);
+      // sin(5 pi) is not exactly 0: the poles get radius 1 exactly, so each is one position.
+      const double r = i == 0 || i == rings ? 1 : 1 + 0.05 * std::sin(5 * theta) * std::cos(3 * phi);
       m.positions.insert(m.positions.end(), {r * p[0], r * p[1], r * p[2]});
       uv.values.insert(uv.values.end(), {double(j) / segments, double(i) / rings});
       normal.values.insert(normal.values.end(), {p[0], p[1], p[2]});
@@ -429,6 +430,23 @@ TEST(Seams, CommandLineLocksSeamsAndNamedVertices) {
   EXPECT_NE(r.out.find("nothere"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("keep"), std::string::npos) << "the error should list the properties there are: " << r.out;
   EXPECT_FALSE(fs::exists(none));
+}
+
+TEST(Seams, CommandLineRefitsAttributesOnlyWhenAsked) {
+  // The default's light refit is left out with attributes (it raised the UV error); --refit makes
+  // it, and the seams stay closed.
+  const std::string dir = test::temp_dir();
+  const std::string obj = dir + "/seams_refit.obj", out = dir + "/seams_refit_out.obj";
+  save_mesh(obj, uv_sphere(30, 60));
+  ASSERT_EQ(open_edges_welded(load_mesh(obj)), 0u);
+  CliRun plain = run_cli("simplify " + obj + " " + out + " --ratio 0.1 --json --quiet --force");
+  ASSERT_EQ(plain.exit_code, 0) << plain.out;
+  EXPECT_NE(plain.out.find("\"refit_rounds\":0,"), std::string::npos) << plain.out;
+  CliRun asked = run_cli("simplify " + obj + " " + out + " --ratio 0.1 --refit --json --quiet --force");
+  ASSERT_EQ(asked.exit_code, 0) << asked.out;
+  EXPECT_EQ(asked.out.find("\"refit_rounds\":0,"), std::string::npos) << asked.out;
+  EXPECT_NE(asked.out.find("\"refit_rounds\":"), std::string::npos) << asked.out;
+  EXPECT_EQ(open_edges_welded(load_mesh(out)), 0u);
 }
 
 TEST(Seams, CommandLinePermissiveReachesTheTarget) {
