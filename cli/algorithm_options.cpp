@@ -46,6 +46,22 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
                       ", scalar=" + json_number(AttributeWeights{}.scalar) + "); seam=W weighs constraint planes along "
                       "the seams, as --boundary-weight for borders (default " + json_number(AttributeWeights{}.seam) + ")")
       ->delimiter(',');
+  sub->add_option("--seams", a.seams,
+                  "With attributes, seams (UV seams, normal creases, colour and material boundaries): strict "
+                  "(a collapse runs only along a seam, both sides together) or permissive (a collapse may "
+                  "cross a seam, not a material boundary, when its error, the attribute error included, "
+                  "allows: reaches targets that many small UV charts block, at some UV quality; "
+                  "docs/attributes.md)")
+      ->check(CLI::IsMember({"strict", "permissive"}))
+      ->capture_default_str();
+  sub->add_option("--lock", a.lock,
+                  "Vertices that never move and are never removed: seams (every position with more than "
+                  "one set of attributes), borders (as --lock-border); separate by commas")
+      ->check(CLI::IsMember({"seams", "borders"}))
+      ->delimiter(',');
+  sub->add_option("--lock-property", a.lock_property,
+                  "Lock the vertices whose PLY vertex property (or scalar attribute) NAME is non-zero")
+      ->type_name("NAME");
   sub->add_option("--inversion", a.inversion, "Contractions that flip a face: forbid, penalize, or off (GH97 6)")
       ->check(CLI::IsMember(option_names<InversionPolicy>()))
       ->capture_default_str();
@@ -72,7 +88,8 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
                     "(--refit-rounds " +
                     std::to_string(kDefaultRefitRounds) + " --refit-sample " +
                     std::to_string(int(kDefaultRefitSample)) +
-                    ") when --placement is optimal; see --no-refit");
+                    ") when --placement is optimal and the mesh has no attributes (with attributes only when "
+                    "asked: it holds the seams; docs/attributes.md); see --no-refit");
   sub->add_option("--refit-rounds", a.refit_rounds,
                   "Project-and-solve rounds of --refit (implies it; default " +
                       std::to_string(RefitOptions{}.rounds) + ")")
@@ -136,6 +153,12 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
                   item + "'");
     *weight = w;
   }
+  opt.permissive_seams = a.seams == "permissive";
+  for (const std::string& what : a.lock) {
+    if (what == "seams") opt.lock_seams = true;
+    else if (what == "borders") opt.lock_border = true;
+    else throw Error("--lock: expected seams or borders, got '" + what + "'");
+  }
   if (a.refit_asked() && a.no_refit)
     throw Error("--no-refit cannot be combined with --refit, --refit-rounds or --refit-sample");
   if (a.refit_asked()) {
@@ -152,7 +175,34 @@ LoadOptions to_load_options(const AlgorithmArgs& a) {
   LoadOptions load;
   if (a.weld) load.weld = Weld::On;
   if (a.no_weld) load.weld = Weld::Off;
+  if (!a.lock_property.empty()) load.keep_vertex_properties = true;
   return load;
+}
+
+unsigned attribute_refit_rounds(const AlgorithmArgs& a, const SimplifyOptions& options) {
+  return a.refit_asked() ? options.refit_rounds : 0;
+}
+
+void apply_lock_property(const AlgorithmArgs& a, const std::string& file, const Mesh& mesh,
+                         std::vector<std::uint8_t>& lock, SimplifyOptions& options) {
+  if (a.lock_property.empty()) return;
+  const std::vector<double>* values = nullptr;
+  std::string known;
+  for (const VertexProperty& p : mesh.vertex_properties) {
+    if (p.name == a.lock_property) values = &p.values;
+    known += (known.empty() ? "" : ", ") + p.name;
+  }
+  for (const VertexAttribute& attr : mesh.attributes) {
+    if (attr.kind != AttributeKind::Scalar || attr.components != 1) continue;
+    if (!values && attr.name == a.lock_property) values = &attr.values;
+    known += (known.empty() ? "" : ", ") + attr.name;
+  }
+  if (!values)
+    throw Error(file + ": --lock-property: no vertex property or scalar attribute named '" + a.lock_property +
+                "' (" + (known.empty() ? std::string("it has none") : "it has: " + known) + ")");
+  lock.assign(mesh.vertex_count(), 0);
+  for (std::size_t v = 0; v < lock.size() && v < values->size(); ++v) lock[v] = (*values)[v] != 0;
+  options.vertex_lock = lock;
 }
 
 }  // namespace qem::cli

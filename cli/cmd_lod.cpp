@@ -130,6 +130,7 @@ int run_lod(const LodArgs& a) {
     SimplifyOptions opt = to_simplify_options(a.algorithm);
     opt.target_faces = 1;
     check_options(opt);
+    opt.refit_rounds = attribute_refit_rounds(a.algorithm, opt);  // as `qem simplify` on a document
     return run_lod_gltf(args, opt);
   }
   return run_lod_mesh(args);
@@ -145,6 +146,8 @@ int run_lod_mesh(const LodArgs& a) {
   // One run to the coarsest level, recorded. Ratios are taken of the faces the run starts from
   // (degenerate and duplicate input faces dropped), exactly as `qem simplify --ratio` does.
   SimplifyOptions opt = to_simplify_options(a.algorithm);
+  std::vector<std::uint8_t> lock;  // --lock-property: outlives the runs, as vertex_lock must
+  apply_lock_property(a.algorithm, a.input, mesh, lock, opt);
   // A refit (the default's, or --refit's): each level is refitted below, as simplify refits its
   // output; the run itself only records the contractions.
   const RefitOptions refit = refit_options_for(opt);
@@ -175,6 +178,9 @@ int run_lod_mesh(const LodArgs& a) {
   for (std::size_t target : attributes ? targets : std::vector<std::size_t>{}) {
     SimplifyOptions level = opt;
     level.target_ratio = 0, level.target_faces = target, level.as_far_as_possible = target == 0;
+    // Refitted in the run, which holds its seams (simplify.cpp): the chain's refit below sees no wedges.
+    level.refit_rounds = refit.rounds, level.refit_points_per_vertex = refit.points_per_vertex;
+    level.refit_rounds = attribute_refit_rounds(a.algorithm, level);
     SimplifyResult r = simplify(mesh, level);
     r.mesh.material_names = mesh.material_names, r.mesh.material_library = mesh.material_library;
     levels.push_back({std::move(r.mesh), target, r.contractions, r.max_error});

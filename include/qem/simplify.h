@@ -137,6 +137,20 @@ struct SimplifyOptions {
   /// other end of a contraction comes to it). With attributes, a position is locked when any of
   /// its vertices is. The caller's buffer must outlive the call.
   std::span<const std::uint8_t> vertex_lock;
+  /// Per input vertex (empty: none), nonzero = protected: with attributes, the seams at it are
+  /// never crossed, even with permissive_seams (meshoptimizer's meshopt_SimplifyVertex_Protect). It
+  /// may still be removed, or move, along its seam as any seam vertex does. Same size and lifetime
+  /// rules as vertex_lock.
+  std::span<const std::uint8_t> vertex_protect;
+  /// With attributes: every vertex on a seam (UV seam, normal crease, colour or material boundary,
+  /// mirror line: any position with more than one attribute set) is locked as by vertex_lock.
+  bool lock_seams = false;
+  /// With attributes: a collapse may cross a UV seam, normal crease or colour boundary (never a
+  /// material boundary, never at a protected vertex) when its cost, which then includes the
+  /// attribute error of merging the two sides, allows (meshoptimizer's SimplifyPermissive). Reaches
+  /// targets that strict seams block (many small UV charts), at the price of attribute quality
+  /// along the seams it crosses (docs/attributes.md). Welded by position, no crack opens either way.
+  bool permissive_seams = false;
   InversionPolicy inversion = InversionPolicy::Forbid;
   /// A face that turns by more than this (degrees) counts as an inversion; must be < 90.
   double max_normal_turn_degrees = 75;
@@ -151,8 +165,11 @@ struct SimplifyOptions {
   unsigned threads = 0;
   /// After the last contraction, refit the vertices to the input surface with the faces fixed
   /// (qem/refit.h, Hoppe et al. 1993) in up to this many rounds; 0 = off (GH97 as published).
-  /// Lowers the geometric error at the same face count; `lock_border` and
-  /// `max_normal_turn_degrees` apply to it too. An observer's contractions are those made
+  /// Lowers the geometric error at the same face count; `lock_border`, `vertex_lock` and
+  /// `max_normal_turn_degrees` apply to it too. With attributes it fits the surface welded by
+  /// position and holds every position that carries more than one attribute set (seams, creases,
+  /// material boundaries, mirror lines); the other vertices move with their values unchanged
+  /// (docs/attributes.md, "Seams, locks and the refit"). An observer's contractions are those made
   /// before it: a replayed level is the unrefitted mesh (refit it with qem::refit to match). The
   /// command line's default is a light refit, refit_rounds = 1 with refit_points_per_vertex = 2
   /// (what it costs and gains: docs/benchmarks.md).

@@ -22,10 +22,11 @@ namespace qem::core {
 namespace {
 
 // The mesh with what the contractions left of it, and the maps the caller asked for.
-void finish(Context& c, std::optional<ContractionMap>& map, MeshView input, SimplifyResult& result) {
+void finish(Context& c, std::optional<ContractionMap>& map, MeshView input, SimplifyResult& result,
+            WedgeRefitData* refit) {
   if (c.wedges) {
     result.mesh = build_wedge_output(c.mesh, *c.wedges, input, result.vertex_source, result.face_source,
-                                     map ? &result.output_vertex_of_input : nullptr);
+                                     map ? &result.output_vertex_of_input : nullptr, refit);
     return;
   }
   std::vector<std::uint32_t> output_index;
@@ -62,6 +63,7 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   if (!input.attributes.empty()) wedges.emplace(build_wedges(input, internal, mesh, options));
   std::vector<std::uint32_t>().swap(internal);
   if (!options.vertex_lock.empty()) lock_vertices(options.vertex_lock, input, wedges ? &*wedges : nullptr, mesh);
+  if (wedges && options.lock_seams) lock_seam_vertices(*wedges, mesh);
   result.input_faces = mesh.faces_alive, result.input_vertices = mesh.vertices_alive;
   result.dropped_degenerate_faces = mesh.dropped_degenerate, result.dropped_duplicate_faces = mesh.dropped_duplicate;
   const Settings settings = resolve(options, mesh);  // targets from the input, before any pruning
@@ -86,7 +88,7 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
     result.stop_reason = StopReason::AlreadyBelowTarget;
     result.stop_detail = stop_detail(result.stop_reason, result, settings.lock_border);
     result.output_components = count_components(mesh);
-    finish(c, map, input, result);
+    finish(c, map, input, result, hooks.wedge_refit);
     return result;
   }
   mesh.rebuild_face_lists();
@@ -115,7 +117,7 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   result.max_error = c.max_error * mesh.frame.scale;
   result.stop_detail = stop_detail(result.stop_reason, result, settings.lock_border);
   result.output_components = count_components(mesh);
-  finish(c, map, input, result);
+  finish(c, map, input, result, hooks.wedge_refit);
   return result;
 }
 
