@@ -350,7 +350,7 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
       scheme: "passes" (fast) or "greedy" (GH97's heap: strictly cheapest first).
       refit: after the last contraction move the vertices to fit the input surface, faces fixed:
         "light" (default, as the command line: 1 round on ~2 input vertices per output vertex, only
-        with optimal placement and without record), "full" (3 rounds, every vertex), "none", or
+        with optimal placement, without record and without attributes), "full" (3 rounds, every vertex), "none", or
         (rounds, points_per_vertex).
       threads: threads for the parallel parts (0 = all cores); the result is the same for any count.
       keep_components: every connected part keeps at least one face (a closed one four); False lets
@@ -391,6 +391,11 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
                        max_turn=max_turn, allow_non_manifold=allow_non_manifold, scheme=scheme, refit=refit,
                        threads=threads, record=record, keep_components=keep_components, prune=prune,
                        prune_relative=prune_relative)
+    # The light default follows the command line here too: not on a mesh with attributes, where it
+    # lowers E but raises the UV and normal errors a little (docs/attributes.md, "Seams, locks and
+    # the refit"); "full" or (rounds, points) still refits them, holding every seam position.
+    if refit == "light" and attributes:
+        options.refit_rounds = 0
     options.map_input_vertices = bool(return_mapping)
     if attribute_weights is not None:
         options.attribute_weights = attribute_weights
