@@ -156,7 +156,7 @@ int run_simplify(const SimplifyArgs& a) {
   // An input too large for memory goes the out-of-core way (qem/out_of_core.h); others as before.
   if (a.record.empty() && wants_out_of_core(a.input, a.out_of_core))
     return run_out_of_core(a.input, a.output, opt, a.out_of_core,
-                           {a.ascii, a.json, a.quiet, a.double_values, a.faces});
+                           {a.ascii, a.json, a.quiet, a.double_values, a.faces.value_or(0)});
 
   const bool show_progress = !a.quiet && !a.json && ::isatty(STDERR_FILENO);
 

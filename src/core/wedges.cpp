@@ -148,9 +148,33 @@ void Wedges::merge(std::uint32_t survivor, std::uint32_t removed, bool moved, co
   }
   first[removed] = kNoVertex;
   if (!moved) return;
+  // Texture coordinates interpolate, never extrapolate: the optimum of Hoppe's quadric at the new
+  // position may lie beyond the values of both ends, which pulls a UV out of its chart (past the
+  // atlas's edge at a pole or a seam). A merged wedge keeps its UVs within the box of those it merged.
+  std::vector<std::uint32_t> boxed;  // survivor wedges, each with `width` lows and highs below
+  std::vector<double> low, high;
+  for (const auto& [r, s] : map) {
+    std::size_t at = std::find(boxed.begin(), boxed.end(), s) - boxed.begin();
+    if (at == boxed.size()) {
+      boxed.push_back(s);
+      low.insert(low.end(), &value[std::size_t(s) * width], &value[std::size_t(s) * width] + width);
+      high.insert(high.end(), &value[std::size_t(s) * width], &value[std::size_t(s) * width] + width);
+    }
+    for (std::uint32_t i = 0; i < width; ++i) {
+      low[at * width + i] = std::min(low[at * width + i], value[std::size_t(r) * width + i]);
+      high[at * width + i] = std::max(high[at * width + i], value[std::size_t(r) * width + i]);
+    }
+  }
   std::uint32_t w = first[survivor];
   do update_values(w, p), w = next[w];
   while (w != first[survivor]);
+  for (std::size_t at = 0; at < boxed.size(); ++at)
+    for (const Channel& ch : channels)
+      if (ch.kind == AttributeKind::TexCoord)
+        for (std::uint32_t c = 0; c < ch.components; ++c) {
+          double& v = value[std::size_t(boxed[at]) * width + ch.first + c];
+          v = std::clamp(v, low[at * width + ch.first + c], high[at * width + ch.first + c]);
+        }
 }
 
 void Wedges::renumber(const std::vector<std::uint32_t>& vertex_to, std::size_t count) {
