@@ -11,41 +11,13 @@
 #include <sstream>
 #include <vector>
 
+#include "io/ply_types.h"
 #include "qem/error.h"
 
 namespace qem::outofcore {
 namespace {
 
-enum class Type { I8, U8, I16, U16, I32, U32, F32, F64 };
-
-std::size_t type_size(Type t) {
-  switch (t) {
-    case Type::I8:
-    case Type::U8:
-      return 1;
-    case Type::I16:
-    case Type::U16:
-      return 2;
-    case Type::I32:
-    case Type::U32:
-    case Type::F32:
-      return 4;
-    case Type::F64:
-      return 8;
-  }
-  return 0;
-}
-
-bool parse_type(const std::string& s, Type& t) {
-  static const std::pair<const char*, Type> names[] = {
-      {"char", Type::I8},   {"int8", Type::I8},     {"uchar", Type::U8},   {"uint8", Type::U8},
-      {"short", Type::I16}, {"int16", Type::I16},   {"ushort", Type::U16}, {"uint16", Type::U16},
-      {"int", Type::I32},   {"int32", Type::I32},   {"uint", Type::U32},   {"uint32", Type::U32},
-      {"float", Type::F32}, {"float32", Type::F32}, {"double", Type::F64}, {"float64", Type::F64}};
-  for (const auto& [name, type] : names)
-    if (s == name) return t = type, true;
-  return false;
-}
+using io::ply::Type, io::ply::parse_type, io::ply::type_size;
 
 struct Property {
   std::string name;
@@ -222,7 +194,7 @@ struct MeshStream::Impl {
           p.is_list = true;
           std::string ct;
           in >> ct;
-          if (!parse_type(ct, p.count_type) || p.count_type == Type::F32 || p.count_type == Type::F64)
+          if (!parse_type(ct, p.count_type) || !io::ply::is_integral(p.count_type))
             bad("list count type must be an integer type");
           in >> t;
         }
