@@ -292,6 +292,18 @@ double value_distance(const Wedges& wg, std::uint32_t x, std::uint32_t y) {
   return d2;
 }
 
+// The survivor's and the removed vertex's wedges at their corners of face f (a face of the edge).
+std::pair<std::uint32_t, std::uint32_t> edge_face_wedges(const WorkingMesh& m, std::uint32_t f, std::uint32_t survivor,
+                                                         std::uint32_t removed) {
+  const std::uint32_t* t = m.face(f);
+  std::uint32_t ws = kNoVertex, wr = kNoVertex;
+  for (int k = 0; k < 3; ++k) {
+    if (t[k] == survivor) ws = m.corner_wedge[3 * std::size_t(f) + k];
+    if (t[k] == removed) wr = m.corner_wedge[3 * std::size_t(f) + k];
+  }
+  return {ws, wr};
+}
+
 // The permissive map: the strict rules failed, so the collapse crosses a seam. A removed wedge on
 // an edge face goes to the survivor's wedge on that face (the first one met), any other to the
 // survivor's wedge of its material with the nearest values; none of its material: refused.
@@ -300,12 +312,7 @@ bool map_crossing(const WorkingMesh& m, const Wedges& wg, std::uint32_t survivor
   map.clear();
   for (std::uint32_t f : m.vertex_faces[survivor]) {
     if (!m.face_alive[f] || !m.face_has(f, removed)) continue;
-    const std::uint32_t* t = m.face(f);
-    std::uint32_t ws = kNoVertex, wr = kNoVertex;
-    for (int k = 0; k < 3; ++k) {
-      if (t[k] == survivor) ws = m.corner_wedge[3 * std::size_t(f) + k];
-      if (t[k] == removed) wr = m.corner_wedge[3 * std::size_t(f) + k];
-    }
+    const auto [ws, wr] = edge_face_wedges(m, f, survivor, removed);
     bool known = false;
     for (const auto& [r, s] : map) known |= r == wr;
     if (!known) map.push_back({wr, ws});
@@ -342,12 +349,7 @@ bool map_wedges(const WorkingMesh& m, const Wedges& wg, std::uint32_t survivor, 
   bool strict = true;
   for (std::uint32_t f : m.vertex_faces[survivor]) {
     if (!m.face_alive[f] || !m.face_has(f, removed)) continue;
-    const std::uint32_t* t = m.face(f);
-    std::uint32_t ws = kNoVertex, wr = kNoVertex;
-    for (int k = 0; k < 3; ++k) {
-      if (t[k] == survivor) ws = m.corner_wedge[3 * std::size_t(f) + k];
-      if (t[k] == removed) wr = m.corner_wedge[3 * std::size_t(f) + k];
-    }
+    const auto [ws, wr] = edge_face_wedges(m, f, survivor, removed);
     bool known = false;
     for (const auto& [r, s] : map) {
       if (r == wr && s == ws) known = true;
