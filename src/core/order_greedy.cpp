@@ -43,13 +43,17 @@ struct GreedyLists {
 
 }  // namespace
 
-void run_greedy(Context& c) {
+void run_greedy(Context& c, const std::vector<std::uint8_t>* stale) {
   PairSet& ps = c.pairs;
   IndexedHeap heap;
   heap.reset(ps.pairs.size());
-  ps.cost.assign(ps.pairs.size(), 0);
+  if (!stale) ps.cost.assign(ps.pairs.size(), 0);
   for (std::uint32_t p = 0; p < ps.pairs.size(); ++p) {
     if (ps.pairs[p].state != kCandidate) continue;
+    if (stale && !(*stale)[p]) {  // pair_cost would give the same key (rounded to float already)
+      heap.push_unordered(p, ps.cost[p]);
+      continue;
+    }
     double cost;
     if (pair_cost(c, p, cost)) heap.push_unordered(p, cost), ps.cost[p] = float(cost);
     else ps.pairs[p].state = kLocked;

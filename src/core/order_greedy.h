@@ -2,12 +2,16 @@
 // cheapest. Exactly the paper's greedy order.
 #pragma once
 
+#include <cstdint>
+#include <vector>
+
 #include "core/context.h"
 
 namespace qem::core {
 
 /// Contracts until the settings' stop criteria are met or nothing is left; the vertex lists must
-/// be exact when it starts (it keeps them exact).
-void run_greedy(Context& c);
+/// be exact when it starts (it keeps them exact). `stale` (may be null: every cost is computed)
+/// marks the pairs whose cost must be computed; the others' `pairs.cost` is taken as current.
+void run_greedy(Context& c, const std::vector<std::uint8_t>* stale = nullptr);
 
 }  // namespace qem::core

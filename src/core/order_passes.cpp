@@ -104,7 +104,12 @@ void run_passes(Context& c, const std::function<void(const Context&, const PassS
     }
     s.merged_from.assign(c.mesh.vertex_count(), kNoVertex);
     if (c.mesh.faces_alive <= c.settings.greedy_below_faces) {
-      run_greedy(c);  // the lists were just rebuilt: exact, as the greedy order needs them
+      // The lists were just rebuilt: exact, as the greedy order needs them. A candidate not marked
+      // dirty was costed after its ends last changed, and its cost depends on nothing else (the
+      // two quadrics, positions and lock flags) unless inversions are penalised (its neighbours)
+      // or it carries wedges (the seams around it): then every cost is computed afresh.
+      const bool reuse = c.settings.inversion != InversionPolicy::Penalize && !c.wedges;
+      run_greedy(c, reuse ? &s.dirty : nullptr);
       if (after_band) after_band(c, PassState{});
       return;
     }
