@@ -98,15 +98,18 @@ void add_faces(MeshView in, const std::vector<std::uint32_t>& internal, bool wel
   if (welded)
     for (std::size_t f = 0; f < nf; ++f)
       if (collapsed(f) && !degenerate(&in.indices[3 * f])) ++m.dropped_degenerate;
+  auto lowest_corner = [&](std::size_t f) {  // sorted_corners(f)[0], without the sort
+    return std::min({internal[in.indices[3 * f]], internal[in.indices[3 * f + 1]], internal[in.indices[3 * f + 2]]});
+  };
   std::vector<std::uint32_t> bucket_start(n + 1, 0);
   for (std::size_t f = 0; f < nf; ++f)
-    if (!collapsed(f)) ++bucket_start[sorted_corners(f)[0] + 1];
+    if (!collapsed(f)) ++bucket_start[lowest_corner(f) + 1];
   for (std::size_t i = 0; i < n; ++i) bucket_start[i + 1] += bucket_start[i];
   std::vector<std::uint32_t> bucketed(bucket_start[n]);
   {
     std::vector<std::uint32_t> fill(bucket_start.begin(), bucket_start.end() - 1);
     for (std::size_t f = 0; f < nf; ++f)
-      if (!collapsed(f)) bucketed[fill[sorted_corners(f)[0]]++] = std::uint32_t(f);
+      if (!collapsed(f)) bucketed[fill[lowest_corner(f)]++] = std::uint32_t(f);
   }
   m.tri.reserve(3 * bucketed.size());
   m.face_source.reserve(bucketed.size());
