@@ -108,6 +108,21 @@ TEST(Components, WithoutTheGuardSmallPartsVanish) {
   }
 }
 
+TEST(Components, InputCountedWithAndWithoutTheGuardAndBelowTheTarget) {
+  // The guard counts the input's parts when it runs; otherwise, and when the input is already at
+  // the target (no guard is made), they are counted on their own: the same count every way.
+  const Parts parts = hundred_parts();
+  for (bool keep : {true, false})
+    for (std::size_t target : {std::size_t(50), parts.mesh.face_count()}) {
+      SimplifyOptions o = low_target(Scheme::Passes, 1);
+      o.keep_components = keep;
+      o.target_faces = target;
+      const SimplifyResult r = simplify(parts.mesh, o);
+      EXPECT_EQ(r.input_components, 100u) << keep << " " << target;
+      EXPECT_EQ(r.stop_reason == StopReason::AlreadyBelowTarget, target == parts.mesh.face_count());
+    }
+}
+
 TEST(Components, AtTenPercentEveryPartStays) {
   const Parts parts = hundred_parts();
   for (unsigned threads : {1u, 2u}) {

@@ -39,6 +39,9 @@ class ComponentGuard {
   /// (WorkingMesh::boundary must be set).
   explicit ComponentGuard(const WorkingMesh& mesh);
 
+  /// The number of components it found at the start (count_components of that mesh).
+  std::size_t initial_count() const { return parent_.size(); }
+
   /// The component of working vertex v now. Reads only: safe on worker threads.
   std::uint32_t root(std::uint32_t v) const;
 

@@ -67,7 +67,10 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   result.input_faces = mesh.faces_alive, result.input_vertices = mesh.vertices_alive;
   result.dropped_degenerate_faces = mesh.dropped_degenerate, result.dropped_duplicate_faces = mesh.dropped_duplicate;
   const Settings settings = resolve(options, mesh);  // targets from the input, before any pruning
-  result.input_components = count_components(mesh);
+  // Without pruning, the component guard (made below, on the same faces) counts the input's
+  // components; otherwise they are counted here, before the pruning.
+  const bool guard_counts = settings.keep_components && settings.prune_size == 0;
+  if (!guard_counts) result.input_components = count_components(mesh);
   if (settings.prune_size > 0)
     result.pruned_components = prune_components(mesh, wedges ? &*wedges : nullptr, settings.prune_size);
   std::optional<ContractionMap> map;
@@ -85,6 +88,7 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
             hooks.observer && hooks.observer->wants_contractions(), map ? &*map : nullptr, {}, {}, result};
   if (wedges) c.wedges = &*wedges;
   if (c.done()) {
+    if (guard_counts) result.input_components = count_components(mesh);
     result.stop_reason = StopReason::AlreadyBelowTarget;
     result.stop_detail = stop_detail(result.stop_reason, result, settings.lock_border);
     result.output_components = count_components(mesh);
@@ -103,6 +107,7 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   c.marks.assign(mesh.vertex_count(), 0);
   std::optional<ComponentGuard> components;  // after add_boundary_planes: it tells closed from open
   if (settings.keep_components) c.components = &components.emplace(mesh);
+  if (guard_counts) result.input_components = components->initial_count();
 
   result.stop_reason = StopReason::TargetReached;  // GH97 §4: contract until a stop criterion holds
   if (settings.scheme == Scheme::Passes) {
