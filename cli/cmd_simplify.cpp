@@ -39,6 +39,10 @@ class Watcher : public ContractionRecorder {
  public:
   Watcher(bool show_progress, bool record) : show_progress_(show_progress), record_(record) {}
   bool wants_contractions() const override { return record_; }
+  // Without --record the input's faces are not kept (the recorder copies and sorts them).
+  void on_start(std::span<const std::uint32_t> input_faces) override {
+    if (record_) ContractionRecorder::on_start(input_faces);
+  }
   bool on_progress(double fraction) override {
     if (show_progress_) {
       std::fprintf(stderr, "\rqem: simplifying %5.1f%%", 100 * fraction);
