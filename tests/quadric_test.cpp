@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
 
 #include "core/placement.h"
 #include "core/quadric.h"
@@ -62,6 +63,30 @@ TEST(Placement, OptimalIsScaleRelative) {
     EXPECT_NEAR(v.x / scale, 1, 1e-9);
     EXPECT_NEAR(v.y / scale, 2, 1e-9);
   }
+}
+
+TEST(Placement, NearlyParallelPlanesMeetAtTheirCornerUntilSingular) {
+  // Three planes through (1, 2, 3) whose normals are theta apart: A's eigenvalue ratio falls like
+  // theta^2 / 9. From 0.3 to 0.05 the determinant bound proves A well conditioned (closed form);
+  // at 0.03 and 0.003 it does not and the eigenvalues decide (ratios 1e-4, 1e-6: still solved).
+  // At 1e-5 (ratio 1e-11) there is no unique optimum. The closed form keeps ~9 digits here;
+  // Eigen's direct eigensolver, fewer as the ratio falls (~1e-6 at 1e-6).
+  const Vec3 corner{1, 2, 3};
+  const auto through_corner = [&](double theta) {
+    Quadric q;
+    for (const Vec3& n : {Vec3{0, 0, 1}, Vec3{std::sin(theta), 0, std::cos(theta)}, Vec3{0, std::sin(theta), std::cos(theta)}})
+      q += Quadric::plane(n, -dot(n, corner), 1);
+    return q;
+  };
+  for (auto [theta, tolerance] : {std::pair{0.3, 1e-9}, {0.1, 1e-9}, {0.05, 1e-9}, {0.03, 1e-7}, {0.003, 1e-5}}) {
+    Vec3 v;
+    ASSERT_TRUE(place_optimal(through_corner(theta), v)) << theta;
+    EXPECT_NEAR(v.x, 1, tolerance) << theta;
+    EXPECT_NEAR(v.y, 2, tolerance) << theta;
+    EXPECT_NEAR(v.z, 3, tolerance) << theta;
+  }
+  Vec3 v;
+  EXPECT_FALSE(place_optimal(through_corner(1e-5), v));
 }
 
 TEST(Placement, FallsBackToSegmentWhenSingular) {
