@@ -34,10 +34,12 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
   sub->add_option("--threads", a.threads, "Threads for the passes: re-costing pairs, and making contractions region by region (0 = all; same result)")
       ->capture_default_str();
   sub->add_option("--boundary-weight", a.boundary_weight,
-                  "Penalty weight of the boundary constraint planes (GH97 6), times the squared edge length; "
-                  "0 = off")
+                  "Borders as GH97 6's penalty instead of exact: weight of the boundary constraint planes, "
+                  "times the squared edge length (0 = off). Without it, border vertices stay on the input's "
+                  "borders (only ever at an input border vertex) and border corners are kept exactly")
+      ->each([&a](const std::string&) { a.penalty_border = true; })
       ->capture_default_str();
-  sub->add_flag("--lock-border", a.lock_border, "Boundary vertices never move");
+  sub->add_flag("--lock-border", a.lock_border, "Boundary vertices never move (nor are removed)");
   sub->add_option("--attribute-weight", a.attribute_weights,
                   "Weight of an attribute's error against distance, as KIND=W (normal, uv, color, scalar; "
                   "repeat or separate by commas): a difference of 1/W costs as much as one bounding-box "
@@ -105,6 +107,7 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
   opt.boundary_weight = a.boundary_weight;
   opt.max_normal_turn_degrees = a.max_turn;
   opt.lock_border = a.lock_border;
+  opt.exact_border = !a.penalty_border;
   opt.preserve_topology = !a.allow_non_manifold;
   for (const std::string& item : a.attribute_weights) {
     const std::size_t eq = item.find('=');

@@ -23,6 +23,7 @@ struct AlgorithmArgs {
   double boundary_weight = SimplifyOptions{}.boundary_weight;
   double max_turn = SimplifyOptions{}.max_normal_turn_degrees;
   bool lock_border = false, allow_non_manifold = false;
+  bool penalty_border = false;  // --boundary-weight given: GH97 §6's penalty instead of exact borders
   bool weld = false, no_weld = false;
   bool refit = false;         // --refit
   unsigned refit_rounds = 0;  // --refit-rounds (implies --refit); 0 = RefitOptions' default

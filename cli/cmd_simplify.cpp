@@ -22,6 +22,7 @@ struct SimplifyArgs {
   std::size_t faces = 0, vertices = 0;
   double ratio = 0;
   double max_error = -1, max_error_rel = -1;
+  double max_distance = -1, max_distance_rel = -1;
   AlgorithmArgs algorithm;
   bool ascii = false, json = false, quiet = false, force = false;
   bool double_values = false;  // --double
@@ -61,6 +62,8 @@ int run_simplify(const SimplifyArgs& a) {
   opt.target_vertices = a.vertices;
   if (a.max_error >= 0) opt.max_error = a.max_error;
   if (a.max_error_rel >= 0) opt.max_error = a.max_error_rel, opt.max_error_is_relative = true;
+  if (a.max_distance >= 0) opt.max_distance = a.max_distance;
+  if (a.max_distance_rel >= 0) opt.max_distance = a.max_distance_rel, opt.max_distance_is_relative = true;
   check_options(opt);  // before the input is read: a slip in the options is said at once
 
   const bool show_progress = !a.quiet && !a.json && ::isatty(STDERR_FILENO);
@@ -103,14 +106,16 @@ int run_simplify(const SimplifyArgs& a) {
         "{\"tool\":\"qem\",\"in_faces\":%zu,\"target_faces\":%zu,\"out_faces\":%zu,\"out_vertices\":%zu,"
         "\"load_s\":%s,\"simplify_s\":%s,\"simplify_cpu_s\":%s,\"write_s\":%s,\"total_s\":%s,"
         "\"peak_rss_mb\":%s,\"max_error\":%s,\"max_error_rel\":%s,\"contractions\":%zu,\"virtual_pairs\":%zu,"
-        "\"rejected_topology\":%zu,\"rejected_inversion\":%zu,\"rejected_error\":%zu,\"refit_rounds\":%zu,"
+        "\"rejected_topology\":%zu,\"rejected_inversion\":%zu,\"rejected_error\":%zu,\"rejected_distance\":%zu,"
+        "\"output_to_input_distance\":%s,\"refit_rounds\":%zu,"
         "\"refit_rms_before\":%s,\"refit_rms_after\":%s,\"dropped_degenerate\":%zu,\"dropped_duplicate\":%zu,"
         "\"stop\":\"%s\"}\n",
         in_faces, a.faces, r.mesh.face_count(), r.mesh.vertex_count(), json_number(load_s).c_str(),
         json_number(simplify_s).c_str(), json_number(simplify_cpu_s).c_str(), json_number(write_s).c_str(),
         json_number(total.seconds()).c_str(), json_number(peak_rss_mb()).c_str(),
         json_number(r.max_error).c_str(), json_number(r.max_error_relative).c_str(), r.contractions,
-        r.virtual_pairs, r.rejected_topology, r.rejected_inversion, r.rejected_error, r.refit_rounds,
+        r.virtual_pairs, r.rejected_topology, r.rejected_inversion, r.rejected_error, r.rejected_distance,
+        json_number(r.output_to_input_distance).c_str(), r.refit_rounds,
         json_number(r.refit_rms_before).c_str(), json_number(r.refit_rms_after).c_str(),
         r.dropped_degenerate_faces, r.dropped_duplicate_faces, to_string(r.stop_reason));
   }
@@ -121,6 +126,10 @@ int run_simplify(const SimplifyArgs& a) {
   if (!a.quiet && r.dropped_degenerate_faces + r.dropped_duplicate_faces > 0)
     std::fprintf(stderr, "qem: left out %zu degenerate and %zu duplicate input faces\n", r.dropped_degenerate_faces,
                  r.dropped_duplicate_faces);
+  if (!a.quiet && std::isfinite(opt.max_distance))
+    std::fprintf(stderr, "qem: distance from the output to the input %.4g (sampled; bound %.4g%s), %zu contractions refused for it\n",
+                 r.output_to_input_distance, opt.max_distance, opt.max_distance_is_relative ? " of the diagonal" : "",
+                 r.rejected_distance);
   if (!a.quiet && opt.refit_rounds > 0)
     std::fprintf(stderr, "qem: refit in %zu round%s: RMS distance of the input's vertices %.4g -> %.4g\n",
                  r.refit_rounds, r.refit_rounds == 1 ? "" : "s", r.refit_rms_before, r.refit_rms_after);
@@ -140,6 +149,13 @@ const bool registered = register_command(10, [](CLI::App& app) {
                 "Never make a contraction whose error exceeds this distance (model units): the error is "
                 "sqrt(Q(v)/weight), the weighted RMS distance of the new vertex to the planes it represents");
   g->add_option("--max-error-rel", args->max_error_rel, "As --max-error, relative to the bounding-box diagonal");
+  g->add_option("--max-distance", args->max_distance,
+                "No output point farther than this from the input surface (model units): each contraction's "
+                "new faces are certified against the input (sampled, with the sample spacing accounted for) "
+                "and refused otherwise; the refit keeps it too. Alone: as few faces as the bound allows")
+      ->check(CLI::PositiveNumber);
+  g->add_option("--max-distance-rel", args->max_distance_rel, "As --max-distance, relative to the bounding-box diagonal")
+      ->check(CLI::PositiveNumber);
   add_algorithm_options(sub, args->algorithm);
   sub->add_flag("--ascii", args->ascii, "Write PLY / STL as text instead of binary");
   sub->add_flag("--double", args->double_values, kDoubleOutputHelp);

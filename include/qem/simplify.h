@@ -103,6 +103,12 @@ struct SimplifyOptions {
   /// weighted RMS distance from the new vertex to the planes it represents. +inf = no limit.
   double max_error = std::numeric_limits<double>::infinity();
   bool max_error_is_relative = false;  ///< max_error is a fraction of the bounding-box diagonal
+  /// A bound on the one-sided Hausdorff distance from the output to the input (distance units): no
+  /// point of an output face farther than this from the input surface. Each contraction's new
+  /// faces are certified against the input (src/core/distance_bound.h) and refused otherwise; the
+  /// refit keeps it too. Alone it is a stop criterion: as few faces as the bound allows. +inf = none.
+  double max_distance = std::numeric_limits<double>::infinity();
+  bool max_distance_is_relative = false;  ///< max_distance is a fraction of the bounding-box diagonal
 
   // --- the algorithm --------------------------------------------------------------------------
   Weighting weighting = Weighting::Area;
@@ -110,9 +116,16 @@ struct SimplifyOptions {
   /// Pair threshold t of GH97 §3.2: vertices closer than t are valid pairs too (0 = edges only).
   double threshold = 0;
   bool threshold_is_relative = false;  ///< threshold is a fraction of the bounding-box diagonal
-  /// Penalty weight of the boundary constraint planes (GH97 §6); 0 disables them.
+  /// Weight of the boundary constraint planes (GH97 §6); 0 disables them. With exact_border they
+  /// rank the contractions only; without, they are GH97's penalty and also pull the placement.
   double boundary_weight = 1;
   bool lock_border = false;  ///< boundary vertices never move
+  /// Open borders stay exact: a border vertex is only ever placed at an input border vertex (its
+  /// own or, along a border edge, its neighbour's), with bit-identical coordinates; border corners
+  /// (a turn above a few degrees, non-manifold edges) are never removed, and the refit does not
+  /// move border vertices. false: GH97 §6's penalty alone (boundary_weight), the vertices may
+  /// leave the border.
+  bool exact_border = true;
   /// Per input vertex (empty: none), nonzero = locked: it never moves and is never removed (the
   /// other end of a contraction comes to it). With attributes, a position is locked when any of
   /// its vertices is. The caller's buffer must outlive the call.
@@ -156,6 +169,10 @@ struct SimplifyResult {
   std::size_t virtual_pairs = 0;    ///< non-edge pairs found with the threshold t
   /// Candidate contractions popped from the heap and refused (each may be retried later).
   std::size_t rejected_topology = 0, rejected_inversion = 0, rejected_error = 0;
+  std::size_t rejected_distance = 0;  ///< refused by max_distance
+  /// With max_distance: the largest distance from the output to the input over the certified
+  /// samples of every output face (after the refit), in distance units; at most max_distance.
+  double output_to_input_distance = 0;
   double max_error = 0;             ///< largest contraction error performed (distance units)
   double max_error_relative = 0;    ///< the same over the bounding-box diagonal
   StopReason stop_reason = StopReason::TargetReached;

@@ -152,6 +152,7 @@ void contract(Context& c, Lists& lists, std::uint32_t p, const Quadric& q, const
   m.pos[a] = target;
   c.quadric[a] = q;
   m.boundary[a] |= m.boundary[b];
+  if (!m.corner.empty()) m.corner[a] |= m.corner[b];  // never set on b under exact borders
   ++w.vertices_removed;
   m.aggregated[a] |= m.aggregated[b] | c.pairs.pairs[p].is_virtual;
 
@@ -209,6 +210,12 @@ bool try_contract(Context& c, Lists& lists, std::uint32_t p, Worker& w) {
   const double err = normalized_error(placed.error, q.weight);
   if (err > c.settings.max_error) {
     ++w.blocked_error;
+    ps.block(p);
+    return false;
+  }
+  // max_distance: the new faces certified against the input (checked last: the costliest).
+  if (c.surface && !contraction_within(*c.surface, c.settings.max_distance, c.mesh, a, b, placed.position)) {
+    ++w.blocked_distance;
     ps.block(p);
     return false;
   }

@@ -7,9 +7,12 @@ bool place_with_wedges(const Context& c, std::uint32_t a, std::uint32_t b, const
   const WorkingMesh& m = c.mesh;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> map;
   bool found = false;
+  const BorderTarget border = border_target(c, a, b);  // exact borders (border_placement.h)
+  if (border == BorderTarget::Never) return false;
   for (int direction = 0; direction < 2; ++direction) {
     const std::uint32_t survivor = direction == 0 ? a : b, removed = direction == 0 ? b : a;
     if (m.held(removed, c.settings.lock_border)) continue;  // locked: it must stay
+    if ((border == BorderTarget::AtA && survivor != a) || (border == BorderTarget::AtB && survivor != b)) continue;
     if (!map_wedges(m, wg, survivor, removed, map)) continue;
     Quadric total = q;
     std::uint32_t w = wg.first[survivor];
@@ -20,7 +23,8 @@ bool place_with_wedges(const Context& c, std::uint32_t a, std::uint32_t b, const
       total += wg.reduced(w, partner);
       w = wg.next[w];
     } while (w != wg.first[survivor]);
-    const bool free = wg.single(a) && wg.single(b) && !m.held(survivor, c.settings.lock_border);
+    const bool free = wg.single(a) && wg.single(b) && !m.held(survivor, c.settings.lock_border) &&
+                      border == BorderTarget::Free;
     const Placed candidate =
         free ? place(total, m.pos[a], m.pos[b], c.settings.placement) : Placed{m.pos[survivor], total.evaluate(m.pos[survivor])};
     if (!found || candidate.error < placed.error) placed = candidate;

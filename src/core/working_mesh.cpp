@@ -185,6 +185,7 @@ void WorkingMesh::squeeze_faces(const std::vector<std::uint32_t>& vertex_to) {
 void WorkingMesh::squeeze_vertices(const std::vector<std::uint32_t>& vertex_to, std::size_t count) {
   squeeze_by(vertex_to, count, pos);
   squeeze_by(vertex_to, count, boundary);
+  if (!corner.empty()) squeeze_by(vertex_to, count, corner);
   squeeze_by(vertex_to, count, moved);
   squeeze_by(vertex_to, count, aggregated);
   squeeze_by(vertex_to, count, source_vertex);

@@ -29,6 +29,8 @@ struct WorkingMesh {
   std::vector<std::uint32_t> source_vertex;  ///< input vertex of each working vertex
   std::vector<std::uint8_t> moved;           ///< left its input position (else written back exactly)
   std::vector<std::uint8_t> boundary;        ///< on a border edge (GH97 §6), inherited through merges
+  /// Under exact borders, never removed and never moved (border_placement.h); empty otherwise.
+  std::vector<std::uint8_t> corner;
   /// Set on both ends of a contracted threshold pair and inherited through merges: an aggregation
   /// joint, non-manifold by design (GH97 §3.2), where the link condition does not apply.
   std::vector<std::uint8_t> aggregated;

@@ -1,0 +1,74 @@
+// Exact borders (the default; SimplifyOptions::exact_border): an open border's vertices never
+// leave the input's border polylines. GH97 §6's border planes are a penalty that the optimal
+// placement trades against the faces' planes, so a border vertex drifts off its border and off
+// the plane of a flat patch; tiles simplified one by one then no longer meet. Here the planes
+// still rank the contractions (they say what cutting a curved border costs), but a contraction
+// that involves a border vertex is placed at an existing border vertex:
+//   - a border vertex and an interior one: at the border vertex;
+//   - the two ends of a border edge: at the end of lower error (so a border vertex only ever
+//     "slides" to its neighbour along its own polyline, and every border vertex of the output is
+//     an input border vertex with bit-identical coordinates);
+//   - two border vertices that do not share a border edge: never (it would join two stretches of
+//     border across the surface);
+//   - a corner (where the border turns by more than kCornerDegrees, where the border is not a
+//     simple chain, or on a non-manifold edge) is never removed: its pairs are placed at it, and
+//     two corners never contract together.
+// Locked vertices (vertex_lock, --lock-border) count as corners.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/context.h"
+#include "core/valid_pairs.h"
+#include "core/working_mesh.h"
+
+namespace qem::core {
+
+/// A border vertex whose two border edges turn by more than this (degrees) is a corner: kept
+/// exactly. A square's or a polygon's corners are kept, and a curve sampled with more than 18
+/// segments per full turn stays free to lose vertices. Scanned borders are jagged: at 5 degrees
+/// nearly every vertex of them is a corner, the border cannot be simplified and crowds the
+/// surface next to it with thin faces.
+inline constexpr double kCornerDegrees = 20;
+
+/// Marks mesh.corner from the input's unique edges (with face counts): ends of non-manifold
+/// edges, border vertices with other than two border edges, and border turns above kCornerDegrees.
+void mark_border_corners(WorkingMesh& mesh, const std::vector<Edge>& edges);
+
+/// Where the contraction of (a, b) may go under exact borders.
+enum class BorderTarget : std::uint8_t { Free, AtA, AtB, AtEither, Never };
+
+namespace border_detail {
+enum class Role : std::uint8_t { Free, Border, Fixed };
+inline Role role(const Context& c, std::uint32_t v) {
+  const WorkingMesh& m = c.mesh;
+  if (m.corner[v] || m.held(v, c.settings.lock_border)) return Role::Fixed;
+  return m.boundary[v] ? Role::Border : Role::Free;
+}
+/// Exactly one live face has both a and b: (a, b) is an edge of the current border.
+inline bool is_border_edge(const WorkingMesh& m, std::uint32_t a, std::uint32_t b) {
+  int shared = 0;
+  for (std::uint32_t f : m.vertex_faces[a])
+    if (m.face_alive[f] && m.face_has(f, b)) ++shared;
+  return shared == 1;
+}
+}  // namespace border_detail
+
+/// The rule above for pair (a, b); Free when exact borders are off or neither end is on a border.
+inline BorderTarget border_target(const Context& c, std::uint32_t a, std::uint32_t b) {
+  using border_detail::Role;
+  if (!c.settings.exact_border) return BorderTarget::Free;
+  const Role ra = border_detail::role(c, a), rb = border_detail::role(c, b);
+  if (ra == Role::Free && rb == Role::Free) return BorderTarget::Free;
+  if (ra == Role::Fixed && rb == Role::Fixed) return BorderTarget::Never;
+  if (ra == Role::Free) return BorderTarget::AtB;
+  if (rb == Role::Free) return BorderTarget::AtA;
+  // Both on a border: only along one of its edges.
+  if (!border_detail::is_border_edge(c.mesh, a, b)) return BorderTarget::Never;
+  if (ra == Role::Fixed) return BorderTarget::AtA;
+  if (rb == Role::Fixed) return BorderTarget::AtB;
+  return BorderTarget::AtEither;
+}
+
+}  // namespace qem::core
