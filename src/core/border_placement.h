@@ -26,11 +26,12 @@
 namespace qem::core {
 
 /// A border vertex whose two border edges turn by more than this (degrees) is a corner: kept
-/// exactly. A square's or a polygon's corners are kept, and a curve sampled with more than 18
-/// segments per full turn stays free to lose vertices. Scanned borders are jagged: at 5 degrees
-/// nearly every vertex of them is a corner, the border cannot be simplified and crowds the
-/// surface next to it with thin faces.
-inline constexpr double kCornerDegrees = 20;
+/// exactly. A square's, a rectangle's or a hexagon's corners are kept; a polygon of 8 or more
+/// sides is a curve, free to lose vertices. Smaller angles froze whole borders: scanned borders
+/// are jagged, and small holes are polygons of a dozen sides; at 20 degrees plane_holes.obj
+/// (27 holes) could not go below 391 faces and its E at 1 % was 40 times GH97's penalty's
+/// (docs/benchmarks.md, "Borders").
+inline constexpr double kCornerDegrees = 45;
 
 /// Marks mesh.corner from the input's unique edges (with face counts): ends of non-manifold
 /// edges, border vertices with other than two border edges, and border turns above kCornerDegrees.
