@@ -45,8 +45,25 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
                   "repeat or separate by commas): a difference of 1/W costs as much as one bounding-box "
                   "diagonal (defaults: normal=" + json_number(AttributeWeights{}.normal) + ", uv=" +
                       json_number(AttributeWeights{}.tex_coord) + ", color=" + json_number(AttributeWeights{}.color) +
-                      ", scalar=" + json_number(AttributeWeights{}.scalar) + ")")
+                      ", scalar=" + json_number(AttributeWeights{}.scalar) + "); seam=W weighs constraint planes along "
+                      "the seams, as --boundary-weight for borders (default " + json_number(AttributeWeights{}.seam) + ")")
       ->delimiter(',');
+  sub->add_option("--seams", a.seams,
+                  "With attributes, seams (UV seams, normal creases, colour and material boundaries): strict "
+                  "(a collapse runs only along a seam, both sides together) or permissive (a collapse may "
+                  "cross a seam, not a material boundary, when its error, the attribute error included, "
+                  "allows: reaches targets that many small UV charts block, at some UV quality; "
+                  "docs/attributes.md)")
+      ->check(CLI::IsMember({"strict", "permissive"}))
+      ->capture_default_str();
+  sub->add_option("--lock", a.lock,
+                  "Vertices that never move and are never removed: seams (every position with more than "
+                  "one set of attributes), borders (as --lock-border); separate by commas")
+      ->check(CLI::IsMember({"seams", "borders"}))
+      ->delimiter(',');
+  sub->add_option("--lock-property", a.lock_property,
+                  "Lock the vertices whose PLY vertex property (or scalar attribute) NAME is non-zero")
+      ->type_name("NAME");
   sub->add_option("--inversion", a.inversion, "Contractions that flip a face: forbid, penalize, or off (GH97 6)")
       ->check(CLI::IsMember(option_names<InversionPolicy>()))
       ->capture_default_str();
@@ -54,6 +71,15 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
       ->capture_default_str();
   sub->add_flag("--allow-non-manifold", a.allow_non_manifold,
                 "Do not check the link condition: edge collapses may create non-manifold edges");
+  sub->add_flag("--allow-vanishing", a.allow_vanishing,
+                "GH97 as published: a connected part may contract to nothing. By default every part keeps at "
+                "least one face, a closed one four (a tetrahedron); parts that --threshold joins count as one");
+  sub->add_option("--prune", a.prune,
+                  "Remove whole the connected parts whose bounding-box diagonal is below this distance (model "
+                  "units) before simplifying; 0 = none")
+      ->check(CLI::NonNegativeNumber);
+  sub->add_option("--prune-rel", a.prune_rel, "As --prune, relative to the whole mesh's bounding-box diagonal")
+      ->check(CLI::NonNegativeNumber);
   sub->add_flag("--weld", a.weld, "Merge exactly coincident vertices on load (default for STL)");
   sub->add_flag("--no-weld", a.no_weld, "Never weld on load, not even STL");
   sub->add_flag("--refit", a.refit,
@@ -64,7 +90,8 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
                     "(--refit-rounds " +
                     std::to_string(kDefaultRefitRounds) + " --refit-sample " +
                     std::to_string(int(kDefaultRefitSample)) +
-                    ") when --placement is optimal; see --no-refit");
+                    ") when --placement is optimal and the mesh has no attributes (with attributes only when "
+                    "asked: it holds the seams; docs/attributes.md); see --no-refit");
   sub->add_option("--refit-rounds", a.refit_rounds,
                   "Project-and-solve rounds of --refit (implies it; default " +
                       std::to_string(RefitOptions{}.rounds) + ")")
@@ -109,6 +136,10 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
   opt.lock_border = a.lock_border;
   opt.exact_border = !a.penalty_border;
   opt.preserve_topology = !a.allow_non_manifold;
+  opt.keep_components = !a.allow_vanishing;
+  if (a.prune > 0 && a.prune_rel > 0) throw Error("give --prune or --prune-rel, not both");
+  if (a.prune_rel > 0) opt.prune_size = a.prune_rel, opt.prune_size_is_relative = true;
+  else opt.prune_size = a.prune;
   for (const std::string& item : a.attribute_weights) {
     const std::size_t eq = item.find('=');
     const std::string kind = item.substr(0, eq);
@@ -116,13 +147,20 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
                      : kind == "uv"   ? &opt.attribute_weights.tex_coord
                      : kind == "color" ? &opt.attribute_weights.color
                      : kind == "scalar" ? &opt.attribute_weights.scalar
+                     : kind == "seam"   ? &opt.attribute_weights.seam
                                         : nullptr;
     char* end = nullptr;
     const double w = eq == std::string::npos ? -1 : std::strtod(item.c_str() + eq + 1, &end);
     if (!weight || eq == std::string::npos || !end || *end != 0 || !(w >= 0) || !std::isfinite(w))
-      throw Error("--attribute-weight: expected KIND=W with KIND normal, uv, color or scalar and W >= 0, got '" +
+      throw Error("--attribute-weight: expected KIND=W with KIND normal, uv, color, scalar or seam and W >= 0, got '" +
                   item + "'");
     *weight = w;
+  }
+  opt.permissive_seams = a.seams == "permissive";
+  for (const std::string& what : a.lock) {
+    if (what == "seams") opt.lock_seams = true;
+    else if (what == "borders") opt.lock_border = true;
+    else throw Error("--lock: expected seams or borders, got '" + what + "'");
   }
   if (a.refit_asked() && a.no_refit)
     throw Error("--no-refit cannot be combined with --refit, --refit-rounds or --refit-sample");
@@ -140,7 +178,34 @@ LoadOptions to_load_options(const AlgorithmArgs& a) {
   LoadOptions load;
   if (a.weld) load.weld = Weld::On;
   if (a.no_weld) load.weld = Weld::Off;
+  if (!a.lock_property.empty()) load.keep_vertex_properties = true;
   return load;
+}
+
+unsigned attribute_refit_rounds(const AlgorithmArgs& a, const SimplifyOptions& options) {
+  return a.refit_asked() ? options.refit_rounds : 0;
+}
+
+void apply_lock_property(const AlgorithmArgs& a, const std::string& file, const Mesh& mesh,
+                         std::vector<std::uint8_t>& lock, SimplifyOptions& options) {
+  if (a.lock_property.empty()) return;
+  const std::vector<double>* values = nullptr;
+  std::string known;
+  for (const VertexProperty& p : mesh.vertex_properties) {
+    if (p.name == a.lock_property) values = &p.values;
+    known += (known.empty() ? "" : ", ") + p.name;
+  }
+  for (const VertexAttribute& attr : mesh.attributes) {
+    if (attr.kind != AttributeKind::Scalar || attr.components != 1) continue;
+    if (!values && attr.name == a.lock_property) values = &attr.values;
+    known += (known.empty() ? "" : ", ") + attr.name;
+  }
+  if (!values)
+    throw Error(file + ": --lock-property: no vertex property or scalar attribute named '" + a.lock_property +
+                "' (" + (known.empty() ? std::string("it has none") : "it has: " + known) + ")");
+  lock.assign(mesh.vertex_count(), 0);
+  for (std::size_t v = 0; v < lock.size() && v < values->size(); ++v) lock[v] = (*values)[v] != 0;
+  options.vertex_lock = lock;
 }
 
 }  // namespace qem::cli

@@ -1,81 +1,83 @@
 // `qem generate KIND OUTPUT`: synthetic meshes of any size, so that the README's first command
-// (and a benchmark) needs no downloaded model.
+// (and a benchmark) needs no downloaded model. A .ply is streamed to disk (bounded memory, up to
+// a billion faces and more); other formats, and meshes with --attributes, are built in memory.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
 #include <string>
 
 #include "command.h"
+#include "outofcore/mesh_generator.h"
 #include "qem/error.h"
 #include "qem/io.h"
 
 namespace qem::cli {
 namespace {
 
-// Icosphere subdivided until it has at least `faces` faces, radially displaced by a few waves so
-// that it has features worth keeping (as the bench's noisy sphere).
-Mesh bumpy_sphere(std::size_t faces) {
-  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-  Mesh m;
-  m.positions = {-1, t, 0, 1, t, 0, -1, -t, 0, 1, -t, 0, 0, -1, t, 0, 1, t,
-                 0, -1, -t, 0, 1, -t, t, 0, -1, t, 0, 1, -t, 0, -1, -t, 0, 1};
-  m.indices = {0, 11, 5, 0, 5, 1, 0, 1, 7, 0, 7, 10, 0, 10, 11, 1, 5, 9, 5, 11, 4, 11, 10, 2, 10, 7, 6, 7, 1, 8,
-               3, 9, 4, 3, 4, 2, 3, 2, 6, 3, 6, 8, 3, 8, 9, 4, 9, 5, 2, 4, 11, 6, 2, 10, 8, 6, 7, 9, 8, 1};
-  while (m.face_count() < faces) {
-    std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> mid;
-    auto midpoint = [&](std::uint32_t a, std::uint32_t b) {
-      auto key = a < b ? std::make_pair(a, b) : std::make_pair(b, a);
-      auto it = mid.find(key);
-      if (it != mid.end()) return it->second;
-      auto v = std::uint32_t(m.vertex_count());
-      for (int k = 0; k < 3; ++k) m.positions.push_back((m.positions[3 * a + k] + m.positions[3 * b + k]) / 2);
-      mid.emplace(key, v);
-      return v;
-    };
-    std::vector<std::uint32_t> next;
-    next.reserve(4 * m.indices.size());
-    for (std::size_t f = 0; f < m.indices.size(); f += 3) {
-      std::uint32_t a = m.indices[f], b = m.indices[f + 1], c = m.indices[f + 2];
-      std::uint32_t ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
-      next.insert(next.end(), {a, ab, ca, b, bc, ab, c, ca, bc, ab, bc, ca});
-    }
-    m.indices.swap(next);
+// Adds smooth normals (area-weighted face normals per position) and a latitude/longitude UV map
+// to a closed mesh centred at the origin, splitting vertices where the map is discontinuous: along
+// the seam where longitude wraps from 1 to 0 (each face that straddles it gets copies with u + 1),
+// and at a pole, where longitude is undefined (one copy per face, u from the face's other corners).
+// The result is what a textured asset looks like to the simplifier: wedges at a UV seam, one UV set.
+Mesh with_uv_and_normals(const Mesh& in) {
+  const std::size_t n = in.vertex_count();
+  std::vector<double> normal(3 * n, 0.0), u(n), v(n);
+  std::vector<bool> pole(n);
+  for (std::size_t f = 0; f < in.indices.size(); f += 3) {
+    const double* p[3];
+    for (int k = 0; k < 3; ++k) p[k] = &in.positions[3 * std::size_t(in.indices[f + k])];
+    const double e1[3] = {p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]};
+    const double e2[3] = {p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]};
+    const double c[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+    for (int k = 0; k < 3; ++k)
+      for (int j = 0; j < 3; ++j) normal[3 * std::size_t(in.indices[f + k]) + j] += c[j];  // |c| = 2 x area
   }
-  for (std::size_t v = 0; v < m.vertex_count(); ++v) {
-    double* p = &m.positions[3 * v];
-    double len = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-    double x = p[0] / len, y = p[1] / len, z = p[2] / len;
-    double r = 1 + 0.08 * std::sin(7 * x + 1) * std::sin(6 * y) + 0.04 * std::cos(13 * z + 2 * x) +
-               0.02 * std::sin(23 * y + 17 * z);
-    p[0] = x * r, p[1] = y * r, p[2] = z * r;
+  for (std::size_t i = 0; i < n; ++i) {
+    double* nv = &normal[3 * i];
+    const double len = std::sqrt(nv[0] * nv[0] + nv[1] * nv[1] + nv[2] * nv[2]);
+    if (len > 0) nv[0] /= len, nv[1] /= len, nv[2] /= len;
+    const double* p = &in.positions[3 * i];
+    const double r = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]), rxz = std::hypot(p[0], p[2]);
+    pole[i] = !(rxz > 1e-12 * r);
+    u[i] = pole[i] ? 0 : std::atan2(p[2], p[0]) / (2 * M_PI) + 0.5;
+    v[i] = r > 0 ? std::acos(std::clamp(p[1] / r, -1.0, 1.0)) / M_PI : 0;
   }
-  return m;
-}
-
-// Torus with major radius 1 and minor radius 0.35 on an n x (n/2) grid.
-Mesh torus(std::size_t faces) {
-  std::size_t n = 8;
-  while (n * (n / 2) * 2 < faces) n += 2;
-  const std::size_t m_ring = n / 2;
   Mesh m;
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t j = 0; j < m_ring; ++j) {
-      double u = 2 * M_PI * double(i) / double(n), v = 2 * M_PI * double(j) / double(m_ring);
-      double r = 1 + 0.35 * std::cos(v);
-      m.positions.insert(m.positions.end(), {r * std::cos(u), r * std::sin(u), 0.35 * std::sin(v)});
+  VertexAttribute uv{"TEXCOORD_0", AttributeKind::TexCoord, 2, {}}, nrm{"NORMAL", AttributeKind::Normal, 3, {}};
+  std::map<std::pair<std::uint32_t, std::uint64_t>, std::uint32_t> copy;  // (vertex, variant) -> output
+  auto emit = [&](std::uint32_t i, std::uint64_t variant, double cu) {
+    auto [it, fresh] = copy.try_emplace({i, variant}, std::uint32_t(m.vertex_count()));
+    if (fresh) {
+      m.positions.insert(m.positions.end(), {in.positions[3 * i], in.positions[3 * i + 1], in.positions[3 * i + 2]});
+      uv.values.insert(uv.values.end(), {cu, v[i]});
+      nrm.values.insert(nrm.values.end(), {normal[3 * i], normal[3 * i + 1], normal[3 * i + 2]});
     }
-  auto id = [&](std::size_t i, std::size_t j) { return std::uint32_t((i % n) * m_ring + (j % m_ring)); };
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t j = 0; j < m_ring; ++j) {
-      m.indices.insert(m.indices.end(), {id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-      m.indices.insert(m.indices.end(), {id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    return it->second;
+  };
+  for (std::size_t f = 0; f < in.indices.size(); f += 3) {
+    const std::uint32_t* t = &in.indices[f];
+    double lo = 1, hi = 0;
+    for (int k = 0; k < 3; ++k)
+      if (!pole[t[k]]) lo = std::min(lo, u[t[k]]), hi = std::max(hi, u[t[k]]);
+    const bool wraps = hi - lo > 0.5;
+    double cu[3], sum = 0;
+    int count = 0;
+    for (int k = 0; k < 3; ++k)
+      if (!pole[t[k]]) cu[k] = u[t[k]] + (wraps && u[t[k]] < 0.5 ? 1 : 0), sum += cu[k], ++count;
+    for (int k = 0; k < 3; ++k) {
+      if (pole[t[k]]) m.indices.push_back(emit(t[k], 2 + f / 3, count ? sum / count : 0));
+      else m.indices.push_back(emit(t[k], cu[k] >= 1 ? 1 : 0, cu[k]));
     }
+  }
+  m.attributes = {std::move(uv), std::move(nrm)};
   return m;
 }
 
 struct GenerateArgs {
   std::string kind = "sphere", output;
   std::size_t faces = 100000;
+  bool attributes = false;
 };
 
 const bool registered = register_command(5, [](CLI::App& app) {
@@ -84,12 +86,31 @@ const bool registered = register_command(5, [](CLI::App& app) {
   sub->add_option("kind", args->kind, "sphere (closed, bumpy icosphere) or torus")
       ->required()
       ->check(CLI::IsMember({"sphere", "torus"}));
-  sub->add_option("output", args->output, "Output mesh (.obj .ply .stl .off)")->required();
-  sub->add_option("--faces", args->faces, "At least this many faces (sphere: next power-of-4 level)")
+  sub->add_option("output", args->output, "Output mesh (.obj .ply .stl .off; .obj, .ply or .glb for --attributes)")->required();
+  sub->add_option("--faces", args->faces,
+                  "At least this many faces (sphere: next 20 * 4^level). A .ply without --attributes is streamed "
+                  "to disk in bounded memory (up to 1342177280 sphere or 2000000000 torus faces); other "
+                  "outputs are built in memory (up to 200000000)")
       ->capture_default_str();
+  sub->add_flag("--attributes", args->attributes,
+                "Add smooth normals and a latitude/longitude UV map (TEXCOORD_0) with its seam: the positions "
+                "where the map is discontinuous are split into several vertices, as in a textured asset");
   return [args] {
-    if (args->faces > 200000000) throw Error("--faces is too large (at most 200000000)");
-    Mesh m = args->kind == "sphere" ? bumpy_sphere(args->faces) : torus(args->faces);
+    const bool sphere = args->kind == "sphere";
+    if (format_from_extension(args->output) == FileFormat::Ply && !args->attributes) {
+      const outofcore::GeneratedCounts n = sphere
+                                               ? outofcore::write_bumpy_sphere_ply(args->output, args->faces)
+                                               : outofcore::write_torus_ply(args->output, args->faces);
+      std::fprintf(stderr, "qem: wrote %s: %llu vertices, %llu faces\n", args->output.c_str(),
+                   static_cast<unsigned long long>(n.vertices), static_cast<unsigned long long>(n.faces));
+      return 0;
+    }
+    if (args->faces > 200000000)
+      throw Error(
+          "--faces is too large for a mesh built in memory (at most 200000000); write a .ply without "
+          "--attributes, which is streamed");
+    Mesh m = sphere ? outofcore::bumpy_sphere(args->faces) : outofcore::torus(args->faces);
+    if (args->attributes) m = with_uv_and_normals(m);
     save_mesh(args->output, m);
     std::fprintf(stderr, "qem: wrote %s: %zu vertices, %zu faces\n", args->output.c_str(), m.vertex_count(),
                  m.face_count());

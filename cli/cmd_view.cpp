@@ -1,6 +1,8 @@
 // `qem view`: shows meshes in a local web page (three.js, bundled in web/dist): one mesh, an LOD
 // chain walked by a slider, or an original/simplified pair side by side; an error heat map when a
-// mesh has a per-vertex `distance` property. `--export DIR` writes the same page to a folder.
+// mesh has a per-vertex `distance` property. Models are drawn with their normals, texture
+// coordinates, colours and materials (OBJ .mtl textures); glTF files are shown as the document
+// itself (materials, skins, animations). `--export DIR` writes the same page to a folder.
 #include <atomic>
 #include <cmath>
 #include <csignal>
@@ -18,6 +20,7 @@
 #include "qem/progressive.h"
 #include "view/http_server.h"
 #include "view/lod_manifest.h"
+#include "view/model_assets.h"
 #include "view/scene.h"
 #include "view/web_assets.h"
 
@@ -88,9 +91,11 @@ view::ViewScene build_scene(const ViewArgs& a) {
       if (view::is_manifest_path(p)) throw Error(p + ": an LOD manifest must be the only input");
       entries.push_back({p, 0, 0, NAN});
     }
-    scene.mode = a.compare            ? view::ViewMode::Compare
-                 : entries.size() > 1 ? view::ViewMode::Chain
-                                      : view::ViewMode::Single;
+    // Two meshes are an original and its simplification, side by side, unless --chain says they
+    // are an LOD chain; more are a chain.
+    scene.mode = a.compare || (entries.size() == 2 && !a.chain) ? view::ViewMode::Compare
+                 : entries.size() > 1                            ? view::ViewMode::Chain
+                                                                 : view::ViewMode::Single;
   }
   // Checked before loading anything: the meshes may be large.
   if (scene.mode == view::ViewMode::Compare && entries.size() != 2)
@@ -100,9 +105,9 @@ view::ViewScene build_scene(const ViewArgs& a) {
   lo.keep_vertex_properties = true;  // the `distance` heat map
   for (std::size_t i = 0; i < entries.size(); ++i) {
     const view::ManifestLevel& e = entries[i];
-    view::ViewLevel level;
-    level.name = std::filesystem::path(e.path).filename().string();
-    level.mesh = load_input(e.path, lo);
+    std::vector<std::string> warnings;
+    view::ViewLevel level = view::load_view_level(e.path, lo, &warnings);
+    for (const std::string& w : warnings) std::fprintf(stderr, "qem: warning: %s\n", w.c_str());
     level.error = e.error;
     if (e.faces && e.faces != level.mesh.face_count())
       throw Error(a.inputs[0] + ": level " + std::to_string(i) + " lists " + std::to_string(e.faces) +
@@ -151,16 +156,18 @@ int run_view(const ViewArgs& a) {
 const bool registered = register_command(80, [](CLI::App& app) -> std::function<int()> {
   auto args = std::make_shared<ViewArgs>();
   CLI::App* cmd =
-      app.add_subcommand("view", "Show meshes in a local web page (three.js): LOD slider, compare, heat map");
+      app.add_subcommand("view", "Show meshes in a local web page (three.js): textures, colours, glTF skins and animations; LOD "
+                        "slider, side by side, seams, heat map");
   cmd->add_option("meshes", args->inputs,
                   "Mesh files (OBJ, PLY, STL, OFF, glTF), or one LOD manifest (.json) listing the levels, or "
                   "one contraction record (`qem simplify --record`): a slider over its face counts")
       ->required();
   cmd->add_flag(
       "--chain", args->chain,
-      "The meshes are an LOD chain, finest first: a slider walks them (the default for several meshes)");
+      "The meshes are an LOD chain, finest first: a slider walks them (the default for three or more meshes)");
   cmd->add_flag("--compare", args->compare,
-                "Two meshes (original, simplified) side by side with linked cameras");
+                "Two meshes (original, simplified) side by side with linked cameras and animation time (the "
+                "default for two meshes)");
   cmd->add_option("--port", args->port, "Port on 127.0.0.1 to serve the page on (0 = any free port)")
       ->capture_default_str();
   cmd->add_option("--export", args->export_dir,

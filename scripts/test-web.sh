@@ -26,4 +26,4 @@ mkdir -p "$OUT_DIR"
 node tests/view/make_meshes.mjs "$OUT_DIR/meshes" >/dev/null
 # The node script stops its servers itself (also on SIGTERM); `timeout` bounds a hung browser.
 QEM="$BUILD_DIR/qem" MESH_DIR="$OUT_DIR/meshes" OUT_DIR="$OUT_DIR" \
-  timeout -k 10 180 node tests/view/viewer.test.mjs
+  timeout -k 10 300 node tests/view/viewer.test.mjs

@@ -4,6 +4,7 @@
 #include "qem/simplify.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <span>
 
@@ -65,12 +66,59 @@ double sampled_distance(std::span<const double> positions, std::span<const std::
   return most * frame.scale;
 }
 
+// The refit of an output with attributes (wedges: the vertices of a seam share a position). It
+// fits the surface welded by position, so that the wedges of one position move together and no
+// crack opens; the positions that hold more than one wedge (UV seams, normal creases, colour and
+// material boundaries, mirror lines) are held where the simplifier left them, on their seam with
+// their values exactly on the chart's edge (moving them would pull one side's UVs out of its
+// chart). The other vertices move with their values unchanged: moving the values along the
+// gradients of their attribute quadrics measured the same to four digits (docs/attributes.md).
+RefitResult refit_with_seams(const refit_detail::FitPoints& points, SimplifyResult& out, RefitOptions options,
+                             const std::vector<std::uint8_t>& locked, const core::WedgeRefitData& data,
+                             const core::SurfaceDistance* surface) {
+  Mesh& mesh = out.mesh;
+  const std::size_t n = mesh.vertex_count();
+  std::vector<std::uint32_t> order(n);
+  for (std::uint32_t v = 0; v < n; ++v) order[v] = v;
+  const auto at = [&](std::uint32_t v) {
+    return std::array<double, 3>{mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2]};
+  };
+  std::sort(order.begin(), order.end(), [&](std::uint32_t x, std::uint32_t y) { return at(x) != at(y) ? at(x) < at(y) : x < y; });
+  // Welded vertices numbered in order of their first output vertex, so the result does not hang
+  // on the sort's order of equal keys.
+  std::vector<std::uint32_t> group(n), welded_of(n, UINT32_MAX);
+  for (std::size_t i = 0; i < n; ++i) group[order[i]] = i > 0 && at(order[i]) == at(order[i - 1]) ? group[order[i - 1]] : order[i];
+  Mesh welded;
+  std::vector<std::uint32_t> wedges_at;  // output vertices per welded vertex
+  std::vector<std::uint8_t> fixed;
+  for (std::uint32_t v = 0; v < n; ++v) {
+    std::uint32_t& w = welded_of[group[v]];
+    if (w == UINT32_MAX) {
+      w = std::uint32_t(wedges_at.size());
+      wedges_at.push_back(0), fixed.push_back(0);
+      welded.positions.insert(welded.positions.end(), &mesh.positions[3 * v], &mesh.positions[3 * v] + 3);
+    }
+    welded_of[v] = w;
+    ++wedges_at[w];
+    if ((!locked.empty() && locked[v]) || data.on_seam[v]) fixed[w] = 1;
+  }
+  for (std::size_t w = 0; w < fixed.size(); ++w) fixed[w] |= wedges_at[w] > 1;
+  welded.indices.reserve(mesh.indices.size());
+  for (std::uint32_t v : mesh.indices) welded.indices.push_back(welded_of[v]);
+  std::vector<std::uint32_t> near = out.output_vertex_of_input;
+  for (std::uint32_t& v : near)
+    if (v != SimplifyResult::kUnmapped) v = welded_of[v];
+  options.fixed_vertices = fixed;
+  const RefitResult fit = refit_detail::refit_to_points(points, welded, options, near, surface);
+  for (std::uint32_t v = 0; v < n; ++v)
+    std::copy_n(&welded.positions[3 * std::size_t(welded_of[v])], 3, &mesh.positions[3 * std::size_t(v)]);
+  return fit;
+}
+
 SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options, SimplifyObserver* observer,
                                   std::vector<std::uint32_t>* consumed_indices) {
   check_options(options);
-  // The refit moves vertices to the input surface, which would pull seam vertices off their seams
-  // and leave the attributes fitted to the old positions: not made with attributes.
-  const bool refit = options.refit_rounds > 0 && input.attributes.empty();
+  const bool refit = options.refit_rounds > 0;
   const bool bounded = std::isfinite(options.max_distance);
   // The refit fits the input's vertices weighted by their share of the area, and its guard (and
   // the distance bound's report) measures against the input's faces: taken before the core
@@ -81,6 +129,8 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
   hooks.observer = observer;
   hooks.consumed_indices = consumed_indices;
   hooks.map_input_vertices = refit;
+  core::WedgeRefitData wedge_refit;  // with attributes, for the refit
+  if (refit && !input.attributes.empty()) hooks.wedge_refit = &wedge_refit;
   if (refit || bounded)
     hooks.before_release = [&](MeshView in) {
       if (refit) weights = refit_detail::vertex_areas(in);
@@ -106,7 +156,9 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
     }
     // Its first search for each input vertex's closest face starts at the vertex it went into.
     const RefitResult fit =
-        refit_detail::refit_to_points(points, out.mesh, refit_options, out.output_vertex_of_input, &surface);
+        out.mesh.attributes.empty()
+            ? refit_detail::refit_to_points(points, out.mesh, refit_options, out.output_vertex_of_input, &surface)
+            : refit_with_seams(points, out, refit_options, fixed, wedge_refit, &surface);
     out.refit_rms_before = fit.rms_before;
     out.refit_rms_after = fit.rms_after;
     out.refit_rounds = fit.rounds;

@@ -248,3 +248,56 @@ TEST(Attributes, BadAttributeDataIsRefused) {
   in.face_materials = {0, 1};
   EXPECT_THROW(simplify(in, to_ten), Error);
 }
+
+// A flat grid textured with two charts: the disc of radius 0.3 around (0.5, 0.5) has its own UVs,
+// so its outline is a UV seam. Flat and linear in UV on each side, every collapse costs zero in the
+// positional and attribute quadrics alike, and only the seam planes (AttributeWeights::seam) see
+// that a collapse along the outline cuts the disc's corner off. With them the disc's area stays.
+TEST(Attributes, SeamPlanesKeepACurvedSeamsShape) {
+  const int n = 60;
+  const double r0 = 0.3;
+  auto inside = [&](double x, double y) { return std::hypot(x - 0.5, y - 0.5) < r0; };
+  Mesh in;
+  VertexAttribute uv{"TEXCOORD_0", AttributeKind::TexCoord, 2, {}};
+  std::map<std::pair<int, int>, std::uint32_t> vid;  // (grid vertex, chart) -> vertex
+  auto vertex = [&](int i, int j, int chart) {
+    auto [it, fresh] = vid.try_emplace({i * (n + 1) + j, chart}, std::uint32_t(in.vertex_count()));
+    if (fresh) {
+      const double x = double(i) / n, y = double(j) / n;
+      in.positions.insert(in.positions.end(), {x, y, 0.0});
+      uv.values.insert(uv.values.end(), {x + 2 * chart, y});
+    }
+    return it->second;
+  };
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const int q[4][2] = {{i, j}, {i + 1, j}, {i + 1, j + 1}, {i, j + 1}};
+      static const int kTriangles[2][3] = {{0, 1, 2}, {0, 2, 3}};
+      for (const int* tri : kTriangles) {
+        double cx = 0, cy = 0;
+        for (int k = 0; k < 3; ++k) cx += q[tri[k]][0] / 3.0 / n, cy += q[tri[k]][1] / 3.0 / n;
+        const int chart = inside(cx, cy) ? 1 : 0;
+        for (int k = 0; k < 3; ++k) in.indices.push_back(vertex(q[tri[k]][0], q[tri[k]][1], chart));
+      }
+    }
+  in.attributes = {uv};
+  auto disc_area = [](const Mesh& m) {
+    const std::vector<double>& t = m.attributes[0].values;
+    double area = 0;
+    for (std::size_t f = 0; f < m.face_count(); ++f) {
+      const std::uint32_t* c = &m.indices[3 * f];
+      if (t[2 * c[0]] < 1.5) continue;  // the outer chart
+      const double* p[3] = {&m.positions[3 * c[0]], &m.positions[3 * c[1]], &m.positions[3 * c[2]]};
+      area += std::abs((p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1])) / 2;
+    }
+    return area;
+  };
+  const double before = disc_area(in);
+  SimplifyOptions o;
+  o.target_ratio = 0.1;
+  const double with_planes = std::abs(disc_area(simplify(in, o).mesh) / before - 1);
+  o.attribute_weights.seam = 0;
+  const double without = std::abs(disc_area(simplify(in, o).mesh) / before - 1);
+  EXPECT_LT(with_planes, 0.02) << "the disc lost or gained area along its seam";
+  EXPECT_LT(with_planes, without) << "seam planes made no difference (without them: " << without << ")";
+}

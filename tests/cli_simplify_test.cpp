@@ -1,6 +1,7 @@
 // `qem simplify` as a user runs it: JSON line, summary, exit codes, nothing lost on failure.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -205,3 +206,35 @@ TEST(CliSimplify, HelpDocumentsEveryOption) {
 }
 
 }  // namespace
+
+// `qem generate --attributes`: the same sphere with unit normals and a UV map whose seam splits
+// positions into wedges, and nothing else changed: same faces, same positions once welded.
+TEST(CliGenerate, AttributesAddNormalsAndASeamedUvMap) {
+  const std::string plain = test::temp_dir() + "/gen_plain.ply", attr = test::temp_dir() + "/gen_attr.ply";
+  ASSERT_EQ(run("generate sphere --faces 1000 " + plain).exit_code, 0);
+  CliRun r = run("generate sphere --faces 1000 --attributes " + attr);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const Mesh p = load_mesh(plain), a = load_mesh(attr);
+  ASSERT_EQ(a.face_count(), p.face_count());
+  const VertexAttribute* uv = a.find_attribute(AttributeKind::TexCoord);
+  const VertexAttribute* n = a.find_attribute(AttributeKind::Normal);
+  ASSERT_NE(uv, nullptr);
+  ASSERT_NE(n, nullptr);
+  EXPECT_GT(a.vertex_count(), p.vertex_count()) << "no vertex split at the seam";
+  for (std::size_t v = 0; v < a.vertex_count(); ++v) {
+    const double* nv = &n->values[3 * v];
+    EXPECT_NEAR(nv[0] * nv[0] + nv[1] * nv[1] + nv[2] * nv[2], 1.0, 1e-5);  // PLY stores floats
+  }
+  // Each face's corners are the plain sphere's, and its UVs span less than half the map (no face
+  // stretched across the seam).
+  for (std::size_t f = 0; f < a.face_count(); ++f) {
+    double lo = 2, hi = -1;
+    for (int k = 0; k < 3; ++k) {
+      for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(a.positions[3 * a.indices[3 * f + k] + c], p.positions[3 * p.indices[3 * f + k] + c], 1e-6);
+      const double u = uv->values[2 * a.indices[3 * f + k]];
+      lo = std::min(lo, u), hi = std::max(hi, u);
+    }
+    EXPECT_LT(hi - lo, 0.5) << "face " << f;
+  }
+}

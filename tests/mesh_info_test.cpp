@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cctype>
-#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -21,19 +20,6 @@
 
 namespace qem {
 namespace {
-
-#if defined(__SANITIZE_ADDRESS__)
-#define QEM_TEST_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define QEM_TEST_ASAN 1
-#endif
-#endif
-#if defined(NDEBUG) && !defined(QEM_TEST_ASAN)
-constexpr bool kOptimisedBuild = true;
-#else
-constexpr bool kOptimisedBuild = false;
-#endif
 
 /// Merges vertices with equal coordinates (first occurrence wins), so meshes built from separate
 /// pieces can share vertices.
@@ -260,27 +246,16 @@ TEST(MeshInfo, FaceOrderDoesNotMatter) {
   EXPECT_EQ(a.euler, b.euler);
 }
 
-TEST(MeshInfo, MillionFacesIsFast) {
+// A million faces, checked for the counts only: mesh_info's speed is BM_MeshInfo's
+// (bench/mesh_info_bench.cpp), not a timed unit test's.
+TEST(MeshInfo, MillionFaces) {
   const int n = 708;  // 2 * 708^2 = 1,002,528 faces
-  Mesh m = test::grid(n);
-  // Best of two runs: the first one pays for page faults, and the machine may be shared.
-  MeshInfo i;
-  double seconds = 1e9;
-  for (int run = 0; run < 2; ++run) {
-    auto t0 = std::chrono::steady_clock::now();
-    i = mesh_info(m);
-    seconds = std::min(seconds, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-  }
-  RecordProperty("seconds", std::to_string(seconds));
+  const MeshInfo i = mesh_info(test::grid(n));
   EXPECT_EQ(i.faces, 2u * n * n);
   EXPECT_EQ(i.boundary_edges, 4u * n);
   EXPECT_EQ(i.boundary_loops, 1u);
   EXPECT_EQ(i.edges, 2u * n * (n + 1) + std::size_t(n) * n);
   EXPECT_EQ(i.euler, 1);
-  // Only optimised, uninstrumented builds promise the speed (1M faces well under a second).
-  if (kOptimisedBuild) {
-    EXPECT_LT(seconds, 1.0);
-  }
 }
 
 // --- agreement with the catalogue's reference statistics (shared data, skipped when absent) ---------

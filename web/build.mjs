@@ -1,4 +1,4 @@
-// Builds the viewer page into dist/: app.js (three.js + OrbitControls + src/main.js bundled by
+// Builds the viewer page into dist/: app.js (three.js + OrbitControls + GLTFLoader + src/*.js bundled by
 // esbuild into one classic script, so the page needs no network and no module loader),
 // index.html and style.css copied. `qem view` serves dist/ (see docs/viewer.md).
 import { build } from 'esbuild';

@@ -10,7 +10,9 @@
 //     if (doc.primitives()[i].simplifiable) doc.replace(i, my_simplify(doc.mesh(i)));
 //   doc.save("out.glb");
 //
-// load_mesh (qem/io.h) on a .gltf/.glb gives the whole scene merged into one Mesh instead.
+// simplify_document (qem/gltf_simplify.h) does this with qem's simplifier and one error budget
+// shared by the scene in world units. load_mesh (qem/io.h) on a .gltf/.glb gives the whole scene
+// merged into one Mesh instead.
 #pragma once
 
 #include <cstddef>
@@ -38,6 +40,12 @@ struct GltfPrimitiveInfo {
   /// targets' per-vertex offsets cannot be kept consistent with new vertices yet).
   bool simplifiable = false;
   std::string why_not;  ///< why it is not simplifiable ("" when it is)
+  /// The largest factor by which the default scene's nodes that place this primitive's mesh scale
+  /// a length (the largest singular value of their world matrix; with a skin, of each joint's
+  /// world matrix times its inverse bind matrix, the bind pose that glTF 2.0 §3.7.3 draws
+  /// instead of the node's transform). 1 when no node places the mesh. A mesh that several nodes
+  /// instance takes the largest: its errors are measured where they are seen the biggest.
+  double world_scale = 1;
 };
 
 /// A loaded glTF file. Movable, not copyable.

@@ -86,12 +86,17 @@ struct ContractionLog {
 /// How much a unit of each attribute counts against a unit of distance, in the normalised frame
 /// (bounding-box diagonal 1): an attribute difference of 1 / weight costs as much as a distance of
 /// one diagonal (Hoppe 1999's attribute quadric, area weighted like the positions). Kinds not
-/// listed (joints, skin weights, tangents) are never interpolated: the survivor's are kept.
+/// listed (joints, skin weights, tangents) are never interpolated: the survivor's are kept. The
+/// defaults were chosen by a sweep against meshoptimizer on textured and coloured assets
+/// (docs/attributes.md, "Weights"; bench/attr_sweep.sh).
 struct AttributeWeights {
-  double normal = 0.03;     ///< a normal turned by ~0.17 rad (10 degrees) ~ 0.5 % of the diagonal
-  double tex_coord = 0.5;   ///< a UV shift of 0.01 ~ 0.5 % of the diagonal
+  double normal = 0.01;     ///< a normal turned by ~0.17 rad (10 degrees) ~ 0.17 % of the diagonal
+  double tex_coord = 0.2;   ///< a UV shift of 0.01 ~ 0.2 % of the diagonal
   double color = 0.1;       ///< a colour change of 0.05 ~ 0.5 % of the diagonal
   double scalar = 0.01;     ///< other per-vertex values
+  /// Constraint planes along the seams (wedge changes: UV seams, creases, material boundaries),
+  /// weighted as the boundary planes (SimplifyOptions::boundary_weight); 0 disables them.
+  double seam = 10;
 };
 
 struct SimplifyOptions {
@@ -99,6 +104,11 @@ struct SimplifyOptions {
   std::size_t target_faces = 0;     ///< stop at or below this many faces (0 = no face target)
   double target_ratio = 0;          ///< stop at or below ratio * input faces (0 = unused)
   std::size_t target_vertices = 0;  ///< stop at or below this many vertices (0 = unused)
+  /// A stop criterion of its own: contract as far as the checks allow (topology, inversion,
+  /// components, max_error, locks), as a face target of 0 does on the command line and in
+  /// meshoptimizer, CGAL and libigl. The target fields keep 0 = unused, so existing callers are
+  /// unchanged; the other criteria still apply (the first reached wins).
+  bool as_far_as_possible = false;
   /// Largest allowed contraction error, in distance units: sqrt(Q(v) / weight of Q), i.e. the
   /// weighted RMS distance from the new vertex to the planes it represents. +inf = no limit.
   double max_error = std::numeric_limits<double>::infinity();
@@ -126,10 +136,34 @@ struct SimplifyOptions {
   /// move border vertices. false: GH97 §6's penalty alone (boundary_weight), the vertices may
   /// leave the border.
   bool exact_border = true;
+  /// Keep every connected component (vertex-connected, counted on the welded working mesh): a
+  /// contraction that would leave a component with fewer than its floor of faces (a closed one 4,
+  /// an open one 1, or as many as it has if fewer) is refused. Components that a threshold pair
+  /// joins are one from then on. false = GH97 as published: a small part may contract to nothing.
+  bool keep_components = true;
+  /// Prune rule: components whose bounding-box diagonal is below this distance are removed whole
+  /// before the first contraction (0 = none). A size rule rather than one tied to the running
+  /// error, so what is removed does not depend on the target or the order of contractions.
+  double prune_size = 0;
+  bool prune_size_is_relative = false;  ///< prune_size is a fraction of the bounding-box diagonal
   /// Per input vertex (empty: none), nonzero = locked: it never moves and is never removed (the
   /// other end of a contraction comes to it). With attributes, a position is locked when any of
   /// its vertices is. The caller's buffer must outlive the call.
   std::span<const std::uint8_t> vertex_lock;
+  /// Per input vertex (empty: none), nonzero = protected: with attributes, the seams at it are
+  /// never crossed, even with permissive_seams (meshoptimizer's meshopt_SimplifyVertex_Protect). It
+  /// may still be removed, or move, along its seam as any seam vertex does. Same size and lifetime
+  /// rules as vertex_lock.
+  std::span<const std::uint8_t> vertex_protect;
+  /// With attributes: every vertex on a seam (UV seam, normal crease, colour or material boundary,
+  /// mirror line: any position with more than one attribute set) is locked as by vertex_lock.
+  bool lock_seams = false;
+  /// With attributes: a collapse may cross a UV seam, normal crease or colour boundary (never a
+  /// material boundary, never at a protected vertex) when its cost, which then includes the
+  /// attribute error of merging the two sides, allows (meshoptimizer's SimplifyPermissive). Reaches
+  /// targets that strict seams block (many small UV charts), at the price of attribute quality
+  /// along the seams it crosses (docs/attributes.md). Welded by position, no crack opens either way.
+  bool permissive_seams = false;
   InversionPolicy inversion = InversionPolicy::Forbid;
   /// A face that turns by more than this (degrees) counts as an inversion; must be < 90.
   double max_normal_turn_degrees = 75;
@@ -144,8 +178,11 @@ struct SimplifyOptions {
   unsigned threads = 0;
   /// After the last contraction, refit the vertices to the input surface with the faces fixed
   /// (qem/refit.h, Hoppe et al. 1993) in up to this many rounds; 0 = off (GH97 as published).
-  /// Lowers the geometric error at the same face count; `lock_border` and
-  /// `max_normal_turn_degrees` apply to it too. An observer's contractions are those made
+  /// Lowers the geometric error at the same face count; `lock_border`, `vertex_lock` and
+  /// `max_normal_turn_degrees` apply to it too. With attributes it fits the surface welded by
+  /// position and holds every position that carries more than one attribute set (seams, creases,
+  /// material boundaries, mirror lines); the other vertices move with their values unchanged
+  /// (docs/attributes.md, "Seams, locks and the refit"). An observer's contractions are those made
   /// before it: a replayed level is the unrefitted mesh (refit it with qem::refit to match). The
   /// command line's default is a light refit, refit_rounds = 1 with refit_points_per_vertex = 2
   /// (what it costs and gains: docs/benchmarks.md).
@@ -173,6 +210,12 @@ struct SimplifyResult {
   /// With max_distance: the largest distance from the output to the input over the certified
   /// samples of every output face (after the refit), in distance units; at most max_distance.
   double output_to_input_distance = 0;
+  /// ... and refused because a connected component would have dropped below its floor
+  /// (SimplifyOptions::keep_components).
+  std::size_t rejected_component = 0;
+  /// Connected components (vertex-connected, of the welded working mesh) of the input and of the
+  /// output, and how many the prune rule removed (SimplifyOptions::prune_size).
+  std::size_t input_components = 0, output_components = 0, pruned_components = 0;
   double max_error = 0;             ///< largest contraction error performed (distance units)
   double max_error_relative = 0;    ///< the same over the bounding-box diagonal
   StopReason stop_reason = StopReason::TargetReached;

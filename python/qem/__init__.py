@@ -150,6 +150,9 @@ class SimplifyResult(Mesh):
       stop_detail: a sentence saying why.
     contractions, input_faces, input_vertices, refit_rounds, refit_rms_before, refit_rms_after,
       dropped_degenerate_faces, dropped_duplicate_faces: counts as in qem::SimplifyResult.
+    input_components, output_components: connected components of the input and the output
+      (vertex-connected); pruned_components: removed by `prune`; rejected_component: contractions
+      refused because a component would have dropped below its floor (keep_components).
     With return_mapping=True (else None):
       vertex_source: (n_out,) int32, the input vertex each output vertex started from;
       face_source: (m_out,) int32, the input face each output face is;
@@ -161,7 +164,8 @@ class SimplifyResult(Mesh):
     __slots__ = (
         "max_error", "max_error_relative", "stop_reason", "stop_detail", "contractions", "input_faces",
         "input_vertices", "refit_rounds", "refit_rms_before", "refit_rms_after", "dropped_degenerate_faces",
-        "dropped_duplicate_faces", "vertex_source", "face_source", "output_vertex_of_input", "record",
+        "dropped_duplicate_faces", "rejected_component", "input_components", "output_components",
+        "pruned_components", "vertex_source", "face_source", "output_vertex_of_input", "record",
     )
 
     def __repr__(self):
@@ -214,7 +218,8 @@ def _attribute_list(attributes):
 
 def _options(*, target_faces, target_ratio, target_vertices, max_error, max_error_relative, threshold,
              threshold_relative, weighting, placement, boundary_weight, lock_border, inversion, max_turn,
-             allow_non_manifold, scheme, refit, threads, record):
+             allow_non_manifold, scheme, refit, threads, record, keep_components=True, prune=None,
+             prune_relative=None):
     o = _qem.SimplifyOptions()
 
     def count(name, value):
@@ -223,8 +228,8 @@ def _options(*, target_faces, target_ratio, target_vertices, max_error, max_erro
         if isinstance(value, bool) or not isinstance(value, (int,)) and not hasattr(value, "__index__"):
             raise ValueError(f"{name}: expected an integer, got {value!r}")
         value = int(value)
-        if value <= 0:
-            raise ValueError(f"{name}: must be positive, got {value}")
+        if value < 0:
+            raise ValueError(f"{name}: must not be negative, got {value}")
         return value
 
     def number(name, value):
@@ -236,13 +241,24 @@ def _options(*, target_faces, target_ratio, target_vertices, max_error, max_erro
             raise ValueError(f"{name}: expected a number, got nan")
         return value
 
+    # A target of 0 means "as far as the checks allow" (the library's as_far_as_possible).
     o.target_faces = count("target_faces", target_faces)
     o.target_vertices = count("target_vertices", target_vertices)
     if target_ratio is not None:
         r = number("target_ratio", target_ratio)
-        if not 0 < r <= 1:
-            raise ValueError(f"target_ratio: the fraction of faces kept must be in (0, 1], got {r}")
+        if not 0 <= r <= 1:
+            raise ValueError(f"target_ratio: the fraction of faces kept must be in [0, 1], got {r}")
         o.target_ratio = r
+    o.as_far_as_possible = target_faces == 0 or target_vertices == 0 or target_ratio == 0
+    o.keep_components = bool(keep_components)
+    if prune is not None and prune_relative is not None:
+        raise ValueError("give prune or prune_relative, not both")
+    for name, value, relative in (("prune", prune, False), ("prune_relative", prune_relative, True)):
+        if value is not None:
+            d = number(name, value)
+            if not 0 <= d < _math.inf:
+                raise ValueError(f"{name}: expected a finite distance >= 0, got {d}")
+            o.prune_size, o.prune_size_is_relative = d, relative
     if max_error is not None and max_error_relative is not None:
         raise ValueError("give max_error or max_error_relative, not both")
     for name, value, relative in (("max_error", max_error, False), ("max_error_relative", max_error_relative, True)):
@@ -307,7 +323,8 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
              threshold_relative: Optional[float] = None, weighting: str = "area", placement: str = "optimal",
              boundary_weight: float = 1.0, lock_border: bool = False, inversion: str = "forbid",
              max_turn: float = 75.0, allow_non_manifold: bool = False, scheme: str = "passes",
-             refit="light", threads: int = 0, attributes: Optional[dict] = None,
+             refit="light", threads: int = 0, keep_components: bool = True, prune: Optional[float] = None,
+             prune_relative: Optional[float] = None, attributes: Optional[dict] = None,
              attribute_weights: Optional[dict] = None, vertex_lock=None, return_mapping: bool = False,
              record: bool = False, progress: Optional[Callable[[float], Optional[bool]]] = None) -> SimplifyResult:
     """Simplifies a triangle mesh by quadric-error pair contraction (Garland & Heckbert 1997).
@@ -315,8 +332,9 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
     vertices: (n, 3) array, any float dtype; faces: (m, 3) array of vertex indices, any integer dtype.
     Stop criteria (at least one; they combine and the first reached wins):
       target_faces: stop at or below this many faces.
-      target_ratio: the fraction of the input's faces kept, in (0, 1] (0.1 keeps 10 %).
+      target_ratio: the fraction of the input's faces kept, in [0, 1] (0.1 keeps 10 %).
       target_vertices: stop at or below this many vertices.
+      A target of 0 means as far as the checks allow (topology, inversion, components, max_error).
       max_error: never make a contraction whose error exceeds this distance (model units): the
         weighted RMS distance of the new vertex to the planes it stands for.
       max_error_relative: the same as a fraction of the bounding-box diagonal.
@@ -332,9 +350,13 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
       scheme: "passes" (fast) or "greedy" (GH97's heap: strictly cheapest first).
       refit: after the last contraction move the vertices to fit the input surface, faces fixed:
         "light" (default, as the command line: 1 round on ~2 input vertices per output vertex, only
-        with optimal placement and without record), "full" (3 rounds, every vertex), "none", or
+        with optimal placement, without record and without attributes), "full" (3 rounds, every vertex), "none", or
         (rounds, points_per_vertex).
       threads: threads for the parallel parts (0 = all cores); the result is the same for any count.
+      keep_components: every connected part keeps at least one face (a closed one four); False lets
+        a part contract to nothing (GH97 as published).
+      prune: remove whole the parts whose bounding-box diagonal is below this distance (model units);
+        prune_relative: the same over the whole mesh's diagonal.
     Data carried along:
       attributes: {name: (n, k) array} of per-vertex data, or {name: (array, kind)}; the kind
         (normal, texcoord, color, joint_indices, joint_weights, tangent, scalar) follows glTF names
@@ -367,7 +389,13 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
                        threshold_relative=threshold_relative, weighting=weighting, placement=placement,
                        boundary_weight=boundary_weight, lock_border=lock_border, inversion=inversion,
                        max_turn=max_turn, allow_non_manifold=allow_non_manifold, scheme=scheme, refit=refit,
-                       threads=threads, record=record)
+                       threads=threads, record=record, keep_components=keep_components, prune=prune,
+                       prune_relative=prune_relative)
+    # The light default follows the command line here too: not on a mesh with attributes, where it
+    # lowers E but raises the UV and normal errors a little (docs/attributes.md, "Seams, locks and
+    # the refit"); "full" or (rounds, points) still refits them, holding every seam position.
+    if refit == "light" and attributes:
+        options.refit_rounds = 0
     options.map_input_vertices = bool(return_mapping)
     if attribute_weights is not None:
         options.attribute_weights = attribute_weights
@@ -511,7 +539,7 @@ def lod(vertices, faces, *, ratios=None, target_faces=None, refit="light", **opt
     """An LOD chain from one recorded run: levels finest first, as `qem lod` writes them.
 
     ratios: fractions of the input's faces kept, e.g. [0.5, 0.25, 0.1]; or target_faces: face
-    counts. Every other option of `simplify` (weighting, placement, threshold, ..., threads)
+    counts (0: as far as the checks allow). Every other option of `simplify` (weighting, placement, threshold, ..., threads)
     applies; each level is refitted as `refit` says (the light refit by default, as the CLI).
     Returns a list of qem.Level (vertices, faces, target_faces, contractions, max_error).
     """
@@ -523,7 +551,8 @@ def lod(vertices, faces, *, ratios=None, target_faces=None, refit="light", **opt
             raise ValueError(f"{bad}: not an option of lod (the levels are its targets)")
     defaults = dict(threshold=0.0, threshold_relative=None, weighting="area", placement="optimal",
                     boundary_weight=1.0, lock_border=False, inversion="forbid", max_turn=75.0,
-                    allow_non_manifold=False, scheme="passes", threads=0)
+                    allow_non_manifold=False, scheme="passes", threads=0, keep_components=True, prune=None,
+                    prune_relative=None)
     unknown = set(options) - set(defaults)
     if unknown:
         raise TypeError(f"lod() got unexpected keyword arguments: {', '.join(sorted(unknown))}")

@@ -65,6 +65,10 @@ class SimplifyResult(Mesh):
     refit_rms_after: float
     dropped_degenerate_faces: int
     dropped_duplicate_faces: int
+    rejected_component: int
+    input_components: int
+    output_components: int
+    pruned_components: int
     vertex_source: Optional[npt.NDArray[np.int32]]
     face_source: Optional[npt.NDArray[np.int32]]
     output_vertex_of_input: Optional[npt.NDArray[np.int32]]
@@ -136,6 +140,9 @@ def simplify(
     scheme: Literal["greedy", "passes"] = ...,
     refit: _Refit = ...,
     threads: int = ...,
+    keep_components: bool = ...,
+    prune: Optional[float] = ...,
+    prune_relative: Optional[float] = ...,
     attributes: Optional[Mapping[str, Union[np.ndarray, Tuple[np.ndarray, str]]]] = ...,
     attribute_weights: Optional[Mapping[str, float]] = ...,
     vertex_lock: Optional[npt.ArrayLike] = ...,

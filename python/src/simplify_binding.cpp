@@ -125,6 +125,10 @@ void bind_simplify(py::module_& m) {
       .def_readwrite("target_faces", &SimplifyOptions::target_faces)
       .def_readwrite("target_ratio", &SimplifyOptions::target_ratio)
       .def_readwrite("target_vertices", &SimplifyOptions::target_vertices)
+      .def_readwrite("as_far_as_possible", &SimplifyOptions::as_far_as_possible)
+      .def_readwrite("keep_components", &SimplifyOptions::keep_components)
+      .def_readwrite("prune_size", &SimplifyOptions::prune_size)
+      .def_readwrite("prune_size_is_relative", &SimplifyOptions::prune_size_is_relative)
       .def_readwrite("max_error", &SimplifyOptions::max_error)
       .def_readwrite("max_error_is_relative", &SimplifyOptions::max_error_is_relative)
       .def_property("weighting", [](const SimplifyOptions& o) { return to_string(o.weighting); },
@@ -248,6 +252,10 @@ void bind_simplify(py::module_& m) {
         out["input_faces"] = r.input_faces;
         out["input_vertices"] = r.input_vertices;
         out["contractions"] = r.contractions;
+        out["rejected_component"] = r.rejected_component;
+        out["input_components"] = r.input_components;
+        out["output_components"] = r.output_components;
+        out["pruned_components"] = r.pruned_components;
         out["refit_rounds"] = r.refit_rounds;
         out["refit_rms_before"] = r.refit_rms_before;
         out["refit_rms_after"] = r.refit_rms_after;

@@ -134,9 +134,7 @@ py::list lod(py::handle vertices, py::handle faces, SimplifyOptions options, con
              const std::vector<double>& ratios) {
   if (faces_targets.empty() == ratios.empty()) throw py::value_error("give the levels as either target_faces or ratios");
   for (double r : ratios)
-    if (!(r > 0 && r <= 1)) throw py::value_error("ratios: every ratio must be in (0, 1]");
-  for (std::size_t n : faces_targets)
-    if (n == 0) throw py::value_error("target_faces: every face count must be positive");
+    if (!(r >= 0 && r <= 1)) throw py::value_error("ratios: every ratio must be in [0, 1]");
   Positions p = positions_from(vertices, "vertices");
   Indices f = indices_from(faces, "faces", p.data.size() / 3);
   const RefitOptions refit = refit_options_for(options);  // as simplify would refit
@@ -145,6 +143,8 @@ py::list lod(py::handle vertices, py::handle faces, SimplifyOptions options, con
     options.target_faces = *std::min_element(faces_targets.begin(), faces_targets.end());
   else
     options.target_ratio = *std::min_element(ratios.begin(), ratios.end());
+  // A level of 0 faces (or ratio 0) is the mesh as far as the checks allow, as in `qem lod`.
+  options.as_far_as_possible = options.target_faces == 0 && options.target_ratio == 0;
   check_options(options);
   std::vector<ReplayLevel> levels;
   {

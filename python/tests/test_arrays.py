@@ -78,10 +78,9 @@ def test_bad_arrays(small_torus, make, name, words):
     "kwargs, name",
     [
         (dict(), "no stop criterion"),
-        (dict(target_faces=0), "target_faces"),
+        (dict(target_ratio=-0.1), "target_ratio"),
         (dict(target_faces=-3), "target_faces"),
         (dict(target_faces=1.5), "target_faces"),
-        (dict(target_ratio=0), "target_ratio"),
         (dict(target_ratio=1.5), "target_ratio"),
         (dict(target_ratio=float("nan")), "target_ratio"),
         (dict(max_error=-1), "max_error"),

@@ -165,3 +165,22 @@ def test_option_names_are_the_librarys():
     assert "passes" in qem.option_names("scheme") and "forbid" in qem.option_names("inversion")
     with pytest.raises(ValueError, match="weighting"):
         qem.simplify(np.eye(3), [[0, 1, 2]], target_faces=1, weighting="areal")
+
+
+def test_components_and_target_zero():
+    # Two separate open squares, one tiny: kept by default, removed by prune, and a target of 0
+    # goes as far as the checks allow (each square down to one face).
+    square = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0.5, 0.5, 0.1]], float)
+    quad = np.array([[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]])
+    v = np.vstack([square, square * 0.01 + [3, 0, 0]])
+    f = np.vstack([quad, quad + 5])
+    r = qem.simplify(v, f, target_faces=0, refit="none")
+    assert r.input_components == 2 and r.output_components == 2 and r.pruned_components == 0
+    assert r.stop_reason == "no valid contraction left" and r.rejected_component > 0
+    assert len(r.faces) == 2
+    r = qem.simplify(v, f, target_faces=0, prune=0.1, refit="none")
+    assert r.pruned_components == 1 and r.output_components == 1
+    gone = qem.simplify(v, f, target_faces=0, keep_components=False, refit="none")
+    assert len(gone.faces) == 0
+    with pytest.raises(ValueError):
+        qem.simplify(v, f, target_faces=-1)

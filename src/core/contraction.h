@@ -1,5 +1,5 @@
 // One contraction (GH97 §4 step 5), with its checks: try_contract checks pair p against the
-// topology, inversion and error limits and contracts it if it passes.
+// topology, component (component_guard.h), inversion and error limits and contracts it if it passes.
 //
 // The two orders keep the vertex lists and the costs differently; that difference, and nothing
 // else, is the `Lists` parameter, which an order provides as:
@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/collapse_checks.h"
+#include "core/component_guard.h"
 #include "core/context.h"
 #include "core/cost_model.h"
 
@@ -157,7 +158,10 @@ void contract(Context& c, Lists& lists, std::uint32_t p, const Quadric& q, const
   m.aggregated[a] |= m.aggregated[b] | c.pairs.pairs[p].is_virtual;
 
   if (c.wedges) map_wedges(m, *c.wedges, a, b, w.wedge_map);  // checked by place_pair
+  if (c.components) c.components->join(a, b);  // a threshold pair joins two parts into one
+  const std::size_t killed_before = w.faces_killed;
   merge_faces(c, a, b, m.aggregated[a] || !c.settings.preserve_topology, w);
+  if (c.components) c.components->faces_died(a, w.faces_killed - killed_before);
   merge_pairs(c, lists, p, a, b, w);
   if (c.wedges) c.wedges->merge(a, b, moves, target, w.wedge_map);
   lists.contracted(a, b, w.faces, w.pairs);
@@ -193,6 +197,14 @@ bool try_contract(Context& c, Lists& lists, std::uint32_t p, Worker& w) {
   if (!is_edge && !ps.pairs[p].is_virtual) {
     // An edge pair whose faces all died: at t = 0 only edges are valid pairs (GH97 §3.2).
     ps.pairs[p].state = kDead;
+    return false;
+  }
+  // As in contract(): faces may land on the same three vertices where the link condition did not run.
+  const bool may_duplicate = c.mesh.aggregated[a] || c.mesh.aggregated[b] || ps.pairs[p].is_virtual ||
+                             !c.settings.preserve_topology;
+  if (c.components && !c.components->allows(c.mesh, a, b, may_duplicate)) {
+    ++w.blocked_component;  // it would take a connected component below its floor
+    ps.block(p);
     return false;
   }
   Quadric q;

@@ -63,10 +63,13 @@ bool Regions::make_band(Context& c, PassLists& lists, const std::uint32_t* band,
   for (auto& pairs : inside_) pairs.clear();
   border_.clear();
   std::size_t faces_at_stake = 0;
+  // Pairs the component guard might refuse, or that join two components, are made one by one
+  // (component_guard.h): whether they are does not depend on the thread count.
+  if (c.components) c.components->risky(c.mesh, c.pairs, band, count, risky_);
   for (std::size_t i = 0; i < count; ++i) {
     const std::uint32_t p = band[i], a = c.pairs.pairs[p].v[0], b = c.pairs.pairs[p].v[1];
     const std::uint32_t region = region_of(a);
-    if (near_cut_[a] || near_cut_[b] || region_of(b) != region) {
+    if (near_cut_[a] || near_cut_[b] || region_of(b) != region || (c.components && risky_[i])) {
       border_.push_back(p);
       continue;
     }

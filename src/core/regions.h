@@ -45,6 +45,7 @@ class Regions {
   std::vector<std::uint8_t> cut_, near_cut_;
   std::array<std::vector<std::uint32_t>, kRegions> inside_;
   std::vector<std::uint32_t> border_;
+  std::vector<std::uint8_t> risky_;  // per pair of the band (ComponentGuard::risky)
 };
 
 }  // namespace qem::core

@@ -30,6 +30,7 @@ void renumber_densely(Context& c, PassState& s) {
   c.marks.assign(count, 0);
   if (c.map) c.map->renumber(vertex_to, count);
   if (c.wedges) c.wedges->renumber(vertex_to, count);
+  if (c.components) c.components->renumber(vertex_to, count);
 }
 
 }  // namespace qem::core

@@ -4,6 +4,7 @@
 #include <optional>
 
 #include "core/border_placement.h"
+#include "core/component_guard.h"
 #include "core/context.h"
 #include "core/fundamental_quadrics.h"
 #include "core/order_greedy.h"
@@ -12,6 +13,7 @@
 #include "core/parallel_chunks.h"
 #include "core/settings.h"
 #include "core/valid_pairs.h"
+#include "core/seam_planes.h"
 #include "core/wedges.h"
 #include "core/working_mesh.h"
 #include "qem/error.h"
@@ -21,10 +23,11 @@ namespace qem::core {
 namespace {
 
 // The mesh with what the contractions left of it, and the maps the caller asked for.
-void finish(Context& c, std::optional<ContractionMap>& map, MeshView input, SimplifyResult& result) {
+void finish(Context& c, std::optional<ContractionMap>& map, MeshView input, SimplifyResult& result,
+            WedgeRefitData* refit) {
   if (c.wedges) {
     result.mesh = build_wedge_output(c.mesh, *c.wedges, input, result.vertex_source, result.face_source,
-                                     map ? &result.output_vertex_of_input : nullptr);
+                                     map ? &result.output_vertex_of_input : nullptr, refit);
     return;
   }
   std::vector<std::uint32_t> output_index;
@@ -61,8 +64,13 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   if (!input.attributes.empty()) wedges.emplace(build_wedges(input, internal, mesh, options));
   std::vector<std::uint32_t>().swap(internal);
   if (!options.vertex_lock.empty()) lock_vertices(options.vertex_lock, input, wedges ? &*wedges : nullptr, mesh);
+  if (wedges && options.lock_seams) lock_seam_vertices(*wedges, mesh);
   result.input_faces = mesh.faces_alive, result.input_vertices = mesh.vertices_alive;
   result.dropped_degenerate_faces = mesh.dropped_degenerate, result.dropped_duplicate_faces = mesh.dropped_duplicate;
+  const Settings settings = resolve(options, mesh);  // targets from the input, before any pruning
+  result.input_components = count_components(mesh);
+  if (settings.prune_size > 0)
+    result.pruned_components = prune_components(mesh, wedges ? &*wedges : nullptr, settings.prune_size);
   std::optional<ContractionMap> map;
   if (options.map_input_vertices || hooks.map_input_vertices) map.emplace(input.vertex_count(), mesh.source_vertex);
   if (hooks.consumed_indices) {
@@ -70,7 +78,6 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
     input.indices = {};
     std::vector<std::uint32_t>().swap(*hooks.consumed_indices);
   }
-  const Settings settings = resolve(options, mesh);
   if (hooks.observer) hooks.observer->on_start(mesh.face_source);
 
   std::vector<Quadric> quadric;
@@ -86,7 +93,8 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   if (c.done()) {
     result.stop_reason = StopReason::AlreadyBelowTarget;
     result.stop_detail = stop_detail(result.stop_reason, result, settings.lock_border);
-    finish(c, map, input, result);
+    result.output_components = count_components(mesh);
+    finish(c, map, input, result, hooks.wedge_refit);
     return result;
   }
   mesh.rebuild_face_lists();
@@ -96,9 +104,12 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
       [&] { edges = unique_edges(mesh.tri, mesh.vertex_faces, mesh.vertex_count()); });
   add_boundary_planes(mesh, edges, settings.boundary_weight, settings.weighting, quadric);  // GH97 §6
   if (settings.exact_border) mark_border_corners(mesh, edges);
+  if (wedges) add_seam_planes(mesh, edges, options.attribute_weights.seam, settings.weighting, quadric);
   pairs = select_pairs(mesh, std::move(edges), settings.threshold);                         // GH97 §3.2
   result.virtual_pairs = pairs.virtual_count;
   c.marks.assign(mesh.vertex_count(), 0);
+  std::optional<ComponentGuard> components;  // after add_boundary_planes: it tells closed from open
+  if (settings.keep_components) c.components = &components.emplace(mesh);
 
   result.stop_reason = StopReason::TargetReached;  // GH97 §4: contract until a stop criterion holds
   if (settings.scheme == Scheme::Passes) {
@@ -112,7 +123,8 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   result.max_error_relative = c.max_error;
   result.max_error = c.max_error * mesh.frame.scale;
   result.stop_detail = stop_detail(result.stop_reason, result, settings.lock_border);
-  finish(c, map, input, result);
+  result.output_components = count_components(mesh);
+  finish(c, map, input, result, hooks.wedge_refit);
   return result;
 }
 

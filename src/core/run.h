@@ -6,6 +6,7 @@
 #include <functional>
 #include <vector>
 
+#include "core/wedges.h"
 #include "qem/simplify.h"
 
 namespace qem::core {
@@ -22,6 +23,8 @@ struct RunHooks {
   std::function<void(MeshView)> before_release;
   /// Fill SimplifyResult::output_vertex_of_input even when the options do not ask for it.
   bool map_input_vertices = false;
+  /// With attributes: filled with what the refit needs of each output vertex (wedges.h).
+  WedgeRefitData* wedge_refit = nullptr;
   /// For the tests: called after each band of a pass with the state the lists are read through,
   /// and with an empty one after the greedy order (alone, or as the passes' tail).
   std::function<void(const Context&, const PassState&)> after_band;

@@ -11,17 +11,21 @@ namespace qem::core {
 
 void validate(const SimplifyOptions& o) {
   const bool any = o.target_faces > 0 || o.target_ratio > 0 || o.target_vertices > 0 || std::isfinite(o.max_error) ||
-                   std::isfinite(o.max_distance);
+                   std::isfinite(o.max_distance) || o.as_far_as_possible;
   if (o.target_ratio < 0 || o.target_ratio > 1 || std::isnan(o.target_ratio))
-    throw Error("target ratio must be in (0, 1]");
+    throw Error("target ratio must be in [0, 1] (0: unused)");
   if (std::isfinite(o.max_error) && o.max_error < 0) throw Error("max error must not be negative");
   if (std::isnan(o.max_error)) throw Error("max error must be a number");
   if (!(o.max_distance > 0)) throw Error("max distance must be positive");
-  if (!any) throw Error("no stop criterion: give a face, ratio, vertex or error target");
+  if (!any)
+    throw Error(
+        "no stop criterion: give a face, ratio, vertex or error target (a face, ratio or vertex target of 0: as far "
+        "as the checks allow)");
   if (!(o.max_normal_turn_degrees > 0 && o.max_normal_turn_degrees < 90))
     throw Error("the inversion angle limit must be in (0, 90) degrees");
   if (!(o.threshold >= 0)) throw Error("threshold must not be negative");
   if (!(o.boundary_weight >= 0)) throw Error("boundary weight must not be negative");
+  if (!(o.prune_size >= 0) || std::isinf(o.prune_size)) throw Error("prune size must be a finite distance >= 0");
 }
 
 Settings resolve(const SimplifyOptions& o, const WorkingMesh& mesh) {
@@ -51,6 +55,8 @@ Settings resolve(const SimplifyOptions& o, const WorkingMesh& mesh) {
   s.scheme = o.scheme;
   s.greedy_below_faces = o.greedy_below_faces;
   s.threads = resolve_threads(o.threads);
+  s.keep_components = o.keep_components;
+  s.prune_size = o.prune_size_is_relative ? o.prune_size : o.prune_size / mesh.frame.scale;
   return s;
 }
 
@@ -62,6 +68,7 @@ std::string stop_detail(StopReason reason, const SimplifyResult& r, bool lock_bo
       return "no valid contraction left (" + std::to_string(r.rejected_topology) + " rejected for topology, " +
              std::to_string(r.rejected_inversion) + " for face inversion" +
              (r.rejected_distance > 0 ? ", " + std::to_string(r.rejected_distance) + " for the distance bound" : "") +
+             (r.rejected_component > 0 ? ", " + std::to_string(r.rejected_component) + " to keep components" : "") +
              (lock_border ? ", border locked" : "") + ")";
     case StopReason::AlreadyBelowTarget: return "the input already meets the target";
     default: return to_string(reason);

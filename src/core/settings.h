@@ -28,6 +28,8 @@ struct Settings {
   Scheme scheme = Scheme::Passes;
   std::size_t greedy_below_faces = 0;
   unsigned threads = 1;       ///< resolved: at least 1
+  bool keep_components = true;
+  double prune_size = 0;      ///< in the working frame (0: no pruning)
 
   bool reached(const WorkingMesh& m) const {
     return m.faces_alive <= target_faces || m.vertices_alive <= target_vertices;

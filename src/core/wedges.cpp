@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <unordered_map>
+
+#include "qem/error.h"
 
 namespace qem::core {
 
@@ -59,16 +62,31 @@ void add_face(Wedges& wg, const Vec3 p[3], const std::uint32_t w[3]) {
 }  // namespace
 
 Quadric Wedges::reduced(std::uint32_t w, std::uint32_t w2) const {
+  return w2 == kNoVertex ? reduced(w, nullptr, 0) : reduced(w, &w2, 1);
+}
+
+namespace {
+
+// The quadric row of w with the rows of `merged` added, in `row` (or `big` when wider).
+const double* summed_row(const Wedges& wg, std::uint32_t w, const std::uint32_t* merged, std::size_t count,
+                         double* row, std::size_t row_size, std::vector<double>& big) {
+  double* q = row;
+  if (wg.quadric_width > row_size) big.resize(wg.quadric_width), q = big.data();
+  const double* a = &wg.quadric[std::size_t(w) * wg.quadric_width];
+  for (std::uint32_t i = 0; i < wg.quadric_width; ++i) q[i] = a[i];
+  for (std::size_t k = 0; k < count; ++k) {
+    const double* b = &wg.quadric[std::size_t(merged[k]) * wg.quadric_width];
+    for (std::uint32_t i = 0; i < wg.quadric_width; ++i) q[i] += b[i];
+  }
+  return q;
+}
+
+}  // namespace
+
+Quadric Wedges::reduced(std::uint32_t w, const std::uint32_t* merged, std::size_t count) const {
   double row[kHead + 4 * 32];
   std::vector<double> big;
-  double* q = row;
-  if (quadric_width > sizeof row / sizeof row[0]) big.resize(quadric_width), q = big.data();
-  const double* a = &quadric[std::size_t(w) * quadric_width];
-  for (std::uint32_t i = 0; i < quadric_width; ++i) q[i] = a[i];
-  if (w2 != kNoVertex) {
-    const double* b = &quadric[std::size_t(w2) * quadric_width];
-    for (std::uint32_t i = 0; i < quadric_width; ++i) q[i] += b[i];
-  }
+  const double* q = summed_row(*this, w, merged, count, row, sizeof row / sizeof row[0], big);
   Quadric r;
   r.a00 = q[0], r.a01 = q[1], r.a02 = q[2], r.a11 = q[3], r.a12 = q[4], r.a22 = q[5];
   r.b0 = q[6], r.b1 = q[7], r.b2 = q[8], r.c = q[9];
@@ -84,6 +102,26 @@ Quadric Wedges::reduced(std::uint32_t w, std::uint32_t w2) const {
   }
   r.weight = 0;
   return r;
+}
+
+double Wedges::error_at(std::uint32_t w, const std::uint32_t* merged, std::size_t count, const Vec3& p) const {
+  double row[kHead + 4 * 32];
+  std::vector<double> big;
+  const double* q = summed_row(*this, w, merged, count, row, sizeof row / sizeof row[0], big);
+  // Q(p, s) = p'Ap + 2 b.p + c + sum_j (W s_j^2 - 2 s_j (G_j.p + D_j)), s the weighted values.
+  double e = p.x * (q[0] * p.x + 2 * q[1] * p.y + 2 * q[2] * p.z) + p.y * (q[3] * p.y + 2 * q[4] * p.z) +
+             q[5] * p.z * p.z + 2 * (q[6] * p.x + q[7] * p.y + q[8] * p.z) + q[9];
+  const double W = q[10];
+  std::uint32_t j = 0;
+  for (const Channel& ch : channels) {
+    if (ch.weight == 0) continue;
+    for (std::uint32_t c = 0; c < ch.components; ++c, ++j) {
+      const double* gd = q + kHead + 4 * j;
+      const double s = ch.weight * value[std::size_t(w) * width + ch.first + c];
+      e += W * s * s - 2 * s * (gd[0] * p.x + gd[1] * p.y + gd[2] * p.z + gd[3]);
+    }
+  }
+  return std::max(e, 0.0);
 }
 
 void Wedges::update_values(std::uint32_t w, const Vec3& p) {
@@ -110,14 +148,39 @@ void Wedges::merge(std::uint32_t survivor, std::uint32_t removed, bool moved, co
   }
   first[removed] = kNoVertex;
   if (!moved) return;
+  // Texture coordinates interpolate, never extrapolate: the optimum of Hoppe's quadric at the new
+  // position may lie beyond the values of both ends, which pulls a UV out of its chart (past the
+  // atlas's edge at a pole or a seam). A merged wedge keeps its UVs within the box of those it merged.
+  std::vector<std::uint32_t> boxed;  // survivor wedges, each with `width` lows and highs below
+  std::vector<double> low, high;
+  for (const auto& [r, s] : map) {
+    std::size_t at = std::find(boxed.begin(), boxed.end(), s) - boxed.begin();
+    if (at == boxed.size()) {
+      boxed.push_back(s);
+      low.insert(low.end(), &value[std::size_t(s) * width], &value[std::size_t(s) * width] + width);
+      high.insert(high.end(), &value[std::size_t(s) * width], &value[std::size_t(s) * width] + width);
+    }
+    for (std::uint32_t i = 0; i < width; ++i) {
+      low[at * width + i] = std::min(low[at * width + i], value[std::size_t(r) * width + i]);
+      high[at * width + i] = std::max(high[at * width + i], value[std::size_t(r) * width + i]);
+    }
+  }
   std::uint32_t w = first[survivor];
   do update_values(w, p), w = next[w];
   while (w != first[survivor]);
+  for (std::size_t at = 0; at < boxed.size(); ++at)
+    for (const Channel& ch : channels)
+      if (ch.kind == AttributeKind::TexCoord)
+        for (std::uint32_t c = 0; c < ch.components; ++c) {
+          double& v = value[std::size_t(boxed[at]) * width + ch.first + c];
+          v = std::clamp(v, low[at * width + ch.first + c], high[at * width + ch.first + c]);
+        }
 }
 
 void Wedges::renumber(const std::vector<std::uint32_t>& vertex_to, std::size_t count) {
   for (std::uint32_t& v : vertex) v = v == kNoVertex ? kNoVertex : vertex_to[v];
   squeeze_by(vertex_to, count, first);
+  if (!protect.empty()) squeeze_by(vertex_to, count, protect);
 }
 
 std::uint32_t Wedges::final_wedge_of_input(std::uint32_t v) const {
@@ -139,7 +202,21 @@ Wedges build_wedges(MeshView in, const std::vector<std::uint32_t>& internal, Wor
   }
   wg.quadric_width = kHead + 4 * interpolated;
 
-  // One wedge per input vertex and material, in the order of first use by a working face.
+  // The first texture coordinates, whose triangles' orientation tells the two sides of a mirror
+  // line apart.
+  const VertexAttribute* uv = nullptr;
+  for (const VertexAttribute& a : in.attributes)
+    if (!uv && a.kind == AttributeKind::TexCoord && a.components >= 2) uv = &a;
+  const auto mirrored = [&](std::uint32_t source) {
+    if (!uv) return false;
+    const auto at = [&](int k, int c) { return uv->values[std::size_t(in.indices[3 * std::size_t(source) + k]) * uv->components + c]; };
+    const double du1 = at(1, 0) - at(0, 0), dv1 = at(1, 1) - at(0, 1), du2 = at(2, 0) - at(0, 0), dv2 = at(2, 1) - at(0, 1);
+    return du1 * dv2 - dv1 * du2 < 0;
+  };
+
+  // One wedge per input vertex, material and side of a mirror line (faces whose UV triangles turn
+  // the other way: a mirrored atlas's mirror line is a seam although both sides share the UV
+  // indices), in the order of first use by a working face. Keyed by `material * 2 + side`.
   std::vector<std::uint32_t> wedge_of(in.vertex_count(), kNoVertex);
   std::unordered_map<std::uint64_t, std::uint32_t> other_material;  // (vertex, material) beyond the first
   std::vector<std::uint32_t> material_of;
@@ -155,6 +232,7 @@ Wedges build_wedges(MeshView in, const std::vector<std::uint32_t>& internal, Wor
     const std::uint32_t id = std::uint32_t(wg.count());
     wg.vertex.push_back(internal[v]);
     wg.source.push_back(v);
+    wg.material.push_back(material / 2);
     material_of.push_back(material);
     for (const VertexAttribute& a : in.attributes)
       for (std::uint32_t c = 0; c < a.components; ++c)
@@ -164,7 +242,8 @@ Wedges build_wedges(MeshView in, const std::vector<std::uint32_t>& internal, Wor
   m.corner_wedge.resize(m.tri.size());
   for (std::size_t f = 0; f < m.face_source.size(); ++f) {
     const std::uint32_t source = m.face_source[f];
-    const std::uint32_t material = in.face_materials.empty() ? 0 : in.face_materials[source];
+    const std::uint32_t material =
+        2 * (in.face_materials.empty() ? 0 : in.face_materials[source]) + (mirrored(source) ? 1 : 0);
     for (int k = 0; k < 3; ++k) m.corner_wedge[3 * f + k] = wedge(in.indices[3 * std::size_t(source) + k], material);
   }
   wg.of_input = std::move(wedge_of);
@@ -181,6 +260,15 @@ Wedges build_wedges(MeshView in, const std::vector<std::uint32_t>& internal, Wor
       wg.next[w] = wg.next[head], wg.next[head] = w;
     }
   }
+  wg.permissive = options.permissive_seams;
+  if (!options.vertex_protect.empty()) {
+    if (options.vertex_protect.size() != in.vertex_count())
+      throw Error("vertex_protect has " + std::to_string(options.vertex_protect.size()) + " entries for " +
+                  std::to_string(in.vertex_count()) + " vertices");
+    wg.protect.assign(m.vertex_count(), 0);
+    for (std::uint32_t w = 0; w < wg.count(); ++w)
+      if (options.vertex_protect[wg.source[w]]) wg.protect[wg.vertex[w]] = 1;
+  }
   wg.quadric.assign(wg.count() * std::size_t(wg.quadric_width), 0);
   for (std::uint32_t f = 0; f < m.face_source.size(); ++f) {
     const std::uint32_t* t = m.face(f);
@@ -190,33 +278,109 @@ Wedges build_wedges(MeshView in, const std::vector<std::uint32_t>& internal, Wor
   return wg;
 }
 
-bool map_wedges(const WorkingMesh& m, const Wedges& wg, std::uint32_t survivor, std::uint32_t removed,
-                std::vector<std::pair<std::uint32_t, std::uint32_t>>& map) {
+namespace {
+
+// The squared weighted distance between the values of wedges x and y (interpolated channels).
+double value_distance(const Wedges& wg, std::uint32_t x, std::uint32_t y) {
+  double d2 = 0;
+  for (const Channel& ch : wg.channels)
+    for (std::uint32_t c = 0; c < ch.components; ++c) {
+      const double d = ch.weight * (wg.value[std::size_t(x) * wg.width + ch.first + c] -
+                                    wg.value[std::size_t(y) * wg.width + ch.first + c]);
+      d2 += d * d;
+    }
+  return d2;
+}
+
+// The survivor's and the removed vertex's wedges at their corners of face f (a face of the edge).
+std::pair<std::uint32_t, std::uint32_t> edge_face_wedges(const WorkingMesh& m, std::uint32_t f, std::uint32_t survivor,
+                                                         std::uint32_t removed) {
+  const std::uint32_t* t = m.face(f);
+  std::uint32_t ws = kNoVertex, wr = kNoVertex;
+  for (int k = 0; k < 3; ++k) {
+    if (t[k] == survivor) ws = m.corner_wedge[3 * std::size_t(f) + k];
+    if (t[k] == removed) wr = m.corner_wedge[3 * std::size_t(f) + k];
+  }
+  return {ws, wr};
+}
+
+// The permissive map: the strict rules failed, so the collapse crosses a seam. A removed wedge on
+// an edge face goes to the survivor's wedge on that face (the first one met), any other to the
+// survivor's wedge of its material with the nearest values; none of its material: refused.
+bool map_crossing(const WorkingMesh& m, const Wedges& wg, std::uint32_t survivor, std::uint32_t removed,
+                  std::vector<std::pair<std::uint32_t, std::uint32_t>>& map) {
   map.clear();
   for (std::uint32_t f : m.vertex_faces[survivor]) {
     if (!m.face_alive[f] || !m.face_has(f, removed)) continue;
-    const std::uint32_t* t = m.face(f);
-    std::uint32_t ws = kNoVertex, wr = kNoVertex;
-    for (int k = 0; k < 3; ++k) {
-      if (t[k] == survivor) ws = m.corner_wedge[3 * std::size_t(f) + k];
-      if (t[k] == removed) wr = m.corner_wedge[3 * std::size_t(f) + k];
+    const auto [ws, wr] = edge_face_wedges(m, f, survivor, removed);
+    bool known = false;
+    for (const auto& [r, s] : map) known |= r == wr;
+    if (!known) map.push_back({wr, ws});
+  }
+  std::uint32_t w = wg.first[removed];
+  do {
+    bool known = false;
+    for (const auto& [r, s] : map) known |= r == w;
+    if (!known) {
+      std::uint32_t best = kNoVertex;
+      double best_d2 = 0;
+      std::uint32_t x = wg.first[survivor];
+      do {
+        if (wg.material[x] == wg.material[w]) {
+          const double d2 = value_distance(wg, w, x);
+          if (best == kNoVertex || d2 < best_d2) best = x, best_d2 = d2;
+        }
+        x = wg.next[x];
+      } while (x != wg.first[survivor]);
+      if (best == kNoVertex) return false;
+      map.push_back({w, best});
     }
+    w = wg.next[w];
+  } while (w != wg.first[removed]);
+  return true;
+}
+
+}  // namespace
+
+bool map_wedges(const WorkingMesh& m, const Wedges& wg, std::uint32_t survivor, std::uint32_t removed,
+                std::vector<std::pair<std::uint32_t, std::uint32_t>>& map, bool* crossed) {
+  if (crossed) *crossed = false;
+  map.clear();
+  bool strict = true;
+  for (std::uint32_t f : m.vertex_faces[survivor]) {
+    if (!m.face_alive[f] || !m.face_has(f, removed)) continue;
+    const auto [ws, wr] = edge_face_wedges(m, f, survivor, removed);
     bool known = false;
     for (const auto& [r, s] : map) {
       if (r == wr && s == ws) known = true;
-      else if (r == wr || s == ws) return false;  // one wedge to two, or two into one
+      else if (r == wr || s == ws) strict = false;  // one wedge to two, or two into one
     }
+    if (!strict) break;
     if (!known) map.push_back({wr, ws});
   }
-  std::size_t removed_wedges = 0;
-  std::uint32_t w = wg.first[removed];
-  do ++removed_wedges, w = wg.next[w];
-  while (w != wg.first[removed]);
-  return !map.empty() && map.size() == removed_wedges;
+  if (strict) {
+    std::size_t removed_wedges = 0;
+    std::uint32_t w = wg.first[removed];
+    do ++removed_wedges, w = wg.next[w];
+    while (w != wg.first[removed]);
+    if (map.empty()) return false;  // not an edge: nothing tells the sides apart
+    if (map.size() == removed_wedges) return true;
+  }
+  const bool protect = !wg.protect.empty() && (wg.protect[survivor] || wg.protect[removed]);
+  if (!wg.permissive || protect || !map_crossing(m, wg, survivor, removed, map)) return false;
+  if (crossed) *crossed = true;
+  return true;
+}
+
+void lock_seam_vertices(const Wedges& wg, WorkingMesh& m) {
+  if (m.locked.empty()) m.locked.assign(m.vertex_count(), 0);
+  for (std::uint32_t v = 0; v < m.vertex_count(); ++v)
+    if (wg.first[v] != kNoVertex && !wg.single(v)) m.locked[v] = 1;
 }
 
 Mesh build_wedge_output(const WorkingMesh& m, const Wedges& wg, MeshView input, std::vector<std::uint32_t>& vertex_source,
-                        std::vector<std::uint32_t>& face_source, std::vector<std::uint32_t>* output_vertex_of_input) {
+                        std::vector<std::uint32_t>& face_source, std::vector<std::uint32_t>* output_vertex_of_input,
+                        WedgeRefitData* refit) {
   std::vector<std::uint32_t> faces;
   std::vector<std::uint8_t> used(wg.count(), 0);
   for (std::uint32_t f = 0; f < m.face_alive.size(); ++f)
@@ -236,13 +400,33 @@ Mesh build_wedge_output(const WorkingMesh& m, const Wedges& wg, MeshView input, 
     out.attributes.push_back({a.name, a.kind, a.components, {}});
     out.attributes.back().values.reserve(survivors.size() * a.components);
   }
+  // Wedges in use per working vertex: a wedge whose faces all died is no seam any more.
+  std::vector<std::uint32_t> used_at(refit ? m.vertex_count() : 0, 0);
+  if (refit)
+    for (std::uint32_t w : survivors) ++used_at[wg.vertex[w]];
   std::vector<std::uint32_t> remap(wg.count(), kNoVertex);
   std::vector<double> values(wg.width);
-  for (std::uint32_t w : survivors) {
+  for (std::size_t i = 0; i < survivors.size(); ++i) {
+    const std::uint32_t w = survivors[i];
+    // The two sides of a mirror line are wedges of one input vertex and material: with equal
+    // values (they stayed on the seam) they are one output vertex again, as in the input.
+    std::uint32_t same = kNoVertex;
+    for (std::size_t j = i; j > 0 && wg.source[survivors[j - 1]] == wg.source[w] && same == kNoVertex; --j) {
+      const std::uint32_t x = survivors[j - 1];
+      if (wg.material[x] == wg.material[w] && wg.vertex[x] == wg.vertex[w] &&
+          std::equal(&wg.value[std::size_t(x) * wg.width], &wg.value[std::size_t(x + 1) * wg.width],
+                     &wg.value[std::size_t(w) * wg.width]))
+        same = x;
+    }
+    if (same != kNoVertex) {
+      remap[w] = remap[same];
+      continue;
+    }
     remap[w] = std::uint32_t(vertex_source.size());
     vertex_source.push_back(wg.source[w]);
     const Vec3 p = m.output_position(wg.vertex[w], input);
     out.positions.insert(out.positions.end(), {p.x, p.y, p.z});
+    if (refit) refit->on_seam.push_back(used_at[wg.vertex[w]] > 1);
     output_values(wg, w, values.data());
     for (std::size_t i = 0; i < wg.channels.size(); ++i)
       out.attributes[i].values.insert(out.attributes[i].values.end(), values.begin() + wg.channels[i].first,

@@ -38,6 +38,12 @@ struct Wedges {
   std::vector<std::uint32_t> merged_into;  ///< kNoVertex, or the wedge this one was merged into
   std::vector<double> value;          ///< `width` per wedge, as given (the quadrics hold the weights)
   std::vector<double> quadric;        ///< `quadric_width` per wedge (see wedges.cpp)
+  std::vector<std::uint32_t> material;  ///< the face material of each wedge (0 without materials)
+  /// SeamPolicy::Permissive: a collapse may cross a seam (map_wedges), never a material boundary.
+  bool permissive = false;
+  /// Per working vertex (empty: none), SimplifyOptions::vertex_protect: its seams are never
+  /// crossed, even when permissive.
+  std::vector<std::uint8_t> protect;
 
   std::size_t count() const { return vertex.size(); }
   bool single(std::uint32_t v) const { return next[first[v]] == first[v]; }
@@ -45,6 +51,11 @@ struct Wedges {
   /// with every channel at its optimum, as a quadric in the position (weight 0: it adds error, not
   /// surface).
   Quadric reduced(std::uint32_t w, std::uint32_t w2) const;
+  /// The same with any number of wedges merged into w.
+  Quadric reduced(std::uint32_t w, const std::uint32_t* merged, std::size_t count) const;
+  /// The attribute error of w with `merged` merged into it, at position p with w's values as they
+  /// are (not at their optimum): what a collapse costs whose survivor keeps its values.
+  double error_at(std::uint32_t w, const std::uint32_t* merged, std::size_t count, const Vec3& p) const;
   /// Sets w's interpolated channels to their optimum at p (after the merge).
   void update_values(std::uint32_t w, const Vec3& p);
   /// `removed` went into `survivor`, now at p: each removed wedge's quadric joins its partner's
@@ -70,14 +81,30 @@ Wedges build_wedges(MeshView input, const std::vector<std::uint32_t>& internal, 
 /// survivor's wedge on the same side of the edge's faces. False if a wedge of the removed vertex is
 /// on no face of the edge (the collapse would move a seam or open it) or two wedges would merge into
 /// one (the collapse would close a seam). `map` gets (removed wedge, survivor wedge) pairs.
+/// Permissive (wedges.permissive, neither end protected): where those rules fail, each removed
+/// wedge goes to the survivor's wedge it meets on an edge face, else to the survivor's wedge of the
+/// same material nearest in weighted attribute values, and `crossed` (if given) is set; still
+/// false if a material would merge into another.
 bool map_wedges(const WorkingMesh& mesh, const Wedges& wedges, std::uint32_t survivor, std::uint32_t removed,
-                std::vector<std::pair<std::uint32_t, std::uint32_t>>& map);
+                std::vector<std::pair<std::uint32_t, std::uint32_t>>& map, bool* crossed = nullptr);
+
+/// SimplifyOptions::lock_seams: every working vertex with more than one wedge (a UV seam, a normal
+/// crease, a colour or material boundary, a mirror line) is locked (WorkingMesh::locked).
+void lock_seam_vertices(const Wedges& wedges, WorkingMesh& mesh);
+
+/// What the refit after a run needs to know of each output vertex (simplify.cpp).
+struct WedgeRefitData {
+  /// Whether its position holds more than one wedge in use (a seam, crease, material boundary or
+  /// mirror line, even where the output merged a mirror line's two sides back into one vertex).
+  std::vector<std::uint8_t> on_seam;
+};
 
 /// The output with attributes: one vertex per surviving wedge, in input order, with the input's
 /// attributes (output_values) and face materials; provenance as build_output's, and, when asked,
-/// each input vertex's output vertex.
+/// each input vertex's output vertex and the refit's data.
 Mesh build_wedge_output(const WorkingMesh& mesh, const Wedges& wedges, MeshView input, std::vector<std::uint32_t>& vertex_source,
-                        std::vector<std::uint32_t>& face_source, std::vector<std::uint32_t>* output_vertex_of_input);
+                        std::vector<std::uint32_t>& face_source, std::vector<std::uint32_t>* output_vertex_of_input,
+                        WedgeRefitData* refit = nullptr);
 
 /// The output's attribute values of wedge w: unweighted, normals unit, colours in [0, 1], skin
 /// weights summing to 1.

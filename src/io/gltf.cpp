@@ -134,6 +134,54 @@ std::array<double, 9> normal_matrix(const Mat4& m) {
   return {A / det, D / det, G / det, B / det, E / det, H / det, C / det, F / det, I / det};
 }
 
+/// The largest singular value of the upper 3x3 of `m`: the most it stretches a length. From the
+/// largest eigenvalue of A^T A, by the closed form for symmetric 3x3 matrices (Smith 1961).
+double largest_scale(const Mat4& m) {
+  double b[3][3];
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) {
+      double s = 0;
+      for (int k = 0; k < 3; ++k) s += m[r * 4 + k] * m[c * 4 + k];  // column r . column c
+      b[r][c] = s;
+    }
+  const double p1 = b[0][1] * b[0][1] + b[0][2] * b[0][2] + b[1][2] * b[1][2];
+  double largest = std::max({b[0][0], b[1][1], b[2][2]});
+  if (p1 > 0) {
+    const double q = (b[0][0] + b[1][1] + b[2][2]) / 3;
+    const double p2 = (b[0][0] - q) * (b[0][0] - q) + (b[1][1] - q) * (b[1][1] - q) +
+                      (b[2][2] - q) * (b[2][2] - q) + 2 * p1;
+    const double p = std::sqrt(p2 / 6);
+    double c[3][3];
+    for (int r = 0; r < 3; ++r)
+      for (int k = 0; k < 3; ++k) c[r][k] = (b[r][k] - (r == k ? q : 0)) / p;
+    const double det = c[0][0] * (c[1][1] * c[2][2] - c[1][2] * c[2][1]) -
+                       c[0][1] * (c[1][0] * c[2][2] - c[1][2] * c[2][0]) +
+                       c[0][2] * (c[1][0] * c[2][1] - c[1][1] * c[2][0]);
+    const double phi = std::acos(std::clamp(det / 2, -1.0, 1.0)) / 3;
+    largest = std::max(largest, q + 2 * p * std::cos(phi));
+  }
+  return std::sqrt(std::max(largest, 0.0));
+}
+
+/// The nodes a scene draws from: the default scene's (or the first scene's), or every node that
+/// is no other's child when the file has no scene.
+std::vector<int> scene_roots(const tinygltf::Model& m) {
+  int scene = -1;
+  if (m.defaultScene >= 0 && static_cast<std::size_t>(m.defaultScene) < m.scenes.size())
+    scene = m.defaultScene;
+  else if (!m.scenes.empty())
+    scene = 0;
+  if (scene >= 0) return m.scenes[static_cast<std::size_t>(scene)].nodes;
+  std::vector<int> roots;
+  std::vector<char> child(m.nodes.size(), 0);
+  for (const tinygltf::Node& n : m.nodes)
+    for (int c : n.children)
+      if (c >= 0 && static_cast<std::size_t>(c) < child.size()) child[static_cast<std::size_t>(c)] = 1;
+  for (std::size_t n = 0; n < m.nodes.size(); ++n)
+    if (!child[n]) roots.push_back(static_cast<int>(n));
+  return roots;
+}
+
 /// Throws unless every coordinate and attribute value fits in single precision, which glTF
 /// stores (converting a double beyond the float range is undefined behaviour, and a file with
 /// infinities is one no reader takes).
@@ -167,6 +215,7 @@ struct GltfDocument::Impl {
     return model.meshes[primitives[i].mesh].primitives[primitives[i].primitive];
   }
   void check_and_list();
+  void measure_world_scales();
   Mesh read(std::size_t i) const;
   tinygltf::Model rebuilt() const;
 };
@@ -237,6 +286,60 @@ void GltfDocument::Impl::check_and_list() {
       if (!primitives[i].why_not.empty())
         notes.push_back(where(i) + ": not simplifiable: " + primitives[i].why_not);
     }
+  measure_world_scales();
+}
+
+void GltfDocument::Impl::measure_world_scales() {
+  const tinygltf::Model& m = model;
+  // World matrices of the nodes the scene reaches (depth first, the current path marked so that a
+  // cyclic, invalid hierarchy cannot loop).
+  std::vector<Mat4> world(m.nodes.size(), identity());
+  std::vector<char> reached(m.nodes.size(), 0), on_path(m.nodes.size(), 0);
+  auto visit = [&](auto&& self, int node, const Mat4& parent) -> void {
+    if (node < 0 || static_cast<std::size_t>(node) >= m.nodes.size() ||
+        on_path[static_cast<std::size_t>(node)])
+      return;
+    const auto n = static_cast<std::size_t>(node);
+    on_path[n] = 1;
+    world[n] = multiply(parent, local_matrix(m.nodes[n]));
+    reached[n] = 1;
+    for (int c : m.nodes[n].children) self(self, c, world[n]);
+    on_path[n] = 0;
+  };
+  for (int r : scene_roots(m)) visit(visit, r, identity());
+  std::vector<double> mesh_scale(m.meshes.size(), 0);
+  for (std::size_t n = 0; n < m.nodes.size(); ++n) {
+    const tinygltf::Node& node = m.nodes[n];
+    if (!reached[n] || node.mesh < 0 || static_cast<std::size_t>(node.mesh) >= m.meshes.size()) continue;
+    double scale = 0;
+    if (node.skin >= 0 && static_cast<std::size_t>(node.skin) < m.skins.size()) {
+      // A skinned mesh is drawn by its joints in the bind pose: joint world x inverse bind matrix.
+      const tinygltf::Skin& skin = m.skins[static_cast<std::size_t>(node.skin)];
+      std::vector<double> ibm;
+      std::uint32_t components = 0;
+      if (skin.inverseBindMatrices >= 0)
+        ibm = read_accessor(m, skin.inverseBindMatrices,
+                            name + ": skin " + std::to_string(node.skin) + " (inverseBindMatrices)",
+                            &components);
+      if (!ibm.empty() && (components != 16 || ibm.size() < 16 * skin.joints.size()))
+        throw Error(name + ": skin " + std::to_string(node.skin) +
+                    ": inverseBindMatrices is not one MAT4 per joint");
+      for (std::size_t j = 0; j < skin.joints.size(); ++j) {
+        const int joint = skin.joints[j];
+        if (joint < 0 || static_cast<std::size_t>(joint) >= m.nodes.size()) continue;
+        Mat4 inverse_bind = identity();
+        if (!ibm.empty()) std::copy(ibm.begin() + 16 * j, ibm.begin() + 16 * (j + 1), inverse_bind.begin());
+        scale =
+            std::max(scale, largest_scale(multiply(world[static_cast<std::size_t>(joint)], inverse_bind)));
+      }
+    } else {
+      scale = largest_scale(world[n]);
+    }
+    double& s = mesh_scale[static_cast<std::size_t>(node.mesh)];
+    if (std::isfinite(scale)) s = std::max(s, scale);
+  }
+  for (GltfPrimitiveInfo& p : primitives)
+    if (mesh_scale[p.mesh] > 0) p.world_scale = mesh_scale[p.mesh];
 }
 
 Mesh GltfDocument::Impl::read(std::size_t i) const {
@@ -256,6 +359,9 @@ Mesh GltfDocument::Impl::read(std::size_t i) const {
     a.name = semantic;
     a.kind = kind_of(semantic);
     a.values = read_accessor(model, accessor, at + " (" + semantic + ")", &a.components);
+    if (a.components > 4)
+      throw Error(at + " (" + semantic + "), accessor " + std::to_string(accessor) +
+                  ": a matrix, which is no vertex attribute type");
     if (a.values.size() != vertices * a.components)
       throw Error(at + " (" + semantic + "), accessor " + std::to_string(accessor) + ": count " +
                   std::to_string(a.values.size() / a.components) + " differs from POSITION's " +
@@ -692,22 +798,7 @@ Mesh GltfDocument::scene_mesh() const {
         parts.push_back({i, world, instances});
     }
   };
-  std::vector<int> roots;
-  int scene = -1;
-  if (m.defaultScene >= 0 && static_cast<std::size_t>(m.defaultScene) < m.scenes.size())
-    scene = m.defaultScene;
-  else if (!m.scenes.empty())
-    scene = 0;
-  if (scene >= 0) {
-    roots = m.scenes[static_cast<std::size_t>(scene)].nodes;
-  } else {
-    std::vector<char> child(m.nodes.size(), 0);
-    for (const tinygltf::Node& n : m.nodes)
-      for (int c : n.children)
-        if (c >= 0 && static_cast<std::size_t>(c) < child.size()) child[static_cast<std::size_t>(c)] = 1;
-    for (std::size_t n = 0; n < m.nodes.size(); ++n)
-      if (!child[n]) roots.push_back(static_cast<int>(n));
-  }
+  const std::vector<int> roots = scene_roots(m);
   // Depth first with the current path marked, so that a cyclic (invalid) hierarchy cannot loop.
   std::vector<char> on_path(m.nodes.size(), 0);
   auto visit = [&](auto&& self, int node, const Mat4& parent) -> void {

@@ -128,7 +128,11 @@ std::vector<double> read_accessor(const tinygltf::Model& model, int index, const
   const tinygltf::Accessor& a = model.accessors[static_cast<std::size_t>(index)];
   const std::uint32_t n = components_of(a.type);
   const std::size_t size = component_size(a.componentType);
-  if (n == 0 || n > 4) fail_accessor(where, index, "type is not SCALAR or VEC2..VEC4");
+  // MAT4 of 4-byte components (skins' inverse bind matrices) has no column padding, so it reads
+  // as 16 tightly packed components; MAT2 / MAT3 of small types are padded per column (glTF 2.0
+  // §3.6.2.4) and are not read.
+  if (n == 0 || (n > 4 && !(n == 16 && size == 4)))
+    fail_accessor(where, index, "type is not SCALAR, VEC2..VEC4 or a MAT4 of 4-byte components");
   if (size == 0) fail_accessor(where, index, "unknown component type " + std::to_string(a.componentType));
   if (components_out) *components_out = n;
   const std::uint64_t element = std::uint64_t(n) * size;

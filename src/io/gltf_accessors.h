@@ -18,7 +18,7 @@ std::uint32_t components_of(int type);
 /// The glTF accessor type with `n` components (1..4).
 int type_of(std::uint32_t n);
 
-/// Reads accessor `index` as count x components values. Normalised integers are mapped to
+/// Reads accessor `index` (SCALAR, VEC2..VEC4, or MAT4 of floats) as count x components values. Normalised integers are mapped to
 /// [0, 1] or [-1, 1] as the spec says; other integers keep their value. Throws qem::Error
 /// "<where>, accessor <index>: <what>" when the accessor or its data is out of range, or a float
 /// is not finite.

@@ -123,6 +123,7 @@ SimplifyOptions gh97_options(std::size_t target_faces, double threshold = 0) {
   o.target_faces = target_faces;
   o.threshold = threshold;
   o.preserve_topology = false;
+  o.keep_components = false;  // as published: a part may contract to nothing (Fig. 16's vanished bones)
   return o;
 }
 

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <bit>
 #include <cstdint>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "geometry/box.h"
@@ -66,7 +67,7 @@ std::map<std::string, std::string> scene_files(const ViewScene& scene) {
   // Keys in the order docs/viewer.md lists them, for whoever reads the file.
   using json = nlohmann::ordered_json;
   json doc = {{"format", "qem-view"},
-              {"version", 1},
+              {"version", 2},
               {"mode", to_string(scene.mode)},
               {"title", scene.title},
               {"center", {center[0], center[1], center[2]}},
@@ -77,23 +78,89 @@ std::map<std::string, std::string> scene_files(const ViewScene& scene) {
   for (std::size_t li = 0; li < scene.levels.size(); ++li) {
     const ViewLevel& level = scene.levels[li];
     const Mesh& m = level.mesh;
-    std::string base = "data/level" + std::to_string(li);
-    std::string pos, idx, dist;
+    const std::string base = "data/level" + std::to_string(li), dir = base + "/";
+    // An unknown error (NaN) is written as null.
+    json entry = {{"name", level.name}, {"faces", m.face_count()}, {"vertices", m.vertex_count()}, {"error", level.error}};
+    for (const auto& [key, bytes] : level.files) {
+      // Keys become paths of `--export`: never absolute, never out of the level's folder.
+      const std::filesystem::path k(key);
+      if (key.empty() || k.is_absolute() || k.lexically_normal().generic_string() != key || *k.begin() == "..")
+        throw Error(level.name + ": file key '" + key + "' is not a plain relative path");
+      files[dir + key] = bytes;
+    }
+    if (!level.gltf.empty()) {
+      if (!level.files.count(level.gltf)) throw Error(level.name + ": the glTF document is not among its files");
+      entry["gltf"] = dir + level.gltf;
+      doc["levels"].push_back(std::move(entry));
+      continue;
+    }
+    entry["positions"] = base + ".pos.f32";
+    entry["indices"] = base + ".idx.u32";
+    std::string pos, idx;
     pos.reserve(m.positions.size() * 4);
     for (std::size_t i = 0; i < m.positions.size(); ++i) put_f32(pos, m.positions[i] - center[int(i % 3)]);
     idx.reserve(m.indices.size() * 4);
     for (std::uint32_t v : m.indices) put_u32(idx, v);
     files[base + ".pos.f32"] = std::move(pos);
     files[base + ".idx.u32"] = std::move(idx);
-    // An unknown error (NaN) is written as null.
-    json entry = {{"name", level.name},   {"faces", m.face_count()},        {"vertices", m.vertex_count()},
-                  {"error", level.error}, {"positions", base + ".pos.f32"}, {"indices", base + ".idx.u32"}};
     const VertexProperty* d = m.find_property(kHeatProperty);
     if (d && d->values.size() == m.vertex_count()) {
+      std::string dist;
       dist.reserve(d->values.size() * 4);
       for (double x : d->values) put_f32(dist, std::isfinite(x) ? x : 0.0);
       files[base + ".dist.f32"] = std::move(dist);
       entry["distance"] = base + ".dist.f32";
+    }
+    // The first normals, texture coordinates and colours: what a renderer draws with.
+    auto attribute = [&](AttributeKind kind, const char* field, const char* suffix, std::uint32_t take) {
+      const VertexAttribute* a = m.find_attribute(kind);
+      if (!a) return;
+      if (a->components == 0 || a->components > 4 || a->values.size() != a->components * m.vertex_count())
+        throw Error(level.name + ": attribute " + a->name + " has " + std::to_string(a->values.size()) +
+                    " values for " + std::to_string(m.vertex_count()) + " vertices of " +
+                    std::to_string(a->components) + " components");
+      if (a->components < take) return;  // e.g. a one-component "texture coordinate"
+      if (take == 0) take = a->components;
+      std::string out;
+      out.reserve(m.vertex_count() * take * 4);
+      for (std::size_t v = 0; v < m.vertex_count(); ++v)
+        for (std::uint32_t c = 0; c < take; ++c) {
+          const double x = a->values[v * a->components + c];
+          put_f32(out, std::isfinite(x) ? x : 0.0);
+        }
+      const std::string path = base + suffix;
+      files[path] = std::move(out);
+      entry[field] = path;
+      if (kind == AttributeKind::Color) entry["color_components"] = take;
+    };
+    attribute(AttributeKind::Normal, "normals", ".nrm.f32", 3);
+    attribute(AttributeKind::TexCoord, "uvs", ".uv.f32", 2);
+    attribute(AttributeKind::Color, "colors", ".col.f32", 0);
+    if (!level.materials.empty()) {
+      if (!m.face_materials.empty() && m.face_materials.size() != m.face_count())
+        throw Error(level.name + ": " + std::to_string(m.face_materials.size()) + " face materials for " +
+                    std::to_string(m.face_count()) + " faces");
+      std::string mats;
+      mats.reserve(m.face_count() * 4);
+      for (std::size_t f = 0; f < m.face_count(); ++f) {
+        const std::uint32_t id = m.face_materials.empty() ? 0 : m.face_materials[f];
+        if (id >= level.materials.size())
+          throw Error(level.name + ": face " + std::to_string(f) + " has material " + std::to_string(id) + " of " +
+                      std::to_string(level.materials.size()));
+        put_u32(mats, id);
+      }
+      files[base + ".mat.u32"] = std::move(mats);
+      entry["face_materials"] = base + ".mat.u32";
+      json list = json::array();
+      for (const ViewMaterial& mat : level.materials) {
+        if (!mat.texture.empty() && !level.files.count(mat.texture))
+          throw Error(level.name + ": material " + mat.name + ": texture " + mat.texture + " is not among its files");
+        list.push_back({{"name", mat.name},
+                        {"color", {mat.color[0], mat.color[1], mat.color[2]}},
+                        {"opacity", mat.opacity},
+                        {"texture", mat.texture.empty() ? json() : json(dir + mat.texture)}});
+      }
+      entry["materials"] = std::move(list);
     }
     doc["levels"].push_back(std::move(entry));
   }

@@ -94,7 +94,12 @@ const char* content_type(const std::string& path) {
   if (ends(".js") || ends(".mjs")) return "text/javascript; charset=utf-8";
   if (ends(".css")) return "text/css; charset=utf-8";
   if (ends(".json")) return "application/json";
-  if (ends(".png")) return "image/png";
+  if (ends(".png") || ends(".PNG")) return "image/png";
+  if (ends(".jpg") || ends(".jpeg") || ends(".JPG") || ends(".JPEG")) return "image/jpeg";
+  if (ends(".webp")) return "image/webp";
+  if (ends(".ktx2")) return "image/ktx2";
+  if (ends(".gltf")) return "model/gltf+json";
+  if (ends(".glb")) return "model/gltf-binary";
   if (ends(".svg")) return "image/svg+xml";
   if (ends(".txt")) return "text/plain; charset=utf-8";
   return "application/octet-stream";

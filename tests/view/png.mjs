@@ -1,6 +1,6 @@
 // Decodes the PNGs Chromium and `qem render` write (8-bit RGB or RGBA, not interlaced) with Node's
 // zlib, so the test can look at the pixels of a screenshot without any image package.
-import { inflateSync } from 'node:zlib';
+import { deflateSync, inflateSync } from 'node:zlib';
 
 export function decodePng(buf) {
   if (buf.readUInt32BE(0) !== 0x89504e47) throw new Error('not a PNG');
@@ -60,4 +60,47 @@ export function regionStats(img, x0 = 0, y0 = 0, x1 = img.width, y1 = img.height
       if (Math.max(r, g, b) - Math.min(r, g, b) > 80) ++saturated;
     }
   return { distinct: colors.size, foreground, saturated, pixels: (x1 - x0) * (y1 - y0) };
+}
+
+const CRC_TABLE = Array.from({ length: 256 }, (_, n) => {
+  let c = n;
+  for (let k = 0; k < 8; ++k) c = c & 1 ? 0xedb88320 ^ (c >>> 1) : c >>> 1;
+  return c >>> 0;
+});
+function crc32(buf) {
+  let c = 0xffffffff;
+  for (const b of buf) c = CRC_TABLE[(c ^ b) & 0xff] ^ (c >>> 8);
+  return (c ^ 0xffffffff) >>> 0;
+}
+
+/// Encodes an 8-bit RGB PNG (the test's textures): `pixel(x, y)` returns [r, g, b].
+export function encodePng(width, height, pixel) {
+  const raw = Buffer.alloc(height * (width * 3 + 1));
+  for (let y = 0; y < height; ++y)
+    for (let x = 0; x < width; ++x) raw.set(pixel(x, y), y * (width * 3 + 1) + 1 + 3 * x);
+  const chunk = (type, data) => {
+    const head = Buffer.alloc(8);
+    head.writeUInt32BE(data.length, 0);
+    head.write(type, 4, 'latin1');
+    const crc = Buffer.alloc(4);
+    crc.writeUInt32BE(crc32(Buffer.concat([head.subarray(4), data])), 0);
+    return Buffer.concat([head, data, crc]);
+  };
+  const ihdr = Buffer.alloc(13);
+  ihdr.writeUInt32BE(width, 0); ihdr.writeUInt32BE(height, 4);
+  ihdr[8] = 8; ihdr[9] = 2;  // 8 bits, RGB
+  return Buffer.concat([Buffer.from([0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a]), chunk('IHDR', ihdr),
+    chunk('IDAT', deflateSync(raw)), chunk('IEND', Buffer.alloc(0))]);
+}
+
+/// Pixels of a rectangle that are clearly of one primary hue: the channel `c` (0 red, 1 green,
+/// 2 blue) exceeds both others by more than 60.
+export function countHue(img, c, x0 = 0, y0 = 0, x1 = img.width, y1 = img.height) {
+  let n = 0;
+  for (let y = y0; y < y1; ++y)
+    for (let x = x0; x < x1; ++x) {
+      const o = (y * img.width + x) * 4, v = [img.data[o], img.data[o + 1], img.data[o + 2]];
+      if (v[c] - Math.max(v[(c + 1) % 3], v[(c + 2) % 3]) > 60) ++n;
+    }
+  return n;
 }

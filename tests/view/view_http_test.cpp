@@ -38,7 +38,9 @@ class ViewHttp : public ::testing::Test {
   void SetUp() override {
     FileSet files{{"index.html", "<html>hello</html>"},
                   {"data/scene.json", "{}"},
-                  {"data/level0.pos.f32", std::string("\0\x01\x02", 3)}};
+                  {"data/level0.pos.f32", std::string("\0\x01\x02", 3)},
+                  {"data/level0/tex/a b.png", "PNG"},
+                  {"data/level1/man.glb", "glTF"}};
     server_ = std::make_unique<HttpServer>(files, 0);
     thread_ = std::thread([this] { server_->serve(stop_); });
   }
@@ -69,6 +71,18 @@ TEST_F(ViewHttp, ServesFilesWithTypesAndLengths) {
   r = get("/data/level0.pos.f32");
   EXPECT_EQ(r.substr(r.size() - 3), std::string("\0\x01\x02", 3));
   EXPECT_GE(server_->requests(), 3u);
+}
+
+TEST_F(ViewHttp, ServesAModelsFilesByTheirEscapedNames) {
+  std::string r = get("/data/level0/tex/a%20b.png");
+  EXPECT_EQ(r.rfind("HTTP/1.1 200", 0), 0u) << r;
+  EXPECT_NE(r.find("Content-Type: image/png\r\n"), std::string::npos) << r;
+  EXPECT_EQ(r.substr(r.size() - 3), "PNG");
+  r = get("/data/level1/man.glb");
+  EXPECT_NE(r.find("Content-Type: model/gltf-binary\r\n"), std::string::npos) << r;
+  // Escaped dots name no key: nothing outside the set, nothing by another path.
+  EXPECT_EQ(get("/data/level0/tex/%2e%2e/%2e%2e/scene.json").rfind("HTTP/1.1 404", 0), 0u);
+  EXPECT_EQ(get("/data/level0/tex/..%2f..%2fscene.json").rfind("HTTP/1.1 404", 0), 0u);
 }
 
 TEST_F(ViewHttp, AnswersErrorsWithoutTouchingTheFileSystem) {

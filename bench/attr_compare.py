@@ -1,0 +1,284 @@
+#!/usr/bin/python3
+"""qem against meshoptimizer's simplifyWithAttributes (and `gltf-transform simplify`) on the
+textured and coloured assets of ../shared/data: one table of E ratios, UV / normal / colour errors
+and seam cracks, measured by `qem measure` and cross-checked with attr_metric.py.
+
+usage: bench/attr_compare.py [--qem build/qem] [--peer /tmp/jspeer] [--out DIR] [--ratios 0.5,0.1,0.01]
+                             [--assets a,b,...] [--qem-arg ARG ...] [--no-check] [--samples N]
+
+The peer folder is a copy of ../shared/bench/peers/js after `npm ci` (it holds
+peer_meshopt_attr.mjs and node_modules/.bin/gltf-transform). Every run's numbers go to
+DIR/rows.jsonl; the peers' outputs and measurements are cached in DIR (keyed by asset, ratio and
+tool), so a sweep over qem's options (--qem-arg) re-runs and re-measures qem only.
+
+Inputs: each tool reads the file itself where it can. The peer script reads .glb and .obj (v/vt/vn)
+but no vertex colours and no materials in OBJ and no attributes in PLY, so the PLY assets and the
+vertex-coloured OBJ are given to the peers as a .glb written here from qem's lossless OBJ copy
+(one primitive per material, i.e. per face colour; COLOR_0, NORMAL, TEXCOORD_0 as float). qem and
+both metrics always read the original file. On .glb files qem simplifies the merged scene (the
+target shared by all primitives) and writes it as one .glb; the peers simplify each primitive to
+the same fraction and keep the document.
+"""
+import argparse
+import json
+import math
+import os
+import struct
+import subprocess
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+DATA = os.path.normpath(os.path.join(HERE, '..', '..', 'shared', 'data'))
+ATTR_METRIC = os.path.normpath(os.path.join(HERE, '..', '..', 'shared', 'bench', 'metric', 'attr_metric.py'))
+ASSETS = ['Duck.glb', 'CesiumMan.glb', 'CesiumMilkTruck.glb', 'SheenCloth.glb', 'tiny_cube_vcolor.glb',
+          'spot.obj', 'beast.obj', 'boat.obj', 'pizza.obj', 'human_neutral.obj', 'trimesh_chair.obj',
+          'trimesh_reference_vcolor.obj', 'tiny_sphere_vcolor.ply', 'trimesh_cycloidal.ply', 'hoppe_cessna.ply',
+          'hoppe_spheretext.ply']
+
+
+def run(cmd, **kw):
+    r = subprocess.run(cmd, capture_output=True, text=True, **kw)
+    if r.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)} failed ({r.returncode}): {r.stderr.strip()[-500:]}")
+    return r.stdout
+
+
+def last_json(text):
+    return json.loads([l for l in text.splitlines() if l.startswith('{')][-1])
+
+
+def obj_to_glb(obj_path, glb_path):
+    """OBJ (v [r g b], vt, vn, usemtl, f v/vt/vn) -> .glb, one primitive per material."""
+    v, col, vt, vn, groups, cur = [], [], [], [], {}, ''
+    for line in open(obj_path):
+        f = line.split()
+        if not f:
+            continue
+        if f[0] == 'v':
+            v.append(tuple(map(float, f[1:4])))
+            col.append(tuple(map(float, f[4:7])) if len(f) >= 7 else None)
+        elif f[0] == 'vt':
+            vt.append((float(f[1]), float(f[2]) if len(f) > 2 else 0.0))
+        elif f[0] == 'vn':
+            vn.append(tuple(map(float, f[1:4])))
+        elif f[0] == 'usemtl':
+            cur = f[1] if len(f) > 1 else ''
+        elif f[0] == 'f':
+            corners = []
+            for c in f[1:]:
+                p = (c.split('/') + ['', ''])[:3]
+                corners.append(tuple(int(x) - 1 if x else -1 for x in p))
+            for i in range(1, len(corners) - 1):
+                groups.setdefault(cur, []).append((corners[0], corners[i], corners[i + 1]))
+    has_c = any(c is not None for c in col)
+    has_t = bool(vt)
+    has_n = bool(vn)
+    bin_, views, accs, prims, mats = bytearray(), [], [], [], []
+
+    def add(data, fmt, count, gltype, comp, target, minmax=None):
+        while len(bin_) % 4:
+            bin_.append(0)
+        views.append({'buffer': 0, 'byteOffset': len(bin_), 'byteLength': len(data), 'target': target})
+        bin_.extend(data)
+        a = {'bufferView': len(views) - 1, 'componentType': comp, 'count': count, 'type': gltype}
+        if minmax:
+            a['min'], a['max'] = minmax
+        accs.append(a)
+        return len(accs) - 1
+
+    for name, tris in groups.items():
+        key, pos, cc, tt, nn, idx = {}, [], [], [], [], []
+        for t in tris:
+            for c in t:
+                if c not in key:
+                    key[c] = len(pos)
+                    pos.append(v[c[0]])
+                    cc.append(col[c[0]] or (1.0, 1.0, 1.0))
+                    tt.append(vt[c[1]] if c[1] >= 0 else (0.0, 0.0))
+                    nn.append(vn[c[2]] if c[2] >= 0 else (0.0, 0.0, 1.0))
+                idx.append(key[c])
+        flat = lambda rows: [x for r in rows for x in r]
+        lo = [min(p[k] for p in pos) for k in range(3)]
+        hi = [max(p[k] for p in pos) for k in range(3)]
+        attrs = {'POSITION': add(struct.pack(f'<{3 * len(pos)}f', *flat(pos)), 'f', len(pos), 'VEC3', 5126, 34962, (lo, hi))}
+        if has_n:
+            attrs['NORMAL'] = add(struct.pack(f'<{3 * len(nn)}f', *flat(nn)), 'f', len(nn), 'VEC3', 5126, 34962)
+        if has_t:
+            attrs['TEXCOORD_0'] = add(struct.pack(f'<{2 * len(tt)}f', *flat(tt)), 'f', len(tt), 'VEC2', 5126, 34962)
+        if has_c:
+            attrs['COLOR_0'] = add(struct.pack(f'<{3 * len(cc)}f', *flat(cc)), 'f', len(cc), 'VEC3', 5126, 34962)
+        ind = add(struct.pack(f'<{len(idx)}I', *idx), 'I', len(idx), 'SCALAR', 5125, 34963)
+        mats.append({'name': name})
+        prims.append({'attributes': attrs, 'indices': ind, 'material': len(mats) - 1, 'mode': 4})
+    while len(bin_) % 4:
+        bin_.append(0)
+    js = {'asset': {'version': '2.0', 'generator': 'qem bench/attr_compare.py'}, 'scene': 0,
+          'scenes': [{'nodes': [0]}], 'nodes': [{'mesh': 0}], 'meshes': [{'primitives': prims}],
+          'materials': mats, 'buffers': [{'byteLength': len(bin_)}], 'bufferViews': views, 'accessors': accs}
+    j = json.dumps(js).encode()
+    j += b' ' * (-len(j) % 4)
+    out = struct.pack('<III', 0x46546C67, 2, 12 + 8 + len(j) + 8 + len(bin_))
+    out += struct.pack('<II', len(j), 0x4E4F534A) + j + struct.pack('<II', len(bin_), 0x004E4942) + bytes(bin_)
+    open(glb_path, 'wb').write(out)
+
+
+def peer_input(asset, path, qem, work):
+    """The file the peers read: the asset itself, or a .glb copy (see the module's doc)."""
+    if path.endswith('.glb'):
+        return path
+    if path.endswith('.obj'):
+        info = json.loads(run([qem, 'info', '--json', path]))
+        if not any(a['kind'] == 'color' for a in info['attributes']) and info['materials'] <= 1:
+            return path
+    glb = os.path.join(work, asset + '.peer.glb')
+    if not os.path.exists(glb):
+        obj = os.path.join(work, asset + '.copy.obj')
+        run([qem, 'simplify', '-q', '--no-refit', '-r', '1', path, obj])
+        obj_to_glb(obj, glb)
+    return glb
+
+
+def measure(qem, orig, approx, samples, check):
+    m = last_json(run([qem, 'measure', '--json', '--samples', str(samples), orig, approx]))
+    row = {k: m.get(k) for k in ('approx_faces', 'E', 'E_rel', 'hausdorff_rel', 'uv_rms', 'normal_rms_deg', 'color_rms',
+                                 'seam_cracks')}
+    if check:
+        a = last_json(run(['/usr/bin/python3', ATTR_METRIC, orig, approx]))
+        row.update({'py_' + k: a.get(k) for k in ('rms_dist_rel', 'uv_rms', 'normal_rms_deg', 'color_rms', 'seam_cracks')})
+    return row
+
+
+def tool_run(tool, asset, path, ratio, faces, args, work):
+    """Simplifies with one tool; returns (output path, its JSON report or {})."""
+    stem = os.path.join(work, f'{asset}.{ratio:g}.{tool}')
+    ext = '.glb' if tool == 'gltft' or path.endswith('.glb') else os.path.splitext(path)[1]
+    if tool == 'qem':
+        out = stem + ext
+        return out, last_json(run([args.qem, 'simplify', '--json', '-q', '-f', str(faces)] + args.qem_arg + [path, out]))
+    src = peer_input(asset, path, args.qem, work)
+    out = stem + (os.path.splitext(src)[1] if tool == 'meshopt' else '.glb')
+    if tool == 'meshopt':
+        return out, last_json(run(['node', os.path.join(args.peer, 'peer_meshopt_attr.mjs'), src, out, str(faces), 'attr']))
+    if not src.endswith('.glb'):
+        src = os.path.join(work, asset + '.peer.glb')
+        if not os.path.exists(src):
+            obj = os.path.join(work, asset + '.copy.obj')
+            run([args.qem, 'simplify', '-q', '--no-refit', '-r', '1', path, obj])
+            obj_to_glb(obj, src)
+    run([os.path.join(args.peer, 'node_modules', '.bin', 'gltf-transform'), 'simplify', src, out, '--ratio', f'{ratio:g}',
+         '--error', '1'])
+    return out, {}
+
+
+def fmt(x, digits=3):
+    if x is None:
+        return '-'
+    if isinstance(x, int):
+        return str(x)
+    return f'{x:.{digits}g}'
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument('--qem', default=os.path.join(HERE, '..', 'build', 'qem'))
+    ap.add_argument('--peer', default='/tmp/jspeer')
+    ap.add_argument('--out', default='/tmp/qem_attr_compare')
+    ap.add_argument('--ratios', default='0.5,0.1,0.01')
+    ap.add_argument('--assets', default=','.join(ASSETS))
+    ap.add_argument('--tools', default='qem,meshopt,gltft')
+    ap.add_argument('--qem-arg', action='append', default=[], help='extra argument of qem simplify (repeat)')
+    ap.add_argument('--samples', type=int, default=1000000, help='samples of qem measure')
+    ap.add_argument('--no-check', action='store_true', help='skip attr_metric.py (qem measure only)')
+    ap.add_argument('--tag', default='', help='label of this run in rows.jsonl')
+    args = ap.parse_args()
+    args.qem = os.path.abspath(args.qem)
+    os.makedirs(args.out, exist_ok=True)
+    cache_path = os.path.join(args.out, 'peer_cache.json')
+    cache = json.load(open(cache_path)) if os.path.exists(cache_path) else {}
+    tools = args.tools.split(',')
+    rows = []
+    print(HEADER)
+    for asset in args.assets.split(','):
+        path = os.path.join(DATA, asset)
+        in_faces = json.loads(run([args.qem, 'info', '--json', path]))['faces']
+        for ratio in map(float, args.ratios.split(',')):
+            faces = max(1, round(ratio * in_faces))
+            row = {'asset': asset, 'ratio': ratio, 'in_faces': in_faces, 'target': faces, 'tag': args.tag,
+                   'qem_args': ' '.join(args.qem_arg)}
+            for tool in tools:
+                key = f'{asset}|{ratio:g}|{tool}|{args.samples}|{not args.no_check}'
+                if tool != 'qem' and key in cache:
+                    row[tool] = cache[key]
+                    continue
+                try:
+                    out, rep = tool_run(tool, asset, path, ratio, faces, args, args.out)
+                    m = measure(args.qem, path, out, args.samples, not args.no_check)
+                    m['simplify_s'] = rep.get('simplify_s')
+                except RuntimeError as e:
+                    m = {'error': str(e)}
+                    print(f'{asset} {ratio:g} {tool}: {e}', file=sys.stderr)
+                row[tool] = m
+                if tool != 'qem':
+                    cache[key] = m
+                    json.dump(cache, open(cache_path, 'w'))
+            rows.append(row)
+            with open(os.path.join(args.out, 'rows.jsonl'), 'a') as f:
+                f.write(json.dumps(row) + '\n')
+            print(line(row, tools), flush=True)
+    print(verdict(rows))
+
+
+HEADER = ('| asset | target | faces q / m / g | E q/m | E q/g | UV q / m | normal° q / m | colour q / m | cracks q / m / g |'
+          ' check |\n|---|---|---|---|---|---|---|---|---|---|')
+
+
+def ratio_of(a, b):
+    return None if a is None or not b else a / b
+
+
+def line(row, tools):
+    q, m, g = row.get('qem', {}), row.get('meshopt', {}), row.get('gltft', {})
+    pair = lambda k, d=3: f"{fmt(q.get(k), d)} / {fmt(m.get(k), d)}" if (q.get(k) is not None or m.get(k) is not None) else '-'
+    # check: the largest relative difference between qem measure and attr_metric.py over the
+    # attribute errors of qem's and meshopt's outputs (sampling noise is a few %).
+    diffs = []
+    # attr_metric.py reads glTF in mesh space and qem's merged .glb is in scene space: no check there.
+    for r in ((m,) if row['asset'].endswith('.glb') else (q, m)):
+        for k in ('uv_rms', 'normal_rms_deg', 'color_rms'):
+            a, b = r.get(k), r.get('py_' + k)
+            if a is not None and b is not None and max(a, b) > 0:
+                diffs.append(abs(a - b) / max(a, b))
+        if r.get('seam_cracks') is not None and r.get('py_seam_cracks') is not None and r['seam_cracks'] != r['py_seam_cracks']:
+            diffs.append(float('inf'))
+    check = '-' if not diffs else ('cracks differ' if max(diffs) == float('inf') else f'{100 * max(diffs):.0f}%')
+    er = lambda x: fmt(ratio_of(q.get('E'), x.get('E')), 2)
+    return (f"| {row['asset']} | {row['ratio']:g} | {fmt(q.get('approx_faces'))} / {fmt(m.get('approx_faces'))} / "
+            f"{fmt(g.get('approx_faces'))} | {er(m)} | {er(g)} | {pair('uv_rms')} | {pair('normal_rms_deg', 2)} | "
+            f"{pair('color_rms')} | {fmt(q.get('seam_cracks'))} / {fmt(m.get('seam_cracks'))} / {fmt(g.get('seam_cracks'))} | {check} |")
+
+
+def verdict(rows):
+    """The issue's goal per row: E <= 0.9x meshopt's, attribute errors <= meshopt's, no cracks."""
+    fails = []
+    for row in rows:
+        q, m = row.get('qem', {}), row.get('meshopt', {})
+        why = []
+        e = ratio_of(q.get('E'), m.get('E'))
+        if e is not None and e > 0.9:
+            why.append(f'E {e:.2f}x')
+        for k in ('uv_rms', 'normal_rms_deg', 'color_rms'):
+            if q.get(k) is not None and m.get(k) is not None and q[k] > m[k] + 1e-9:  # 1e-9: rounding noise
+                why.append(f'{k} {q[k]:.3g} > {m[k]:.3g}')
+        if q.get('seam_cracks'):
+            why.append(f"{q['seam_cracks']} cracks")
+        if why:
+            fails.append(f"{row['asset']} {row['ratio']:g}: " + ', '.join(why))
+    er = [ratio_of(r.get('qem', {}).get('E'), r.get('meshopt', {}).get('E')) for r in rows]
+    er = [x for x in er if x]
+    gm = math.exp(sum(map(math.log, er)) / len(er)) if er else float('nan')
+    return f'{len(rows) - len(fails)} of {len(rows)} rows meet the goal, geometric mean E q/m {gm:.3f}' + (
+        '; not met: ' + '; '.join(fails) if fails else '')
+
+
+if __name__ == '__main__':
+    main()

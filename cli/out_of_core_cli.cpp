@@ -1,0 +1,90 @@
+#include "out_of_core_cli.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+
+#include "cli_util.h"
+#include "qem/error.h"
+#include "qem/io.h"
+#include "qem/out_of_core.h"
+
+namespace qem::cli {
+
+void add_out_of_core_options(CLI::App* sub, OutOfCoreArgs& args) {
+  sub->add_option("--memory-limit", args.memory_limit,
+                  "Memory budget, e.g. 2G or 512M (default: half of the available memory). A binary PLY or "
+                  "STL whose in-memory run would exceed it is simplified out of core: clustered while "
+                  "streamed (Lindstrom 2000), then simplified in memory (docs/out-of-core.md)");
+  sub->add_option("--temp-dir", args.temp_dir,
+                  "Folder for the out-of-core run's temporary files (default: $TMPDIR, else the output's "
+                  "folder); they are removed at the end, on failure and on Ctrl-C");
+}
+
+bool wants_out_of_core(const std::string& input, const OutOfCoreArgs& args) {
+  const std::uint64_t limit = args.memory_limit.empty() ? 0 : parse_memory_size(args.memory_limit);
+  return !fits_in_memory(input, limit);
+}
+
+int run_out_of_core(const std::string& input, const std::string& output, const SimplifyOptions& options,
+                    const OutOfCoreArgs& args, const OutputArgs& out) {
+  OutOfCoreOptions ooc;
+  if (!args.memory_limit.empty()) ooc.memory_limit = parse_memory_size(args.memory_limit);
+  ooc.temp_dir = args.temp_dir;
+  if (ooc.temp_dir.empty() && !std::getenv("TMPDIR")) {
+    const auto slash = output.find_last_of('/');
+    ooc.temp_dir = slash == std::string::npos ? "." : output.substr(0, slash + 1);
+  }
+  const bool show = !out.quiet && !out.json;
+  const bool tty = ::isatty(STDERR_FILENO);
+  if (show)
+    ooc.progress = [tty](const OutOfCoreProgress& p) {
+      char left[32] = "";
+      if (p.seconds_left >= 0) std::snprintf(left, sizeof left, ", about %.0f s left", p.seconds_left);
+      std::fprintf(stderr, "%sqem: out of core, phase %d/%d %s: %.2f of %.2f GB read, %.0f s%s%s",
+                   tty ? "\r" : "", p.phase_index, p.phase_count, p.phase, double(p.bytes_read) / 1e9,
+                   double(p.bytes_total) / 1e9, p.seconds, left, tty ? "\x1b[K" : "\n");
+      std::fflush(stderr);
+      return true;
+    };
+  Stopwatch total;
+  OutOfCoreReport report;
+  SimplifyResult r = simplify_out_of_core(input, options, ooc, &report);
+  if (show && tty) std::fprintf(stderr, "\n");
+  SaveOptions save;
+  save.binary = !out.ascii;
+  save.double_precision = out.double_values;
+  save_mesh(output, r.mesh, save);
+  if (out.json) {
+    std::string phases = "[";
+    for (const OutOfCorePhase& p : report.phases)
+      phases += std::string(phases.size() > 1 ? "," : "") + "{\"name\":" + json_string(p.name) +
+                ",\"seconds\":" + json_number(p.seconds) + "}";
+    phases += "]";
+    std::printf(
+        "{\"tool\":\"qem\",\"out_of_core\":true,\"in_faces\":%llu,\"target_faces\":%zu,\"out_faces\":%zu,"
+        "\"out_vertices\":%zu,\"clustered_faces\":%llu,\"grid_resolution\":%llu,\"memory_limit_bytes\":%llu,"
+        "\"peak_memory_bytes\":%llu,\"temp_bytes_written\":%llu,\"total_s\":%s,\"peak_rss_mb\":%s,"
+        "\"max_error\":%s,\"max_error_rel\":%s,\"stop\":\"%s\",\"phases\":%s}\n",
+        static_cast<unsigned long long>(report.input_faces), out.target_faces, r.mesh.face_count(),
+        r.mesh.vertex_count(), static_cast<unsigned long long>(report.clustered_faces),
+        static_cast<unsigned long long>(report.grid_resolution),
+        static_cast<unsigned long long>(report.memory_limit),
+        static_cast<unsigned long long>(report.peak_memory_bytes),
+        static_cast<unsigned long long>(report.temp_bytes_written), json_number(total.seconds()).c_str(),
+        json_number(peak_rss_mb()).c_str(), json_number(r.max_error).c_str(),
+        json_number(r.max_error_relative).c_str(), to_string(r.stop_reason), phases.c_str());
+  }
+  if (!out.quiet)
+    std::fprintf(stderr,
+                 "qem: %llu -> %zu faces out of core (clustered to %llu faces on a grid of %llu), %.3f s, "
+                 "peak memory %.0f MB, %.0f MB of temporary files\n",
+                 static_cast<unsigned long long>(report.input_faces), r.mesh.face_count(),
+                 static_cast<unsigned long long>(report.clustered_faces),
+                 static_cast<unsigned long long>(report.grid_resolution), total.seconds(),
+                 double(report.peak_memory_bytes) / 1e6, double(report.temp_bytes_written) / 1e6);
+  return 0;
+}
+
+}  // namespace qem::cli

@@ -1,0 +1,79 @@
+// Simplifying a mesh file larger than memory: Garland & Shaffer 2002's two phases. Phase 1 is
+// Lindstrom 2000's out-of-core vertex clustering: the input is read as a stream (binary PLY or
+// binary STL, in chunks), every triangle's plane quadric is added to the grid cells of its corners
+// (memory proportional to the occupied cells, not to the input), and the triangles that span three
+// cells are written to a temporary file as cell triples. Phase 2 is the in-core simplification
+// (qem::simplify) of that clustered mesh down to the target. The grid is chosen as fine as the
+// memory budget allows, so that phase 2, which decides quality, starts from as many faces as fit.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "qem/simplify.h"
+
+namespace qem {
+
+/// What a long out-of-core run is doing, for a progress display.
+struct OutOfCoreProgress {
+  const char* phase = "";  ///< "bounds", "grid", "clustering", "reading clusters", "simplifying"
+  int phase_index = 0;     ///< 1-based, of phase_count
+  int phase_count = 0;
+  std::uint64_t bytes_read = 0;   ///< of the input, all passes so far
+  std::uint64_t bytes_total = 0;  ///< input bytes all passes will read
+  double seconds = 0;             ///< since the run started
+  double seconds_left = -1;       ///< estimated from the read rate; -1 when unknown
+};
+
+struct OutOfCoreOptions {
+  /// Bytes the run may use; 0 = default_memory_limit().
+  std::uint64_t memory_limit = 0;
+  /// Folder of the temporary files; empty = $TMPDIR, else /tmp.
+  std::string temp_dir;
+  /// Called about once a second (and at each phase change); returning false cancels the run
+  /// (qem::Error "cancelled"), after which no temporary file is left.
+  std::function<bool(const OutOfCoreProgress&)> progress;
+};
+
+/// One phase of a run and how long it took.
+struct OutOfCorePhase {
+  std::string name;
+  double seconds = 0;
+};
+
+struct OutOfCoreReport {
+  std::uint64_t input_faces = 0, input_vertices = 0;
+  std::uint64_t memory_limit = 0;        ///< the budget used (after the default)
+  std::uint64_t grid_resolution = 0;     ///< cells along the bounding box's longest side
+  std::uint64_t clustered_vertices = 0;  ///< occupied cells
+  std::uint64_t clustered_faces = 0;     ///< faces handed to phase 2 (after dropping duplicates)
+  std::uint64_t temp_bytes_written = 0;
+  std::uint64_t peak_memory_bytes = 0;  ///< peak resident set of the process (VmHWM)
+  std::vector<OutOfCorePhase> phases;
+};
+
+/// Half of the memory the kernel reports available (MemAvailable in /proc/meminfo), at least
+/// 256 MB; 4 GB when it cannot be read.
+std::uint64_t default_memory_limit();
+
+/// Parses a size such as "2G", "512M", "1.5GB", "800000000" (bytes; K, M, G, T are powers of
+/// 1024). Throws qem::Error on anything else.
+std::uint64_t parse_memory_size(const std::string& text);
+
+/// True when simplifying `path` in memory (load_mesh + simplify) is expected to stay within
+/// `memory_limit` bytes (0 = default): about 180 bytes a face at peak, plus the file itself.
+/// False also needs MeshStream to read the file (binary PLY or STL); other formats always say true.
+bool fits_in_memory(const std::string& path, std::uint64_t memory_limit);
+
+/// Simplifies the mesh file `path` in the two phases, whatever its size, under the options'
+/// budget. `options` are those of qem::simplify and apply to phase 2 (its quadrics are recomputed
+/// from the clustered faces); target_ratio counts the input's faces; vertex_lock is refused. Throws
+/// qem::Error on a malformed input, an unwritable or full temporary folder, or a cancel; temporary files are
+/// removed in every case (and on SIGINT/SIGTERM).
+SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptions& options,
+                                    const OutOfCoreOptions& ooc = {}, OutOfCoreReport* report = nullptr);
+
+}  // namespace qem

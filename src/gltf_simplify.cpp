@@ -1,0 +1,286 @@
+// simplify_document (qem/gltf_simplify.h): the primitives of a glTF document simplified under one
+// shared error budget in world units, or each on its own.
+#include "qem/gltf_simplify.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <exception>
+#include <functional>
+#include <limits>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+#include "qem/error.h"
+
+namespace qem {
+namespace {
+
+/// Runs job(0) ... job(n-1) on up to `threads` threads and rethrows the exception of the lowest
+/// failed job, so that which error is reported does not depend on the scheduling.
+void for_each_job(std::size_t n, unsigned threads, const std::function<void(std::size_t)>& job) {
+  std::vector<std::exception_ptr> failed(n);
+  std::atomic<std::size_t> next{0};
+  auto worker = [&] {
+    for (std::size_t i = next++; i < n; i = next++) {
+      try {
+        job(i);
+      } catch (...) {
+        failed[i] = std::current_exception();
+      }
+    }
+  };
+  const std::size_t count = std::min<std::size_t>(threads, n);
+  std::vector<std::thread> pool;
+  for (std::size_t t = 1; t < count; ++t) pool.emplace_back(worker);
+  worker();
+  for (std::thread& t : pool) t.join();
+  for (const std::exception_ptr& e : failed)
+    if (e) std::rethrow_exception(e);
+}
+
+/// One primitive's error curve from a watched run: after each contraction, the largest error so
+/// far (world units; contraction errors are not monotone, the running maximum is) and the faces
+/// left. A threshold T then stands for the longest prefix of contractions that all stay within T.
+class ErrorCurve : public SimplifyObserver {
+ public:
+  explicit ErrorCurve(double world_scale) : scale_(world_scale) {}
+  bool wants_contractions() const override { return true; }
+  void on_start(std::span<const std::uint32_t> input_faces) override { initial = input_faces.size(); }
+  void on_contraction(const Contraction& c) override {
+    const double e = c.error * scale_;
+    errors.push_back(e);
+    running_max.push_back(running_max.empty() ? e : std::max(running_max.back(), e));
+    const std::size_t before = faces.empty() ? initial : faces.back();
+    faces.push_back(before - std::min(before, c.dead_faces.size()));
+  }
+  /// Contractions within `threshold`.
+  std::size_t contractions_within(double threshold) const {
+    return static_cast<std::size_t>(std::upper_bound(running_max.begin(), running_max.end(), threshold) -
+                                    running_max.begin());
+  }
+  std::size_t faces_within(double threshold) const {
+    const std::size_t k = contractions_within(threshold);
+    return k == 0 ? initial : faces[k - 1];
+  }
+
+  std::size_t initial = 0;
+  std::vector<double> errors, running_max;
+  StopReason stop_reason = StopReason::TargetReached;  // of the watched run
+  std::vector<std::size_t> faces;
+
+ private:
+  double scale_;
+};
+
+/// A stop criterion in world units turned into the primitive's own units.
+double local_error(double world_error, double world_scale) {
+  return std::isfinite(world_error) && world_scale > 0 ? world_error / world_scale : world_error;
+}
+
+}  // namespace
+
+GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& options,
+                                     const GltfSimplifyOptions& gltf_options) {
+  check_options(options);
+  const std::vector<GltfPrimitiveInfo>& info = doc.primitives();
+  GltfSimplifyReport report;
+  std::vector<std::size_t> jobs;  // the primitives that can be simplified
+  for (std::size_t i = 0; i < info.size(); ++i) {
+    GltfPrimitiveOutcome o;
+    o.primitive = i;
+    o.faces_in = o.faces_out = info[i].face_count;
+    o.world_scale = info[i].world_scale;
+    if (!info[i].simplifiable)
+      o.note = info[i].why_not;
+    else if (info[i].face_count == 0)
+      o.note = "no triangles (passed through untouched)";
+    else
+      o.status = GltfPrimitiveOutcome::Status::Unchanged, jobs.push_back(i);
+    report.faces_in += o.faces_in;
+    report.primitives.push_back(std::move(o));
+  }
+  const unsigned hardware = std::max(1u, std::thread::hardware_concurrency());
+  const unsigned threads = gltf_options.threads == 0 ? hardware : gltf_options.threads;
+  // Several primitives at once, each on one thread; one at a time, each with the caller's threads.
+  const unsigned inner_threads = threads > 1 && jobs.size() > 1 ? 1 : options.threads;
+
+  std::vector<Mesh> meshes(jobs.size());
+  for (std::size_t j = 0; j < jobs.size(); ++j) meshes[j] = doc.mesh(jobs[j]);
+
+  // The error limit in world units (relative: of the scene's diagonal, in shared mode).
+  double world_max_error = options.max_error;
+  if (options.max_error_is_relative && std::isfinite(world_max_error) && !gltf_options.per_primitive)
+    world_max_error *= bounding_box(doc.scene_mesh()).diagonal();
+
+  // Per primitive: the options of its final run, and (shared budget) its watched run's curve.
+  std::vector<std::optional<SimplifyOptions>> final_options(jobs.size());
+  std::vector<ErrorCurve> curves;
+  if (gltf_options.per_primitive) {
+    for (std::size_t j = 0; j < jobs.size(); ++j) {
+      SimplifyOptions o = options;
+      o.threads = inner_threads;
+      if (!o.max_error_is_relative) o.max_error = local_error(o.max_error, info[jobs[j]].world_scale);
+      final_options[j] = o;
+    }
+  } else {
+    // The scene's face target: the smallest that the criteria give.
+    std::size_t total_faces = 0, total_vertices = 0;
+    for (std::size_t j = 0; j < jobs.size(); ++j)
+      total_faces += info[jobs[j]].face_count, total_vertices += info[jobs[j]].vertex_count;
+    std::size_t target = std::numeric_limits<std::size_t>::max();
+    if (options.target_faces > 0) target = std::min(target, options.target_faces);
+    if (options.target_ratio > 0)
+      target =
+          std::min(target, static_cast<std::size_t>(std::floor(options.target_ratio * double(total_faces))));
+    if (options.target_vertices > 0 && total_vertices > 0)
+      target = std::min(
+          target, static_cast<std::size_t>(std::floor(double(total_faces) * double(options.target_vertices) /
+                                                      double(total_vertices))));
+    const bool face_target = target != std::numeric_limits<std::size_t>::max();
+    report.target_faces = face_target ? target : total_faces;
+
+    if (jobs.size() == 1) {
+      // One primitive: the scene's target is its own, and there is nothing to share.
+      SimplifyOptions o = options;
+      o.target_ratio = 0, o.target_vertices = 0;
+      o.target_faces = face_target ? std::max<std::size_t>(1, target) : 0;
+      o.max_error = local_error(world_max_error, info[jobs[0]].world_scale);
+      o.max_error_is_relative = false;
+      o.threads = inner_threads;
+      final_options[0] = o;
+    } else {
+      // 1. Watched runs down to a floor: a quarter of the scene's ratio on every primitive, so that
+      // any threshold the target needs lies on every curve unless a primitive cannot go further.
+      const double floor_ratio =
+          face_target && total_faces > 0 ? 0.25 * double(target) / double(total_faces) : 0;
+      auto watch = [&](std::size_t j, std::size_t floor_faces) {
+        curves[j] = ErrorCurve(info[jobs[j]].world_scale);
+        SimplifyOptions o = options;
+        o.target_ratio = 0, o.target_vertices = 0;
+        o.target_faces = std::max<std::size_t>(1, floor_faces);
+        o.max_error = local_error(world_max_error, info[jobs[j]].world_scale);
+        o.max_error_is_relative = false;
+        o.refit_rounds = 0;  // the curve is the contractions'; the final run refits
+        o.threads = inner_threads;
+        curves[j].stop_reason = simplify(meshes[j], o, &curves[j]).stop_reason;
+      };
+      for (std::size_t j = 0; j < jobs.size(); ++j) curves.emplace_back(info[jobs[j]].world_scale);
+      for_each_job(jobs.size(), threads, [&](std::size_t j) {
+        watch(j, static_cast<std::size_t>(floor_ratio * double(info[jobs[j]].face_count)));
+      });
+      // When primitives that can go no further keep the scene above its target, those that stopped at
+      // the floor are watched again to the end, so that they take the rest of the reduction.
+      std::size_t at_floor = 0;
+      for (const ErrorCurve& c : curves) at_floor += c.faces.empty() ? c.initial : c.faces.back();
+      if (face_target && at_floor > target) {
+        std::vector<std::size_t> again;
+        for (std::size_t j = 0; j < jobs.size(); ++j)
+          if (curves[j].stop_reason == StopReason::TargetReached) again.push_back(j);
+        for_each_job(again.size(), threads, [&](std::size_t k) { watch(again[k], 1); });
+      }
+
+      // 2. The smallest world threshold at which the primitives together meet the face target
+      // (their faces only fall as it grows); without a face target, the error limit itself.
+      std::vector<double> candidates{0.0};
+      for (const ErrorCurve& c : curves)
+        for (double e : c.running_max)
+          if (e <= world_max_error) candidates.push_back(e);
+      std::sort(candidates.begin(), candidates.end());
+      candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+      auto faces_at = [&](double t) {
+        std::size_t sum = 0;
+        for (const ErrorCurve& c : curves) sum += c.faces_within(t);
+        return sum;
+      };
+      std::size_t at = candidates.size() - 1;
+      if (face_target) {
+        auto it = std::partition_point(candidates.begin(), candidates.end(),
+                                       [&](double t) { return faces_at(t) > target; });
+        if (it != candidates.end()) at = static_cast<std::size_t>(it - candidates.begin());
+      }
+      const double threshold = candidates[at];
+      report.world_threshold = threshold;
+      std::vector<std::size_t> faces(jobs.size());
+      for (std::size_t j = 0; j < jobs.size(); ++j) faces[j] = curves[j].faces_within(threshold);
+      // The running maximum has plateaus: the contraction that reaches the threshold is followed by
+      // cheaper ones, all within it. The primitives that step at the threshold may stop anywhere on
+      // that step at the same error, so the faces the whole step would remove beyond the target are
+      // given back to them (in proportion, in document order): the total meets the target closely.
+      if (face_target && at > 0 && faces_at(threshold) < target) {
+        std::vector<std::size_t> step(jobs.size());
+        std::size_t steps = 0;
+        for (std::size_t j = 0; j < jobs.size(); ++j) {
+          const std::size_t before = curves[j].faces_within(candidates[at - 1]);
+          // Up to the faces just before the threshold's contraction, less one so that it is made.
+          step[j] = before > faces[j] ? before - faces[j] - 1 : 0;
+          steps += step[j];
+        }
+        const std::size_t slack = target - faces_at(threshold);
+        std::size_t given = 0;
+        for (std::size_t j = 0; j < jobs.size() && steps > 0; ++j) {
+          const std::size_t share =
+              std::min(step[j], static_cast<std::size_t>(double(slack) * double(step[j]) / double(steps)));
+          faces[j] += share, given += share;
+        }
+        for (std::size_t j = 0; j < jobs.size() && given < slack; ++j) {  // what rounding left over
+          const std::size_t more = std::min(
+              slack - given, step[j] - std::min(step[j], faces[j] - curves[j].faces_within(threshold)));
+          faces[j] += more, given += more;
+        }
+      }
+
+      // 3. Each primitive's final run stops at the faces found for it. It makes the same contractions
+      // as its watched run (the order depends on neither the face target nor the observer), with the
+      // same error limit, which blocks the same pairs.
+      for (std::size_t j = 0; j < jobs.size(); ++j) {
+        if (faces[j] >= curves[j].initial) continue;  // nothing to do: left as it is
+        SimplifyOptions o = options;
+        o.target_ratio = 0, o.target_vertices = 0;
+        o.target_faces = std::max<std::size_t>(1, faces[j]);
+        o.max_error = local_error(world_max_error, info[jobs[j]].world_scale);
+        o.max_error_is_relative = false;
+        o.threads = inner_threads;
+        final_options[j] = o;
+      }
+    }
+  }
+
+  // The final runs, then the replacements in document order (none is made if a run fails).
+  std::vector<std::optional<SimplifyResult>> results(jobs.size());
+  for_each_job(jobs.size(), threads, [&](std::size_t j) {
+    if (final_options[j]) results[j] = simplify(meshes[j], *final_options[j]);
+  });
+  for (std::size_t j = 0; j < jobs.size(); ++j) {
+    GltfPrimitiveOutcome& o = report.primitives[jobs[j]];
+    if (!results[j] || results[j]->contractions == 0) continue;
+    SimplifyResult& r = *results[j];
+    o.status = GltfPrimitiveOutcome::Status::Simplified;
+    o.faces_out = r.mesh.face_count();
+    o.max_error = r.max_error;
+    o.world_error = r.max_error * o.world_scale;
+    o.stop_reason = r.stop_reason;
+    if (!curves.empty() && r.contractions < curves[j].errors.size())
+      o.next_world_error = curves[j].errors[r.contractions];
+    // A final run that made every contraction of its watched run met its face target there, but
+    // it stopped because no contraction was left when the watched run did.
+    if (!curves.empty() && r.contractions >= curves[j].errors.size() &&
+        curves[j].stop_reason == StopReason::NoValidPair)
+      o.stop_reason = StopReason::NoValidPair;
+    doc.replace(jobs[j], std::move(r.mesh));
+  }
+  if (!gltf_options.per_primitive && jobs.size() == 1)
+    report.world_threshold = report.primitives[jobs[0]].world_error;
+  report.faces_out = 0;
+  for (const GltfPrimitiveOutcome& o : report.primitives) {
+    report.faces_out += o.faces_out;
+    report.max_world_error = std::max(report.max_world_error, o.world_error);
+    if (o.status == GltfPrimitiveOutcome::Status::Simplified) ++report.simplified;
+    if (o.status == GltfPrimitiveOutcome::Status::Unchanged) ++report.unchanged;
+    if (o.status == GltfPrimitiveOutcome::Status::Kept) ++report.kept;
+  }
+  return report;
+}
+
+}  // namespace qem

@@ -1,0 +1,379 @@
+// simplify_document (qem/gltf_simplify.h) and `qem simplify` / `qem lod` on glTF documents built in
+// code: the shared error budget in world units, the per-mesh mode, primitives that must be kept,
+// and inputs that must be refused with no output written.
+#include "qem/gltf_simplify.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "qem/error.h"
+#include "qem/gltf.h"
+#include "test_meshes.h"
+
+namespace {
+
+using json = nlohmann::json;
+
+std::string base64(const std::string& in) {
+  static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  std::size_t i = 0;
+  for (; i + 2 < in.size(); i += 3) {
+    unsigned v = (unsigned char)in[i] << 16 | (unsigned char)in[i + 1] << 8 | (unsigned char)in[i + 2];
+    for (int s = 18; s >= 0; s -= 6) out += k[(v >> s) & 63];
+  }
+  if (i + 1 == in.size()) {
+    unsigned v = (unsigned char)in[i] << 16;
+    out += {k[(v >> 18) & 63], k[(v >> 12) & 63], '=', '='};
+  } else if (i + 2 == in.size()) {
+    unsigned v = (unsigned char)in[i] << 16 | (unsigned char)in[i + 1] << 8;
+    out += {k[(v >> 18) & 63], k[(v >> 12) & 63], k[(v >> 6) & 63], '='};
+  }
+  return out;
+}
+
+/// A glTF document assembled in code: meshes of float POSITION (+ NORMAL) and uint32 indices,
+/// each placed by a node with a uniform scale, one embedded buffer.
+struct Scene {
+  json doc = json::parse(R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": []}],
+                             "nodes": [], "meshes": [], "accessors": [], "bufferViews": [],
+                             "buffers": [{"byteLength": 0}]})");
+  std::string bin;
+
+  int accessor(const std::vector<float>& values, const char* type, std::size_t count, bool bounds) {
+    const std::size_t offset = bin.size();
+    bin.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(float));
+    doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", values.size() * 4}});
+    json a = {{"bufferView", doc["bufferViews"].size() - 1},
+              {"componentType", 5126},
+              {"count", count},
+              {"type", type}};
+    if (bounds) {
+      std::vector<float> lo(3, 1e30f), hi(3, -1e30f);
+      for (std::size_t i = 0; i < values.size(); ++i)
+        lo[i % 3] = std::min(lo[i % 3], values[i]), hi[i % 3] = std::max(hi[i % 3], values[i]);
+      a["min"] = lo, a["max"] = hi;
+    }
+    doc["accessors"].push_back(a);
+    return int(doc["accessors"].size() - 1);
+  }
+  int indices(const std::vector<std::uint32_t>& idx) {
+    const std::size_t offset = bin.size();
+    bin.append(reinterpret_cast<const char*>(idx.data()), idx.size() * 4);
+    doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", idx.size() * 4}});
+    doc["accessors"].push_back({{"bufferView", doc["bufferViews"].size() - 1},
+                                {"componentType", 5125},
+                                {"count", idx.size()},
+                                {"type", "SCALAR"}});
+    return int(doc["accessors"].size() - 1);
+  }
+  /// A mesh of one primitive; normals from the positions' direction (a sphere's).
+  int mesh(const qem::Mesh& m, bool normals = true) {
+    std::vector<float> p(m.positions.begin(), m.positions.end()), n;
+    for (std::size_t v = 0; v < m.vertex_count(); ++v) {
+      const double* q = &m.positions[3 * v];
+      const double len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+      for (int c = 0; c < 3; ++c) n.push_back(float(q[c] / len));
+    }
+    json prim = {{"attributes", {{"POSITION", accessor(p, "VEC3", m.vertex_count(), true)}}}};
+    if (normals) prim["attributes"]["NORMAL"] = accessor(n, "VEC3", m.vertex_count(), false);
+    prim["indices"] = indices(m.indices);
+    doc["meshes"].push_back({{"primitives", json::array({prim})}});
+    return int(doc["meshes"].size() - 1);
+  }
+  void node(int mesh, double scale) {
+    doc["nodes"].push_back({{"mesh", mesh}, {"scale", {scale, scale, scale}}});
+    doc["scenes"][0]["nodes"].push_back(doc["nodes"].size() - 1);
+  }
+  std::string text() const {
+    json d = doc;
+    d["buffers"][0]["byteLength"] = bin.size();
+    d["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64(bin);
+    return d.dump();
+  }
+};
+
+/// Two spheres of 5120 faces: a unit one at scale 1 and one of local radius 0.1 drawn at scale 100
+/// (world radius 10). In its own units the second is tiny; in the world it is the big one.
+Scene two_spheres() {
+  Scene s;
+  s.node(s.mesh(qem::test::icosphere(4)), 1);
+  s.node(s.mesh(qem::test::transformed(qem::test::icosphere(4), 0.1, 0, 0, 0)), 100);
+  return s;
+}
+
+TEST(GltfSimplify, WorldScaleFollowsTheNodes) {
+  Scene s = two_spheres();
+  s.node(1, 30);  // the second mesh instanced again, smaller: its largest scale counts
+  qem::GltfDocument doc = qem::GltfDocument::parse(s.text(), "two.gltf");
+  EXPECT_DOUBLE_EQ(doc.primitives()[0].world_scale, 1);
+  EXPECT_NEAR(doc.primitives()[1].world_scale, 100, 1e-9);
+}
+
+TEST(GltfSimplify, SharedBudgetStopsEveryPrimitiveAtTheSameWorldError) {
+  qem::GltfDocument doc = qem::GltfDocument::parse(two_spheres().text(), "two.gltf");
+  qem::SimplifyOptions opt;
+  opt.target_ratio = 0.1;
+  const qem::GltfSimplifyReport r = qem::simplify_document(doc, opt);
+  ASSERT_EQ(r.primitives.size(), 2u);
+  EXPECT_EQ(r.simplified, 2u);
+  EXPECT_EQ(r.faces_in, 2 * 5120u);
+  EXPECT_EQ(r.target_faces, 1024u);
+  EXPECT_LE(r.faces_out, 1024u);
+  EXPECT_GT(r.faces_out, 900u);  // the threshold is the smallest that meets the target
+  const qem::GltfPrimitiveOutcome &small = r.primitives[0], &big = r.primitives[1];
+  // The big sphere (in the world) keeps more of its faces than the small one.
+  EXPECT_GT(big.faces_out, 2 * small.faces_out);
+  // Both stop at the threshold: every contraction made is within it, and the next one is beyond
+  // it, or the primitive stopped on the step that reaches it. The primitive whose contraction set
+  // the threshold stops there exactly.
+  bool at_threshold = false;
+  for (const auto* o : {&small, &big}) {
+    EXPECT_LE(o->world_error, r.world_threshold * (1 + 1e-12));
+    const bool on_step = std::fabs(o->world_error - r.world_threshold) <= 1e-12 * r.world_threshold;
+    at_threshold = at_threshold || on_step;
+    if (!on_step) {
+      EXPECT_GT(o->next_world_error, r.world_threshold);
+    }
+    EXPECT_NEAR(o->world_error, o->max_error * o->world_scale, 1e-12 * o->world_error);
+  }
+  EXPECT_TRUE(at_threshold);
+  EXPECT_EQ(doc.primitives()[0].face_count, small.faces_out);
+  EXPECT_EQ(doc.primitives()[1].face_count, big.faces_out);
+  // Normals came through the simplification with the positions, of unit length.
+  const qem::Mesh m = doc.mesh(1);
+  ASSERT_EQ(m.attributes.size(), 1u);
+  for (std::size_t v = 0; v < m.vertex_count(); ++v) {
+    const double* n = &m.attributes[0].values[3 * v];
+    EXPECT_NEAR(n[0] * n[0] + n[1] * n[1] + n[2] * n[2], 1, 1e-6);
+  }
+}
+
+TEST(GltfSimplify, PerMeshModeAppliesTheRatioToEachPrimitive) {
+  qem::GltfDocument doc = qem::GltfDocument::parse(two_spheres().text(), "two.gltf");
+  qem::SimplifyOptions opt;
+  opt.target_ratio = 0.1;
+  qem::GltfSimplifyOptions per;
+  per.per_primitive = true;
+  const qem::GltfSimplifyReport r = qem::simplify_document(doc, opt, per);
+  for (const qem::GltfPrimitiveOutcome& o : r.primitives) {
+    EXPECT_EQ(o.status, qem::GltfPrimitiveOutcome::Status::Simplified);
+    EXPECT_LE(o.faces_out, 512u);
+    EXPECT_GT(o.faces_out, 480u);
+  }
+  // The same shape at ten times the world size: ten times the world error.
+  EXPECT_NEAR(r.primitives[1].world_error / r.primitives[0].world_error, 10, 0.5);
+}
+
+TEST(GltfSimplify, OutputDoesNotDependOnThreads) {
+  std::string bytes[2];
+  for (unsigned threads : {1u, 2u}) {
+    qem::GltfDocument doc = qem::GltfDocument::parse(two_spheres().text(), "two.gltf");
+    qem::SimplifyOptions opt;
+    opt.target_ratio = 0.2;
+    qem::GltfSimplifyOptions g;
+    g.threads = threads;
+    qem::simplify_document(doc, opt, g);
+    bytes[threads - 1] = doc.serialize(true);
+  }
+  EXPECT_EQ(bytes[0], bytes[1]);
+}
+
+TEST(GltfSimplify, WorldErrorLimitIsSharedToo) {
+  qem::GltfDocument doc = qem::GltfDocument::parse(two_spheres().text(), "two.gltf");
+  qem::SimplifyOptions opt;
+  opt.max_error = 0.01;  // world units
+  const qem::GltfSimplifyReport r = qem::simplify_document(doc, opt);
+  EXPECT_EQ(r.simplified, 2u);
+  for (const qem::GltfPrimitiveOutcome& o : r.primitives) {
+    EXPECT_LE(o.world_error, 0.01);
+    EXPECT_GT(o.world_error, 0.005);
+  }
+}
+
+TEST(GltfSimplify, VertexTargetIsTheSameFractionOfTheFaces) {
+  qem::GltfDocument doc = qem::GltfDocument::parse(two_spheres().text(), "two.gltf");
+  const std::size_t vertices = doc.primitives()[0].vertex_count + doc.primitives()[1].vertex_count;
+  qem::SimplifyOptions opt;
+  opt.target_vertices = vertices / 5;
+  const qem::GltfSimplifyReport r = qem::simplify_document(doc, opt);
+  EXPECT_EQ(r.target_faces, std::size_t(10240.0 * double(vertices / 5) / double(vertices)));
+  EXPECT_LE(r.faces_out, r.target_faces);
+  EXPECT_GT(r.faces_out, r.target_faces * 9 / 10);
+}
+
+TEST(GltfSimplify, PrimitivesAtADeadEndLeaveTheReductionToTheOthers) {
+  // 200 separate tetrahedra: no contraction keeps their topology, so their 800 faces stay; the
+  // sphere must then go below the watched run's floor (a quarter of the scene's ratio) to come
+  // as close to the target as it can.
+  Scene s;
+  qem::Mesh tetras;
+  for (int k = 0; k < 200; ++k)
+    tetras = qem::test::concatenated(
+        tetras, qem::test::transformed(qem::test::tetrahedron(), 0.05, k % 20, k / 20.0, 0));
+  s.node(s.mesh(tetras, false), 1);
+  s.node(s.mesh(qem::test::icosphere(4)), 1);
+  qem::GltfDocument doc = qem::GltfDocument::parse(s.text(), "dead_end.gltf");
+  qem::SimplifyOptions opt;
+  opt.target_ratio = 0.1;  // 592 of 5920 faces
+  const qem::GltfSimplifyReport r = qem::simplify_document(doc, opt);
+  EXPECT_EQ(r.primitives[0].faces_out, 800u);
+  EXPECT_LT(r.primitives[1].faces_out, 128u);  // 0.25 x 0.1 x 5120, the first floor
+  EXPECT_EQ(r.primitives[1].stop_reason, qem::StopReason::NoValidPair);
+}
+
+TEST(GltfSimplify, MorphTargetPrimitiveIsKeptUnchanged) {
+  Scene s = two_spheres();
+  // Mesh 0 gets a morph target (its normals' accessor serves as the offsets).
+  s.doc["meshes"][0]["primitives"][0]["targets"] = json::array({{{"POSITION", 1}}});
+  qem::GltfDocument doc = qem::GltfDocument::parse(s.text(), "morph.gltf");
+  const std::string before = doc.serialize(false);
+  qem::SimplifyOptions opt;
+  opt.target_ratio = 0.2;
+  const qem::GltfSimplifyReport r = qem::simplify_document(doc, opt);
+  EXPECT_EQ(r.kept, 1u);
+  EXPECT_EQ(r.simplified, 1u);
+  EXPECT_EQ(r.primitives[0].status, qem::GltfPrimitiveOutcome::Status::Kept);
+  EXPECT_NE(r.primitives[0].note.find("morph"), std::string::npos);
+  EXPECT_EQ(r.primitives[0].faces_out, 5120u);
+  EXPECT_LE(r.primitives[1].faces_out, 1024u);  // the target counts the simplifiable faces only
+  json a = json::parse(before), b = json::parse(doc.serialize(false));
+  EXPECT_EQ(a["meshes"][0], b["meshes"][0]);
+  for (int k : {0, 1, 2}) EXPECT_EQ(a["accessors"][k], b["accessors"][k]) << k;
+  bool noted = false;
+  for (const std::string& n : doc.notes()) noted = noted || n.find("morph") != std::string::npos;
+  EXPECT_TRUE(noted);
+}
+
+// --- through the command line -------------------------------------------------------------------
+
+std::string write(const std::string& path, const std::string& bytes) {
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  std::fwrite(bytes.data(), 1, bytes.size(), f);
+  std::fclose(f);
+  return path;
+}
+
+/// Runs `qem ARGS`, stderr to a file; gives the exit status and the stderr text.
+int run_qem(const std::string& args, std::string* err) {
+  const std::string log = qem::test::temp_dir() + "/stderr.txt";
+  const int status =
+      std::system((std::string(QEM_CLI_PATH) + " " + args + " > /dev/null 2> '" + log + "'").c_str());
+  *err = qem::test::slurp(log);
+  return status;
+}
+
+TEST(GltfSimplifyCli, KeepsTheDocumentAndNotesKeptPrimitives) {
+  Scene s = two_spheres();
+  s.doc["meshes"][0]["primitives"][0]["targets"] = json::array({{{"POSITION", 1}}});
+  s.doc["nodes"][0]["extras"] = {{"tag", "kept"}};
+  const std::string dir = qem::test::temp_dir();
+  const std::string in = write(dir + "/morph.gltf", s.text()), out = dir + "/out.glb";
+  std::string err;
+  ASSERT_EQ(run_qem("simplify '" + in + "' '" + out + "' --ratio 0.2", &err), 0) << err;
+  EXPECT_NE(err.find("morph targets"), std::string::npos) << err;
+  EXPECT_NE(err.find("1 simplified"), std::string::npos) << err;
+  qem::GltfDocument doc = qem::GltfDocument::load(out);
+  EXPECT_EQ(doc.primitives()[0].face_count, 5120u);
+  EXPECT_LE(doc.primitives()[1].face_count, 1024u);
+  EXPECT_FALSE(doc.primitives()[0].simplifiable);
+  // --json: the counts, and each primitive.
+  const std::string out_json = dir + "/out.json";
+  ASSERT_EQ(std::system((std::string(QEM_CLI_PATH) + " simplify '" + in + "' '" + out +
+                         "' --ratio 0.2 --json -q > '" + out_json + "' 2> /dev/null")
+                            .c_str()),
+            0);
+  const json report = json::parse(qem::test::slurp(out_json));
+  EXPECT_EQ(report["format"], "gltf");
+  EXPECT_EQ(report["simplified"], 1);
+  EXPECT_EQ(report["kept"], 1);
+  EXPECT_EQ(report["in_faces"], 10240);
+  EXPECT_EQ(report["out_faces"].get<std::size_t>(), 5120 + doc.primitives()[1].face_count);
+  ASSERT_EQ(report["each"].size(), 2u);
+  EXPECT_EQ(report["each"][0]["status"], "kept");
+  EXPECT_EQ(report["each"][1]["status"], "simplified");
+  EXPECT_EQ(report["each"][1]["out_faces"].get<std::size_t>(), doc.primitives()[1].face_count);
+  EXPECT_NEAR(report["each"][1]["world_scale"].get<double>(), 100, 1e-9);
+  // --per-mesh on a non-glTF output is refused.
+  EXPECT_NE(run_qem("simplify '" + in + "' '" + dir + "/x.ply' --ratio 0.5 --per-mesh", &err), 0);
+  EXPECT_NE(err.find("--per-mesh"), std::string::npos) << err;
+}
+
+TEST(GltfSimplifyCli, CompressedGeometryIsRefusedWithNoOutput) {
+  Scene s = two_spheres();
+  s.doc["extensionsUsed"] = {"KHR_draco_mesh_compression"};
+  s.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"};
+  s.doc["meshes"][0]["primitives"][0]["extensions"]["KHR_draco_mesh_compression"] = {
+      {"bufferView", 0}, {"attributes", {{"POSITION", 0}}}};
+  const std::string dir = qem::test::temp_dir();
+  const std::string in = write(dir + "/draco.gltf", s.text()), out = dir + "/draco_out.glb";
+  std::string err;
+  EXPECT_NE(run_qem("simplify '" + in + "' '" + out + "' --ratio 0.5", &err), 0);
+  EXPECT_NE(
+      err.find(
+          "draco.gltf: uses KHR_draco_mesh_compression (compressed geometry), which qem does not decode"),
+      std::string::npos)
+      << err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+TEST(GltfSimplifyCli, AccessorOutOfRangeIsAnErrorWithNoOutput) {
+  Scene s = two_spheres();
+  s.doc["accessors"][3]["count"] = 1000000;  // mesh 1's POSITION, far beyond its buffer view
+  const std::string dir = qem::test::temp_dir();
+  const std::string in = write(dir + "/bad.gltf", s.text()), out = dir + "/bad_out.glb";
+  std::string err;
+  EXPECT_NE(run_qem("simplify '" + in + "' '" + out + "' --ratio 0.5", &err), 0);
+  EXPECT_NE(err.find("bad.gltf: mesh 1, primitive 0 (POSITION), accessor 3"), std::string::npos) << err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  EXPECT_NE(run_qem("lod '" + in + "' '" + dir + "/lods' --ratios 0.5", &err), 0);
+  EXPECT_FALSE(std::filesystem::exists(dir + "/lods/bad_lod0.glb"));
+}
+
+TEST(GltfLodCli, OneWholeDocumentPerLevel) {
+  Scene s = two_spheres();
+  s.doc["nodes"][1]["name"] = "big";
+  const std::string dir = qem::test::temp_dir();
+  const std::string in = write(dir + "/two.gltf", s.text());
+  std::string err;
+  ASSERT_EQ(run_qem("lod '" + in + "' '" + dir + "/lods' --ratios 0.5,0.1", &err), 0) << err;
+  const json manifest = json::parse(qem::test::slurp(dir + "/lods/manifest.json"));
+  ASSERT_EQ(manifest["levels"].size(), 2u);
+  std::size_t previous = 10240;
+  for (std::size_t i = 0; i < 2; ++i) {
+    const std::string file = manifest["levels"][i]["path"];
+    EXPECT_EQ(file, "two_lod" + std::to_string(i) + ".glb");
+    qem::GltfDocument level = qem::GltfDocument::load(dir + "/lods/" + file);
+    ASSERT_EQ(level.primitives().size(), 2u);
+    const std::size_t faces = level.primitives()[0].face_count + level.primitives()[1].face_count;
+    EXPECT_EQ(faces, manifest["levels"][i]["faces"].get<std::size_t>());
+    EXPECT_LE(faces, i == 0 ? 5120u : 1024u);
+    EXPECT_LT(faces, previous);
+    previous = faces;
+    // The same as `qem simplify --faces <target>` writes.
+    const std::string single = dir + "/single" + std::to_string(i) + ".glb";
+    ASSERT_EQ(run_qem("simplify '" + in + "' '" + single + "' --faces " +
+                          std::to_string(manifest["levels"][i]["target_faces"].get<std::size_t>()),
+                      &err),
+              0)
+        << err;
+    EXPECT_EQ(qem::test::slurp(single), qem::test::slurp(dir + "/lods/" + file)) << i;
+  }
+  // --format gltf writes .gltf levels; a non-glTF input cannot give glTF levels.
+  ASSERT_EQ(run_qem("lod '" + in + "' '" + dir + "/text' --ratios 0.5 --format gltf", &err), 0) << err;
+  EXPECT_EQ(qem::GltfDocument::load(dir + "/text/two_lod0.gltf").primitives().size(), 2u);
+  const std::string ply = dir + "/sphere.ply";
+  ASSERT_EQ(run_qem("generate sphere '" + ply + "' --faces 1000", &err), 0) << err;
+  EXPECT_NE(run_qem("lod '" + ply + "' '" + dir + "/p' --ratios 0.5 --format glb", &err), 0);
+  EXPECT_NE(err.find("glTF levels are made from a glTF input"), std::string::npos) << err;
+}
+
+}  // namespace

@@ -1,0 +1,322 @@
+// The out-of-core path (qem/out_of_core.h, docs/out-of-core.md) forced with a tiny memory limit
+// on a generated mesh: face target met, no crack, E close to the in-core run's; and what a failed
+// run leaves behind (nothing). Also the streamed generator against the in-memory one.
+#include "qem/out_of_core.h"
+
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "mesh_checks.h"
+#include "outofcore/mesh_generator.h"
+#include "outofcore/temp_file.h"
+#include "qem/io.h"
+#include "qem/measure.h"
+#include "qem/simplify.h"
+#include "test_meshes.h"
+
+using namespace qem;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string slurp(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+/// A fresh, empty folder for one test's temporary files.
+std::string fresh_dir(const std::string& name) {
+  const std::string d = test::temp_dir() + "/ooc_" + name;
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+std::size_t entries(const std::string& dir) {
+  return std::size_t(std::distance(fs::directory_iterator(dir), fs::directory_iterator()));
+}
+
+/// The 327,680-face bumpy sphere (closed), streamed to disk once.
+const std::string& big_sphere() {
+  static const std::string path = [] {
+    const std::string p = test::temp_dir() + "/ooc_sphere_327k.ply";
+    outofcore::write_bumpy_sphere_ply(p, 300000);
+    return p;
+  }();
+  return path;
+}
+
+// 16 MB for a 327,680-face mesh (the in-core run needs about 60 MB): the grid keeps ~40k cells.
+constexpr std::uint64_t kTinyLimit = std::uint64_t(16) << 20;
+
+TEST(OutOfCore, StreamedGeneratorWritesTheInMemoryMesh) {
+  const std::string dir = fresh_dir("generate");
+  for (std::size_t faces : {20, 1000, 20480}) {
+    const std::string p = dir + "/sphere.ply";
+    outofcore::write_bumpy_sphere_ply(p, faces);
+    EXPECT_EQ(slurp(p), serialize_mesh(outofcore::bumpy_sphere(faces), FileFormat::Ply, true)) << faces;
+  }
+  for (std::size_t faces : {100, 5000}) {
+    const std::string p = dir + "/torus.ply";
+    outofcore::write_torus_ply(p, faces);
+    EXPECT_EQ(slurp(p), serialize_mesh(outofcore::torus(faces), FileFormat::Ply, true)) << faces;
+  }
+  EXPECT_EQ(entries(dir), 2u);  // the two outputs, no temporary left
+}
+
+TEST(OutOfCore, ForcedRunMeetsTargetWithoutCracksAndNearInCoreError) {
+  const std::string dir = fresh_dir("forced");
+  const Mesh input = load_mesh(big_sphere());
+  ASSERT_EQ(input.face_count(), 327680u);
+  ASSERT_EQ(test::boundary_edges(input), 0u);
+  SimplifyOptions opt;
+  opt.target_faces = 5000;
+  OutOfCoreOptions ooc;
+  ooc.memory_limit = kTinyLimit;
+  ooc.temp_dir = dir;
+  OutOfCoreReport report;
+  SimplifyResult r = simplify_out_of_core(big_sphere(), opt, ooc, &report);
+  EXPECT_EQ(entries(dir), 0u);
+  // It really clustered: phase 2 started from far fewer faces than the input.
+  EXPECT_LT(report.clustered_faces, input.face_count() / 2);
+  EXPECT_GT(report.clustered_faces, 4 * opt.target_faces);
+  EXPECT_GT(report.temp_bytes_written, 0u);
+  EXPECT_EQ(report.phases.size(), 4u);
+  EXPECT_LE(r.mesh.face_count(), opt.target_faces);
+  EXPECT_GE(r.mesh.face_count(), opt.target_faces - 2);
+  Mesh welded = r.mesh;
+  weld_exact(welded);
+  EXPECT_EQ(test::validity_problem(welded), "");
+  EXPECT_EQ(test::boundary_edges(welded), 0u);  // the input is closed: no crack
+
+  const SimplifyResult in_core = simplify(input, opt);
+  MeasureOptions mo;
+  mo.seed = 7;
+  const double e_ooc = measure(input, r.mesh, mo).E, e_in = measure(input, in_core.mesh, mo).E;
+  EXPECT_LE(e_ooc, 1.5 * e_in) << "out of core E " << e_ooc << " vs in core " << e_in;
+  std::printf("out of core: %llu clustered faces, E %.4g = %.3fx the in-core run's\n",
+              static_cast<unsigned long long>(report.clustered_faces), e_ooc, e_ooc / e_in);
+}
+
+TEST(OutOfCore, PositionsBeyondTheBudgetAreMappedFromATemporaryFile) {
+  const std::string dir = fresh_dir("mapped");
+  SimplifyOptions opt;
+  opt.target_faces = 3000;
+  OutOfCoreOptions ooc;
+  ooc.memory_limit = std::uint64_t(4) << 20;  // the 163,842 positions (1.9 MB) exceed a third of it
+  ooc.temp_dir = dir;
+  OutOfCoreReport report;
+  SimplifyResult r = simplify_out_of_core(big_sphere(), opt, ooc, &report);
+  EXPECT_GE(report.temp_bytes_written, 163842u * 12 + 12 * report.clustered_faces);
+  EXPECT_LE(r.mesh.face_count(), 3000u);
+  Mesh welded = r.mesh;
+  weld_exact(welded);
+  EXPECT_EQ(test::boundary_edges(welded), 0u);
+  EXPECT_EQ(entries(dir), 0u);
+}
+
+TEST(OutOfCore, FullDiskMidwayLeavesNoTemporaryFile) {
+  const std::string dir = fresh_dir("full_disk");
+  SimplifyOptions opt;
+  opt.target_faces = 5000;
+  OutOfCoreOptions ooc;
+  ooc.memory_limit = kTinyLimit;
+  ooc.temp_dir = dir;
+  // The clustered faces take ~1 MB: fail after the first 64 KB of them reach the disk.
+  outofcore::inject_write_failure_after(outofcore::temp_bytes_written() + 65536);
+  try {
+    simplify_out_of_core(big_sphere(), opt, ooc);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("No space left on device"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(dir), std::string::npos) << e.what();
+  }
+  outofcore::inject_write_failure_after(0);
+  EXPECT_EQ(entries(dir), 0u);
+}
+
+TEST(OutOfCore, CancelLeavesNoTemporaryFile) {
+  const std::string dir = fresh_dir("cancel");
+  SimplifyOptions opt;
+  opt.target_faces = 5000;
+  OutOfCoreOptions ooc;
+  ooc.memory_limit = kTinyLimit;
+  ooc.temp_dir = dir;
+  ooc.progress = [](const OutOfCoreProgress& p) { return std::string(p.phase) != "simplifying"; };
+  EXPECT_THROW(simplify_out_of_core(big_sphere(), opt, ooc), Error);
+  EXPECT_EQ(entries(dir), 0u);
+}
+
+TEST(OutOfCore, UnusableTemporaryFolderIsAClearError) {
+  SimplifyOptions opt;
+  opt.target_faces = 5000;
+  OutOfCoreOptions ooc;
+  ooc.memory_limit = kTinyLimit;
+  for (const std::string& bad : {test::temp_dir() + "/ooc_no_such_folder/x", big_sphere()}) {
+    ooc.temp_dir = bad;
+    try {
+      simplify_out_of_core(big_sphere(), opt, ooc);
+      ADD_FAILURE() << "no error for " << bad;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("temporary folder " + bad), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(OutOfCore, StlSoupAndRatioOfTheInput) {
+  const std::string dir = fresh_dir("stl");
+  const std::string stl = dir + "/sphere.stl";
+  save_mesh(stl, outofcore::bumpy_sphere(80000));
+  SimplifyOptions opt;
+  opt.target_ratio = 0.02;  // of the input's 81,920 faces, not of the clustered mesh's
+  OutOfCoreOptions ooc;
+  ooc.memory_limit = std::uint64_t(4) << 20;
+  ooc.temp_dir = dir;
+  OutOfCoreReport report;
+  SimplifyResult r = simplify_out_of_core(stl, opt, ooc, &report);
+  EXPECT_EQ(report.input_faces, 81920u);
+  EXPECT_LT(report.clustered_faces, 81920u);
+  EXPECT_LE(r.mesh.face_count(), 1638u);
+  EXPECT_GE(r.mesh.face_count(), 1636u);
+  Mesh welded = r.mesh;
+  weld_exact(welded);
+  EXPECT_EQ(test::boundary_edges(welded), 0u);
+  EXPECT_EQ(entries(dir), 1u);  // the input only
+}
+
+TEST(OutOfCore, TruncatedOrBrokenInputIsAClearError) {
+  const std::string dir = fresh_dir("broken");
+  const std::string bytes = slurp(big_sphere());
+  SimplifyOptions opt;
+  opt.target_faces = 5000;
+  OutOfCoreOptions ooc;
+  ooc.memory_limit = kTinyLimit;
+  ooc.temp_dir = dir;
+  auto error_of = [&](const std::string& contents) {
+    const std::string p = dir + "/broken.ply";
+    std::ofstream(p, std::ios::binary) << contents;
+    try {
+      simplify_out_of_core(p, opt, ooc);
+    } catch (const Error& e) {
+      fs::remove(p);
+      return std::string(e.what());
+    }
+    fs::remove(p);
+    return std::string("no error");
+  };
+  // Cut inside the faces: the last face is incomplete.
+  EXPECT_NE(
+      error_of(bytes.substr(0, bytes.size() - 5)).find("broken.ply, face 327679: the file ends inside it"),
+      std::string::npos);
+  // A face's first index made 2^31 - 1.
+  std::string bad = bytes;
+  const std::size_t first_face = bytes.size() - 327680 * 13;
+  bad[first_face + 1] = '\xff', bad[first_face + 2] = '\xff', bad[first_face + 3] = '\xff',
+                   bad[first_face + 4] = 0x7f;
+  EXPECT_NE(error_of(bad).find("broken.ply, face 0: vertex index 2147483647 out of range (163842 vertices)"),
+            std::string::npos)
+      << error_of(bad);
+  EXPECT_NE(error_of("ply\nformat ascii 1.0\nelement vertex 0\nend_header\n").find("ASCII PLY"),
+            std::string::npos);
+  EXPECT_EQ(entries(dir), 0u);
+}
+
+TEST(OutOfCore, MemorySizes) {
+  EXPECT_EQ(parse_memory_size("2G"), std::uint64_t(2) << 30);
+  EXPECT_EQ(parse_memory_size("512M"), std::uint64_t(512) << 20);
+  EXPECT_EQ(parse_memory_size("1.5GB"), std::uint64_t(3) << 29);
+  EXPECT_EQ(parse_memory_size("1000"), 1000u);
+  for (const char* bad : {"", "G", "2X", "-1G", "0"}) EXPECT_THROW(parse_memory_size(bad), Error) << bad;
+  EXPECT_GE(default_memory_limit(), std::uint64_t(256) << 20);
+  EXPECT_FALSE(fits_in_memory(big_sphere(), kTinyLimit));
+  EXPECT_TRUE(fits_in_memory(big_sphere(), std::uint64_t(1) << 30));
+}
+
+// --- the command line -----------------------------------------------------------------------------
+
+struct CliRun {
+  int exit_code;
+  std::string out;
+};
+
+CliRun run(const std::string& args) {
+  std::string cmd = std::string(QEM_CLI_PATH) + " " + args + " 2>&1";
+  CliRun r{-1, {}};
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return r;
+  std::array<char, 4096> buf;
+  while (std::size_t n = std::fread(buf.data(), 1, buf.size(), pipe)) r.out.append(buf.data(), n);
+  int status = pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+TEST(OutOfCoreCli, MemoryLimitSendsALargeInputOutOfCore) {
+  const std::string dir = fresh_dir("cli");
+  const std::string out = dir + "/out.ply";
+  CliRun r = run("simplify " + big_sphere() + " " + out + " --faces 3000 --memory-limit 16M --temp-dir " +
+                 dir + " --json --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  for (const char* field : {"\"out_of_core\":true", "\"out_faces\":", "\"peak_memory_bytes\":",
+                            "\"temp_bytes_written\":", "\"phases\":[{\"name\":\"bounds\""})
+    EXPECT_NE(r.out.find(field), std::string::npos) << field << " missing in " << r.out;
+  EXPECT_LE(load_mesh(out).face_count(), 3000u);
+  EXPECT_EQ(entries(dir), 1u);  // the output only
+  // Enough memory: the in-core path, whose JSON has no out_of_core field.
+  r = run("simplify " + big_sphere() + " " + out + " --faces 3000 --memory-limit 2G --json --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_EQ(r.out.find("out_of_core"), std::string::npos) << r.out;
+}
+
+TEST(OutOfCoreCli, FailedRunLeavesNoOutput) {
+  const std::string dir = fresh_dir("cli_fail");
+  const std::string out = dir + "/out.ply";
+  CliRun r = run("simplify " + big_sphere() + " " + out + " --faces 3000 --memory-limit 16M --temp-dir " +
+                 dir + "/missing");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.out.find("temporary folder"), std::string::npos) << r.out;
+  EXPECT_EQ(entries(dir), 0u);
+}
+
+TEST(OutOfCoreCli, TerminatedRunLeavesNothing) {
+  const std::string dir = fresh_dir("cli_term"), temp = dir + "/temp", out = dir + "/out.ply";
+  fs::create_directories(temp);
+  const std::string input = big_sphere();
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    execl(QEM_CLI_PATH, "qem", "simplify", input.c_str(), out.c_str(), "--faces", "3000", "--memory-limit",
+          "16M", "--temp-dir", temp.c_str(), "--quiet", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  // SIGTERM once the clustered faces' temporary file exists: mid-way through phase 1.
+  bool seen = false;
+  for (int i = 0; i < 60000 && !seen; ++i) {
+    for (const auto& e : fs::directory_iterator(temp))
+      if (e.path().filename().string().find(".qem-faces") != std::string::npos) seen = true;
+    if (!seen) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  ASSERT_TRUE(seen);
+  kill(pid, SIGTERM);
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) GTEST_SKIP() << "the run finished before the signal";
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) << status;
+  EXPECT_EQ(entries(temp), 0u);
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_EQ(entries(dir), 1u);  // the temporary folder, empty
+}
+
+}  // namespace

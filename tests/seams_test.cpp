@@ -1,0 +1,499 @@
+// Seams with appearance attributes (issue 18): they stay closed through the refit at several
+// targets, a mirrored atlas's mirror line is a seam, seams and named vertices can be locked,
+// protected vertices keep their seams, and the permissive mode crosses seams to reach targets that
+// strict seams block. The command line's --lock, --lock-property and --seams, and its refusal of
+// bad attribute data, are tested as a user runs them.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+
+#include "qem/error.h"
+#include "qem/io.h"
+#include "qem/simplify.h"
+#include "test_meshes.h"
+
+using namespace qem;
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+using Point = std::array<double, 3>;
+
+Point position(const Mesh& m, std::uint32_t v) { return {m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]}; }
+
+std::set<Point> positions_of(const Mesh& m) {
+  std::set<Point> out;
+  for (std::uint32_t v = 0; v < m.vertex_count(); ++v) out.insert(position(m, v));
+  return out;
+}
+
+// A latitude-longitude sphere whose column u = 1 repeats the positions of u = 0 with other UVs,
+// and whose poles are one position with a wedge per segment.
+Mesh uv_sphere(int rings, int segments) {
+  Mesh m;
+  VertexAttribute uv{"TEXCOORD_0", AttributeKind::TexCoord, 2, {}};
+  VertexAttribute normal{"NORMAL", AttributeKind::Normal, 3, {}};
+  for (int i = 0; i <= rings; ++i)
+    for (int j = 0; j <= segments; ++j) {
+      const double theta = kPi * i / rings, phi = 2 * kPi * (j % segments) / segments;
+      double p[3] = {std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)};
+      if (i == 0 || i == rings) p[0] = p[1] = 0;
+      // sin(5 pi) is not exactly 0: the poles get radius 1 exactly, so each is one position.
+      const double r = i == 0 || i == rings ? 1 : 1 + 0.05 * std::sin(5 * theta) * std::cos(3 * phi);
+      m.positions.insert(m.positions.end(), {r * p[0], r * p[1], r * p[2]});
+      uv.values.insert(uv.values.end(), {double(j) / segments, double(i) / rings});
+      normal.values.insert(normal.values.end(), {p[0], p[1], p[2]});
+    }
+  auto id = [&](int i, int j) { return std::uint32_t(i * (segments + 1) + j); };
+  for (int i = 0; i < rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      if (i > 0) m.indices.insert(m.indices.end(), {id(i, j), id(i + 1, j), id(i, j + 1)});
+      if (i + 1 < rings) m.indices.insert(m.indices.end(), {id(i, j + 1), id(i + 1, j), id(i + 1, j + 1)});
+    }
+  m.attributes = {uv, normal};
+  return m;
+}
+
+// A cube of side 2 whose six sides are n x n grids, each its own UV chart (a cell of a 3 x 2
+// atlas) with its own vertices, so that every cube edge is a UV seam. `relief` bulges each side
+// (zero on the cube's edges, so the sides still meet); normals are the side's (flat shading) or
+// the position's direction.
+// With `block` > 0, each side is cut further into block x block-cell charts (many small UV
+// islands), and the sides of +x, +y, +z have material 0, the others material 1.
+Mesh uv_cube(int n, double relief, bool flat_normals, int block = 0) {
+  Mesh m;
+  VertexAttribute uv{"TEXCOORD_0", AttributeKind::TexCoord, 2, {}};
+  VertexAttribute normal{"NORMAL", AttributeKind::Normal, 3, {}};
+  std::map<std::array<int, 5>, std::uint32_t> ids;  // (side, i, j, chart i, chart j)
+  for (int side = 0; side < 6; ++side) {
+    const int axis = side / 2;
+    const double sign = side % 2 ? -1 : 1;
+    const auto vertex = [&](int i, int j, int ci, int cj) {
+      auto [it, fresh] = ids.try_emplace({side, i, j, ci, cj}, std::uint32_t(m.vertex_count()));
+      if (!fresh) return it->second;
+      const double s = -1 + 2.0 * i / n, t = -1 + 2.0 * j / n;
+        double p[3];
+        p[axis] = sign * (1 + relief * (1 - s * s) * (1 - t * t) * std::cos(2 * s + t));
+        p[(axis + 1) % 3] = sign * s;  // the side's orientation follows its outward normal
+        p[(axis + 2) % 3] = t;
+        m.positions.insert(m.positions.end(), {p[0], p[1], p[2]});
+        // Each chart shifted in the atlas, so that neighbouring charts' UVs differ.
+        uv.values.insert(uv.values.end(), {(side % 3 + 0.05 + 0.9 * (s + 1) / 2) / 3 + 0.01 * ci,
+                                           (side / 3 + 0.05 + 0.9 * (t + 1) / 2) / 2 + 0.01 * cj});
+        double nn[3] = {0, 0, 0};
+        nn[axis] = sign;
+        const double len = std::hypot(p[0], p[1], p[2]);
+        if (flat_normals)
+          normal.values.insert(normal.values.end(), {nn[0], nn[1], nn[2]});
+        else
+          normal.values.insert(normal.values.end(), {p[0] / len, p[1] / len, p[2] / len});
+      return it->second;
+    };
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) {
+        const int ci = block > 0 ? i / block : 0, cj = block > 0 ? j / block : 0;
+        const std::uint32_t a = vertex(i, j, ci, cj), b = vertex(i + 1, j, ci, cj), c = vertex(i + 1, j + 1, ci, cj),
+                            d = vertex(i, j + 1, ci, cj);
+        m.indices.insert(m.indices.end(), {a, b, c, a, c, d});
+        if (block > 0) m.face_materials.insert(m.face_materials.end(), 2, std::uint32_t(side % 2));
+      }
+  }
+  m.attributes = {uv, normal};
+  return m;
+}
+
+// A wavy n x n grid over the unit square cut into `block` x `block` cell charts: every chart has
+// its own vertices and UVs, so chart boundaries are seams and the points where four charts meet
+// hold four wedges.
+Mesh chart_grid(int n, int block) {
+  Mesh m;
+  VertexAttribute uv{"TEXCOORD_0", AttributeKind::TexCoord, 2, {}};
+  std::map<std::array<int, 4>, std::uint32_t> ids;  // (i, j, chart i, chart j)
+  auto vertex = [&](int i, int j, int ci, int cj) {
+    auto [it, fresh] = ids.try_emplace({i, j, ci, cj}, std::uint32_t(m.vertex_count()));
+    if (fresh) {
+      const double x = double(i) / n, y = double(j) / n;
+      m.positions.insert(m.positions.end(), {x, y, 0.08 * std::sin(5 * x) * std::cos(4 * y)});
+      // Each chart mapped with a gap into the atlas: neighbouring charts' UVs differ.
+      uv.values.insert(uv.values.end(), {0.9 * x + 0.05 * ci, 0.9 * y + 0.03 * cj});
+    }
+    return it->second;
+  };
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const int ci = i / block, cj = j / block;
+      const std::uint32_t a = vertex(i, j, ci, cj), b = vertex(i + 1, j, ci, cj), c = vertex(i + 1, j + 1, ci, cj),
+                          d = vertex(i, j + 1, ci, cj);
+      m.indices.insert(m.indices.end(), {a, b, c, a, c, d});
+    }
+  m.attributes = {uv};
+  return m;
+}
+
+// Boundary edges of m welded by position: on these closed meshes, the cracks a simplification
+// opened along a seam.
+std::size_t open_edges_welded(const Mesh& m) {
+  std::map<std::pair<Point, Point>, int> uses;
+  for (std::size_t f = 0; f < m.face_count(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      Point a = position(m, m.indices[3 * f + k]), b = position(m, m.indices[3 * f + (k + 1) % 3]);
+      if (b < a) std::swap(a, b);
+      ++uses[{a, b}];
+    }
+  std::size_t open = 0;
+  for (const auto& [edge, count] : uses) open += count == 1;
+  return open;
+}
+
+const VertexAttribute& attribute(const Mesh& m, AttributeKind kind) {
+  const VertexAttribute* a = m.find_attribute(kind);
+  EXPECT_NE(a, nullptr);
+  return *a;
+}
+
+// The input vertices on a seam: positions held by more than one referenced vertex.
+std::vector<std::uint8_t> seam_vertices(const Mesh& m) {
+  std::map<Point, int> count;
+  std::vector<std::uint8_t> used(m.vertex_count(), 0);
+  for (std::uint32_t v : m.indices) used[v] = 1;
+  for (std::uint32_t v = 0; v < m.vertex_count(); ++v)
+    if (used[v]) ++count[position(m, v)];
+  std::vector<std::uint8_t> seam(m.vertex_count(), 0);
+  for (std::uint32_t v = 0; v < m.vertex_count(); ++v) seam[v] = used[v] && count[position(m, v)] > 1;
+  return seam;
+}
+
+}  // namespace
+
+TEST(Seams, UvCubeAndSphereStayClosedThroughTheRefit) {
+  const Mesh cube = uv_cube(16, 0.15, false), sphere = uv_sphere(40, 80);
+  ASSERT_EQ(open_edges_welded(cube), 0u);
+  ASSERT_EQ(open_edges_welded(sphere), 0u);
+  for (const Mesh* in : {&cube, &sphere})
+    for (double ratio : {0.5, 0.2, 0.05, 0.01}) {
+      SimplifyOptions o;
+      o.target_ratio = ratio;
+      o.refit_rounds = 3;
+      o.map_input_vertices = true;
+      const SimplifyResult r = simplify(*in, o);
+      SCOPED_TRACE((in == &cube ? "cube at " : "sphere at ") + std::to_string(ratio));
+      EXPECT_EQ(open_edges_welded(r.mesh), 0u) << "a crack opened along a seam";
+      EXPECT_GT(r.refit_rounds, 0u) << "the refit did not run";
+      EXPECT_LT(r.refit_rms_after, r.refit_rms_before);
+      // Seam vertices stay exactly where they were, with their UVs; every UV stays in [0, 1].
+      const VertexAttribute& uv = attribute(r.mesh, AttributeKind::TexCoord);
+      const std::vector<std::uint8_t> seam = seam_vertices(*in);
+      std::size_t seam_checked = 0, moved_by_refit = 0;
+      for (std::uint32_t v = 0; v < r.mesh.vertex_count(); ++v) {
+        const std::uint32_t s = r.vertex_source[v];
+        for (int c = 0; c < 2; ++c) {
+          EXPECT_GE(uv.values[2 * v + c], -1e-9);
+          EXPECT_LE(uv.values[2 * v + c], 1 + 1e-9);
+        }
+        const bool stayed = position(r.mesh, v) == position(*in, s);
+        if (!seam[s]) {
+          moved_by_refit += !stayed;
+          continue;
+        }
+        ++seam_checked;
+        EXPECT_TRUE(stayed) << "seam vertex " << v << " moved";
+        EXPECT_EQ(uv.values[2 * v], in->attributes[0].values[2 * s]);
+        EXPECT_EQ(uv.values[2 * v + 1], in->attributes[0].values[2 * s + 1]);
+      }
+      EXPECT_GT(seam_checked, 8u);
+      EXPECT_GT(moved_by_refit, 0u);
+    }
+}
+
+TEST(Seams, FlatShadedCubeKeepsItsSidesAndNormals) {
+  // Each side flat with its own normal: the cube's edges are normal creases. Simplified as far as
+  // it goes, it is the 12-triangle cube, each face's normals its side's, through the refit too.
+  const Mesh in = uv_cube(8, 0, true);  // n a power of 2: the sides' shared coordinates agree exactly
+  for (unsigned refit : {0u, 3u}) {
+    SimplifyOptions o;
+    o.target_faces = 12;
+    o.refit_rounds = refit;
+    const SimplifyResult r = simplify(in, o);
+    SCOPED_TRACE("refit rounds " + std::to_string(refit));
+    EXPECT_EQ(r.mesh.face_count(), 12u);
+    EXPECT_EQ(r.mesh.vertex_count(), 24u);  // 4 wedges a side: one per corner and side
+    EXPECT_EQ(open_edges_welded(r.mesh), 0u);
+    const VertexAttribute& n = attribute(r.mesh, AttributeKind::Normal);
+    for (std::size_t f = 0; f < r.mesh.face_count(); ++f) {
+      const std::uint32_t* t = &r.mesh.indices[3 * f];
+      Point p[3];
+      for (int k = 0; k < 3; ++k) {
+        p[k] = position(r.mesh, t[k]);
+        for (int c = 0; c < 3; ++c) EXPECT_EQ(std::abs(p[k][c]), 1.0) << "a corner left the cube's corner";
+      }
+      const double e1[3] = {p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]};
+      const double e2[3] = {p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]};
+      const double g[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+      const double len = std::hypot(g[0], g[1], g[2]);
+      ASSERT_GT(len, 0);
+      for (int k = 0; k < 3; ++k)
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(n.values[3 * t[k] + c], g[c] / len, 1e-12) << "face " << f;
+    }
+  }
+}
+
+TEST(Seams, MirroredUvEdgeIsASeam) {
+  // A wavy grid whose right half mirrors the left half's UVs (u = 2x, then 2 - 2x): the vertices
+  // on x = 0.5 are shared, with one UV each, and the UV triangles of the two halves turn opposite
+  // ways. The mirror line must stay: no face straddles it, its vertices keep x = 0.5 and u = 1,
+  // and it is one vertex per position in the output as in the input.
+  const int n = 40;
+  Mesh in = test::height_field(n, [](double x, double y) { return 0.1 * std::sin(7 * x + 1) * std::cos(5 * y); });
+  VertexAttribute uv{"TEXCOORD_0", AttributeKind::TexCoord, 2, {}};
+  for (std::size_t v = 0; v < in.vertex_count(); ++v) {
+    const double x = in.positions[3 * v], y = in.positions[3 * v + 1];
+    uv.values.insert(uv.values.end(), {x <= 0.5 ? 2 * x : 2 - 2 * x, y});
+  }
+  in.attributes = {uv};
+  for (Scheme scheme : {Scheme::Passes, Scheme::Greedy}) {
+    SimplifyOptions o;
+    o.scheme = scheme;
+    o.target_ratio = 0.05;
+    o.refit_rounds = 2;
+    const SimplifyResult r = simplify(in, o);
+    SCOPED_TRACE(to_string(scheme));
+    EXPECT_LE(r.mesh.face_count(), in.face_count() / 20);
+    const VertexAttribute& out_uv = r.mesh.attributes[0];
+    std::set<Point> on_line;
+    std::size_t line_vertices = 0;
+    for (std::uint32_t v = 0; v < r.mesh.vertex_count(); ++v)
+      if (r.mesh.positions[3 * v] == 0.5) {
+        on_line.insert(position(r.mesh, v)), ++line_vertices;
+        EXPECT_EQ(out_uv.values[2 * v], 1.0);
+      }
+    EXPECT_GE(on_line.size(), 2u);
+    EXPECT_EQ(line_vertices, on_line.size()) << "the mirror line's vertices were split in the output";
+    for (std::size_t f = 0; f < r.mesh.face_count(); ++f) {
+      bool left = false, right = false;
+      for (int k = 0; k < 3; ++k) {
+        const double x = r.mesh.positions[3 * r.mesh.indices[3 * f + k]];
+        left |= x < 0.5, right |= x > 0.5;
+      }
+      EXPECT_FALSE(left && right) << "face " << f << " crosses the mirror line";
+    }
+  }
+}
+
+TEST(Seams, LockSeamsKeepsEverySeamVertex) {
+  const Mesh in = uv_sphere(30, 60);
+  const std::vector<std::uint8_t> seam = seam_vertices(in);
+  SimplifyOptions o;
+  o.target_ratio = 0.1;
+  o.lock_seams = true;
+  o.refit_rounds = 2;
+  o.map_input_vertices = true;
+  const SimplifyResult r = simplify(in, o);
+  EXPECT_LT(r.mesh.face_count(), in.face_count() / 4);
+  // Every seam position is still there, exactly (a wedge of it may go with its faces: a pole's
+  // wedges are one per face around it).
+  const std::set<Point> kept = positions_of(r.mesh);
+  std::size_t checked = 0;
+  for (std::uint32_t v = 0; v < in.vertex_count(); ++v) {
+    if (!seam[v]) continue;
+    EXPECT_TRUE(kept.count(position(in, v))) << "seam vertex " << v << " moved or went";
+    ++checked;
+  }
+  EXPECT_GT(checked, 60u);
+}
+
+TEST(Seams, PermissiveCrossesSeamsToReachTheTarget) {
+  // A closed cube of 2 x 2-cell charts, two materials: strict seams stop far above the target
+  // (every point where charts meet stays); permissive reaches it, with no crack and without
+  // merging the two materials.
+  const Mesh in = uv_cube(16, 0.1, false, 2);
+  ASSERT_EQ(open_edges_welded(in), 0u);
+  const auto both_materials = [](const Mesh& m) {
+    std::map<Point, std::set<std::uint32_t>> at;
+    for (std::size_t f = 0; f < m.face_count(); ++f)
+      for (int k = 0; k < 3; ++k) at[position(m, m.indices[3 * f + k])].insert(m.face_materials[f]);
+    std::set<Point> out;
+    for (const auto& [p, materials] : at)
+      if (materials.size() > 1) out.insert(p);
+    return out;
+  };
+  const std::set<Point> boundary = both_materials(in);
+  SimplifyOptions o;
+  o.target_faces = 150;
+  const SimplifyResult strict = simplify(in, o);
+  EXPECT_GT(strict.mesh.face_count(), 2 * o.target_faces) << "the mesh does not test what it should";
+  o.permissive_seams = true;
+  o.refit_rounds = 2;
+  for (Scheme scheme : {Scheme::Passes, Scheme::Greedy}) {
+    o.scheme = scheme;
+    const SimplifyResult r = simplify(in, o);
+    SCOPED_TRACE(to_string(scheme));
+    EXPECT_LE(r.mesh.face_count(), o.target_faces);
+    EXPECT_EQ(r.stop_reason, StopReason::TargetReached);
+    EXPECT_EQ(open_edges_welded(r.mesh), 0u) << "a crack opened";
+    ASSERT_EQ(r.mesh.face_materials.size(), r.mesh.face_count());
+    for (std::size_t f = 0; f < r.mesh.face_count(); ++f)
+      EXPECT_EQ(r.mesh.face_materials[f], in.face_materials[r.face_source[f]]);
+    for (const Point& p : both_materials(r.mesh))
+      EXPECT_TRUE(boundary.count(p)) << "a point of both materials left the material boundary";
+  }
+}
+
+TEST(Seams, ProtectedVerticesKeepTheirSeamsInPermissiveMode) {
+  // Every vertex protected: permissive makes exactly what strict makes.
+  const Mesh in = chart_grid(24, 3);
+  const std::vector<std::uint8_t> all(in.vertex_count(), 1);
+  SimplifyOptions o;
+  o.target_faces = 40;
+  const SimplifyResult strict = simplify(in, o);
+  EXPECT_GT(strict.mesh.face_count(), o.target_faces) << "the mesh does not test what it should";
+  o.permissive_seams = true;
+  o.vertex_protect = all;
+  const SimplifyResult protect = simplify(in, o);
+  EXPECT_EQ(protect.mesh.indices, strict.mesh.indices);
+  EXPECT_EQ(protect.mesh.positions, strict.mesh.positions);
+  EXPECT_EQ(protect.mesh.attributes[0].values, strict.mesh.attributes[0].values);
+  o.vertex_protect = {};
+  const SimplifyResult permissive = simplify(in, o);
+  EXPECT_LT(permissive.mesh.face_count(), strict.mesh.face_count()) << "permissive crossed nothing";
+  // A wrong size is refused.
+  const std::vector<std::uint8_t> short_list(3, 1);
+  o.vertex_protect = short_list;
+  EXPECT_THROW(simplify(in, o), Error);
+}
+
+namespace {
+
+struct CliRun {
+  int exit_code;
+  std::string out;
+};
+
+CliRun run_cli(const std::string& args) {
+  const std::string cmd = std::string(QEM_CLI_PATH) + " " + args + " 2>&1";
+  CliRun r{-1, {}};
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return r;
+  char buf[4096];
+  while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe)) r.out.append(buf, n);
+  const int status = pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+}  // namespace
+
+TEST(Seams, CommandLineLocksSeamsAndNamedVertices) {
+  const std::string dir = test::temp_dir();
+  const Mesh sphere = uv_sphere(20, 40);
+  const std::string obj = dir + "/seams_sphere.obj", out = dir + "/seams_sphere_out.obj";
+  save_mesh(obj, sphere);
+  CliRun r = run_cli("simplify " + obj + " " + out + " --ratio 0.1 --lock seams --quiet --force");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  {
+    const std::set<Point> kept = positions_of(load_mesh(out));
+    const std::vector<std::uint8_t> seam = seam_vertices(sphere);
+    for (std::uint32_t v = 0; v < sphere.vertex_count(); ++v)
+      if (seam[v]) {
+        EXPECT_TRUE(kept.count(position(sphere, v))) << "seam vertex " << v << " is gone";
+      }
+  }
+
+  // A PLY vertex property names the vertices to lock.
+  Mesh ball = test::icosphere(3);
+  VertexProperty keep{"keep", std::vector<double>(ball.vertex_count(), 0)};
+  for (std::size_t v = 0; v < ball.vertex_count(); v += 9) keep.values[v] = 1;
+  ball.vertex_properties = {keep};
+  const std::string ply = dir + "/seams_keep.ply", ply_out = dir + "/seams_keep_out.ply";
+  save_mesh(ply, ball);
+  ball = load_mesh(ply);  // as the file holds it (float coordinates)
+  r = run_cli("simplify " + ply + " " + ply_out + " --ratio 0.05 --lock-property keep --quiet --force");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const Mesh simplified = load_mesh(ply_out);
+  EXPECT_LT(simplified.face_count(), ball.face_count() / 4);
+  const std::set<Point> kept = positions_of(simplified);
+  for (std::uint32_t v = 0; v < ball.vertex_count(); v += 9)
+    EXPECT_TRUE(kept.count(position(ball, v))) << "locked vertex " << v << " moved or went";
+
+  // An unknown property: a clear error, and no output.
+  const std::string none = dir + "/seams_none.ply";
+  fs::remove(none);
+  r = run_cli("simplify " + ply + " " + none + " --ratio 0.05 --lock-property nothere --quiet");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.out.find("nothere"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("keep"), std::string::npos) << "the error should list the properties there are: " << r.out;
+  EXPECT_FALSE(fs::exists(none));
+}
+
+TEST(Seams, CommandLineRefitsAttributesOnlyWhenAsked) {
+  // The default's light refit is left out with attributes (it raised the UV error); --refit makes
+  // it, and the seams stay closed.
+  const std::string dir = test::temp_dir();
+  const std::string obj = dir + "/seams_refit.obj", out = dir + "/seams_refit_out.obj";
+  save_mesh(obj, uv_sphere(30, 60));
+  ASSERT_EQ(open_edges_welded(load_mesh(obj)), 0u);
+  CliRun plain = run_cli("simplify " + obj + " " + out + " --ratio 0.1 --json --quiet --force");
+  ASSERT_EQ(plain.exit_code, 0) << plain.out;
+  EXPECT_NE(plain.out.find("\"refit_rounds\":0,"), std::string::npos) << plain.out;
+  CliRun asked = run_cli("simplify " + obj + " " + out + " --ratio 0.1 --refit --json --quiet --force");
+  ASSERT_EQ(asked.exit_code, 0) << asked.out;
+  EXPECT_EQ(asked.out.find("\"refit_rounds\":0,"), std::string::npos) << asked.out;
+  EXPECT_NE(asked.out.find("\"refit_rounds\":"), std::string::npos) << asked.out;
+  EXPECT_EQ(open_edges_welded(load_mesh(out)), 0u);
+}
+
+TEST(Seams, CommandLinePermissiveReachesTheTarget) {
+  const std::string dir = test::temp_dir();
+  const std::string obj = dir + "/seams_charts.obj", out = dir + "/seams_charts_out.obj";
+  save_mesh(obj, chart_grid(40, 2));
+  CliRun strict = run_cli("simplify " + obj + " " + out + " --faces 160 --json --quiet --force");
+  ASSERT_EQ(strict.exit_code, 0) << strict.out;
+  EXPECT_EQ(strict.out.find("\"out_faces\":160"), std::string::npos) << strict.out;
+  CliRun permissive = run_cli("simplify " + obj + " " + out + " --faces 160 --seams permissive --json --quiet --force");
+  ASSERT_EQ(permissive.exit_code, 0) << permissive.out;
+  EXPECT_EQ(load_mesh(out).face_count(), 160u);
+  CliRun bad = run_cli("simplify " + obj + " " + out + " --faces 160 --seams sometimes --quiet --force");
+  EXPECT_NE(bad.exit_code, 0);
+}
+
+TEST(Seams, BadAttributeDataGivesAClearErrorAndNoOutput) {
+  SimplifyOptions o;
+  o.target_faces = 10;
+  Mesh in = uv_sphere(6, 12);
+  in.attributes[0].values[5] = std::nan("");
+  try {
+    simplify(in, o);
+    ADD_FAILURE() << "a NaN UV was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("TEXCOORD_0"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("vertex 2"), std::string::npos) << e.what();
+  }
+  in = uv_sphere(6, 12);
+  in.attributes[1].values.pop_back();
+  try {
+    simplify(in, o);
+    ADD_FAILURE() << "a short NORMAL attribute was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("NORMAL"), std::string::npos) << e.what();
+  }
+  // From a file: the reader names the file and line, exits non-zero, and writes nothing.
+  const std::string dir = test::temp_dir();
+  const std::string obj = dir + "/seams_nan_uv.obj", out = dir + "/seams_nan_uv_out.obj";
+  {
+    std::ofstream f(obj);
+    f << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\nvt nan 0\nvt 0 1\nf 1/1 2/2 3/3\nf 2/2 4/1 3/3\n";
+  }
+  fs::remove(out);
+  const CliRun r = run_cli("simplify " + obj + " " + out + " --faces 1 --quiet");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.out.find("seams_nan_uv.obj"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("6"), std::string::npos) << "the error should name line 6: " << r.out;
+  EXPECT_FALSE(fs::exists(out));
+}
