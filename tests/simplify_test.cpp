@@ -187,12 +187,7 @@ TEST_P(Simplify, LockBorderKeepsBoundaryVerticesExactly) {
 
 TEST_P(Simplify, InversionCheckKeepsHeightFieldFacingUp) {
   Mesh in = test::height_field(30, [](double x, double y) { return 0.3 * std::sin(9 * x) * std::sin(7 * y); });
-  // GH97's border penalty: with exact borders (border_test.cpp) the passes order leaves one of the
-  // 60 faces of this steep surface tilted just past vertical (nz = -0.009), each contraction within
-  // the 75-degree turn limit (the check is per contraction, not against the input).
-  SimplifyOptions o = faces(60);
-  o.exact_border = false;
-  SimplifyResult r = simplify(in, o);
+  SimplifyResult r = simplify(in, faces(60));
   for (std::size_t f = 0; f < r.mesh.face_count(); ++f) {
     const std::uint32_t* t = &r.mesh.indices[3 * f];
     const double* a = &r.mesh.positions[3 * t[0]];

@@ -3,23 +3,27 @@
 // placement trades against the faces' planes, so a border vertex drifts off its border and off
 // the plane of a flat patch; tiles simplified one by one then no longer meet. Here the planes
 // still rank the contractions (they say what cutting a curved border costs), but a contraction
-// that involves a border vertex is placed at an existing border vertex:
+// that involves a border vertex is placed on the input's border (border_chains.h):
 //   - a border vertex and an interior one: at the border vertex;
-//   - the two ends of a border edge: at the end of lower error (so a border vertex only ever
-//     "slides" to its neighbour along its own polyline, and every border vertex of the output is
-//     an input border vertex with bit-identical coordinates);
+//   - the two ends of a border edge: at the minimiser of the quadric restricted to the input
+//     border between them (each input border edge of that stretch, GH97 §4's segment placement
+//     on each), or at either end, whichever has the lowest error and turns no face by more than
+//     the inversion limit (the next lowest otherwise): a border vertex slides along its own
+//     polyline, and one that stays or lands on another's place keeps bit-identical coordinates;
 //   - two border vertices that do not share a border edge: never (it would join two stretches of
 //     border across the surface);
 //   - a corner (where the border turns by more than kCornerDegrees, where the border is not a
-//     simple chain, or on a non-manifold edge) is never removed: its pairs are placed at it, and
-//     two corners never contract together.
+//     simple chain, or on a non-manifold edge) is never removed nor moved: its pairs are placed
+//     at it, two corners never contract together, and no vertex slides past one.
 // Locked vertices (vertex_lock, --lock-border) count as corners.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
 #include "core/context.h"
+#include "core/placement.h"
 #include "core/valid_pairs.h"
 #include "core/working_mesh.h"
 
@@ -33,9 +37,18 @@ namespace qem::core {
 /// (docs/benchmarks.md, "Borders").
 inline constexpr double kCornerDegrees = 45;
 
+/// A border vertex slides at most this many input border edges per contraction (the stretch
+/// between the two ends is walked edge by edge); a longer stretch is placed at either end.
+inline constexpr std::size_t kMaxBorderWalk = 4096;
+
 /// Marks mesh.corner from the input's unique edges (with face counts): ends of non-manifold
-/// edges, border vertices with other than two border edges, and border turns above kCornerDegrees.
+/// edges, border vertices with other than two border edges, and border turns above kCornerDegrees;
+/// and builds mesh.chains and mesh.border_spot (each border vertex at its own slot).
 void mark_border_corners(WorkingMesh& mesh, const std::vector<Edge>& edges);
+
+/// The placement of border edge (a, b) whose ends may both move (BorderTarget::AtEither): the
+/// lowest-error non-flipping point of the input border between them, ends included (above).
+void place_along_border(const Context& c, std::uint32_t a, std::uint32_t b, const Quadric& q, Placed& placed);
 
 /// Where the contraction of (a, b) may go under exact borders.
 enum class BorderTarget : std::uint8_t { Free, AtA, AtB, AtEither, Never };

@@ -233,6 +233,9 @@ bool try_contract(Context& c, Lists& lists, std::uint32_t p, Worker& w) {
   }
   w.max_error = std::max(w.max_error, err);
   contract(c, lists, p, q, placed.position, w);
+  // Exact borders: where the survivor lies on the input's border (it slid, or took the place of
+  // the other end; an interior vertex that came to a border vertex takes that one's).
+  if (!c.mesh.border_spot.empty() && placed.spot.from != kNoSlot) c.mesh.border_spot[w.last_kept] = placed.spot;
   ++w.contractions;
   if (c.observe_contractions) report_contraction(c, err, w);
   return true;

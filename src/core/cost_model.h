@@ -47,15 +47,7 @@ inline bool place_pair(const Context& c, std::uint32_t p, Quadric& q, Placed& pl
     case BorderTarget::Never: return false;
     case BorderTarget::AtA: placed = {m.pos[a], q.evaluate(m.pos[a])}; return true;
     case BorderTarget::AtB: placed = {m.pos[b], q.evaluate(m.pos[b])}; return true;
-    case BorderTarget::AtEither: {  // the end of lower error, unless only the other keeps every face's side
-      Placed other{m.pos[b], q.evaluate(m.pos[b])};
-      placed = {m.pos[a], q.evaluate(m.pos[a])};
-      if (other.error < placed.error) std::swap(placed, other);
-      if (flips(m, a, b, placed.position, c.settings.cos_max_turn) &&
-          !flips(m, a, b, other.position, c.settings.cos_max_turn))
-        placed = other;
-      return true;
-    }
+    case BorderTarget::AtEither: place_along_border(c, a, b, q, placed); return true;
   }
   const bool held_a = m.held(a, c.settings.lock_border), held_b = m.held(b, c.settings.lock_border);
   if (held_a || held_b) {
