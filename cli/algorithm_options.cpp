@@ -36,7 +36,8 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
   sub->add_option("--boundary-weight", a.boundary_weight,
                   "Borders as GH97 6's penalty instead of exact: weight of the boundary constraint planes, "
                   "times the squared edge length (0 = off). Without it, border vertices stay on the input's "
-                  "borders (only ever at an input border vertex) and border corners are kept exactly")
+                  "border polylines (they may slide along them) and border corners (turns above 45 degrees) "
+                  "are kept exactly")
       ->each([&a](const std::string&) { a.penalty_border = true; })
       ->capture_default_str();
   sub->add_flag("--lock-border", a.lock_border, "Boundary vertices never move (nor are removed)");
@@ -64,7 +65,8 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
   sub->add_option("--lock-property", a.lock_property,
                   "Lock the vertices whose PLY vertex property (or scalar attribute) NAME is non-zero")
       ->type_name("NAME");
-  sub->add_option("--inversion", a.inversion, "Contractions that flip a face: forbid, penalize, or off (GH97 6)")
+  sub->add_option("--inversion", a.inversion, "Contractions that flip a face (turn it past --max-turn, or make it face away from its input "
+                  "face): forbid, penalize, or off (GH97 6)")
       ->check(CLI::IsMember(option_names<InversionPolicy>()))
       ->capture_default_str();
   sub->add_option("--max-turn", a.max_turn, "A face normal turning by more than this (degrees, < 90) is a flip")

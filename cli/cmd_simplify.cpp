@@ -267,7 +267,7 @@ const bool registered = register_command(10, [](CLI::App& app) {
                 "As --max-error, relative to the bounding-box diagonal; 0 = only contractions without error");
   g->add_option("--max-distance", args->max_distance,
                 "No output point farther than this from the input surface (model units): each contraction's "
-                "new faces are certified against the input (sampled, with the sample spacing accounted for) "
+                "new faces are certified against the input (adaptive subdivision, conservative) "
                 "and refused otherwise; the refit keeps it too. Alone: as few faces as the bound allows")
       ->check(CLI::PositiveNumber);
   g->add_option("--max-distance-rel", args->max_distance_rel, "As --max-distance, relative to the bounding-box diagonal")

@@ -130,9 +130,10 @@ struct SimplifyOptions {
   /// rank the contractions only; without, they are GH97's penalty and also pull the placement.
   double boundary_weight = 1;
   bool lock_border = false;  ///< boundary vertices never move
-  /// Open borders stay exact: a border vertex is only ever placed at an input border vertex (its
-  /// own or, along a border edge, its neighbour's), with bit-identical coordinates; border corners
-  /// (a turn above a few degrees, non-manifold edges) are never removed, and the refit does not
+  /// Open borders stay exact: a border vertex never leaves the input's border polylines (it stays,
+  /// or slides along its own polyline to the lowest-error point between the two ends of a border
+  /// edge); border corners (a turn above 45 degrees, border ends and junctions, non-manifold
+  /// edges) are never removed nor moved and keep bit-identical coordinates, and the refit does not
   /// move border vertices. false: GH97 §6's penalty alone (boundary_weight), the vertices may
   /// leave the border.
   bool exact_border = true;
