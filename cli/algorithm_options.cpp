@@ -34,10 +34,13 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
   sub->add_option("--threads", a.threads, "Threads for the passes: re-costing pairs, and making contractions region by region (0 = all; same result)")
       ->capture_default_str();
   sub->add_option("--boundary-weight", a.boundary_weight,
-                  "Penalty weight of the boundary constraint planes (GH97 6), times the squared edge length; "
-                  "0 = off")
+                  "Borders as GH97 6's penalty instead of exact: weight of the boundary constraint planes, "
+                  "times the squared edge length (0 = off). Without it, border vertices stay on the input's "
+                  "border polylines (they may slide along them) and border corners (turns above 45 degrees) "
+                  "are kept exactly")
+      ->each([&a](const std::string&) { a.penalty_border = true; })
       ->capture_default_str();
-  sub->add_flag("--lock-border", a.lock_border, "Boundary vertices never move");
+  sub->add_flag("--lock-border", a.lock_border, "Boundary vertices never move (nor are removed)");
   sub->add_option("--attribute-weight", a.attribute_weights,
                   "Weight of an attribute's error against distance, as KIND=W (normal, uv, color, scalar; "
                   "repeat or separate by commas): a difference of 1/W costs as much as one bounding-box "
@@ -62,7 +65,8 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
   sub->add_option("--lock-property", a.lock_property,
                   "Lock the vertices whose PLY vertex property (or scalar attribute) NAME is non-zero")
       ->type_name("NAME");
-  sub->add_option("--inversion", a.inversion, "Contractions that flip a face: forbid, penalize, or off (GH97 6)")
+  sub->add_option("--inversion", a.inversion, "Contractions that flip a face (turn it past --max-turn, or make it face away from its input "
+                  "face): forbid, penalize, or off (GH97 6)")
       ->check(CLI::IsMember(option_names<InversionPolicy>()))
       ->capture_default_str();
   sub->add_option("--max-turn", a.max_turn, "A face normal turning by more than this (degrees, < 90) is a flip")
@@ -132,6 +136,7 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
   opt.boundary_weight = a.boundary_weight;
   opt.max_normal_turn_degrees = a.max_turn;
   opt.lock_border = a.lock_border;
+  opt.exact_border = !a.penalty_border;
   opt.preserve_topology = !a.allow_non_manifold;
   opt.keep_components = !a.allow_vanishing;
   if (a.prune > 0 && a.prune_rel > 0) throw Error("give --prune or --prune-rel, not both");

@@ -26,6 +26,7 @@ struct SimplifyArgs {
   std::optional<std::size_t> faces, vertices;  // given as 0: as far as the checks allow
   std::optional<double> ratio;
   double max_error = -1, max_error_rel = -1;
+  double max_distance = -1, max_distance_rel = -1;
   AlgorithmArgs algorithm;
   bool ascii = false, json = false, quiet = false, force = false;
   bool double_values = false;  // --double
@@ -152,6 +153,8 @@ int run_simplify(const SimplifyArgs& a) {
   opt.as_far_as_possible = a.faces == 0u || a.ratio == 0.0 || a.vertices == 0u;
   if (a.max_error >= 0) opt.max_error = a.max_error;
   if (a.max_error_rel >= 0) opt.max_error = a.max_error_rel, opt.max_error_is_relative = true;
+  if (a.max_distance >= 0) opt.max_distance = a.max_distance;
+  if (a.max_distance_rel >= 0) opt.max_distance = a.max_distance_rel, opt.max_distance_is_relative = true;
   check_options(opt);  // before the input is read: a slip in the options is said at once
   // A document's primitives carry attributes (NORMAL, TEXCOORD_n...) as a rule: the default's light
   // refit is left out for them as for any mesh with attributes; --refit asks for it.
@@ -208,6 +211,7 @@ int run_simplify(const SimplifyArgs& a) {
         "\"load_s\":%s,\"simplify_s\":%s,\"simplify_cpu_s\":%s,\"write_s\":%s,\"total_s\":%s,"
         "\"peak_rss_mb\":%s,\"max_error\":%s,\"max_error_rel\":%s,\"contractions\":%zu,\"virtual_pairs\":%zu,"
         "\"rejected_topology\":%zu,\"rejected_inversion\":%zu,\"rejected_error\":%zu,\"rejected_component\":%zu,"
+        "\"rejected_distance\":%zu,\"output_to_input_distance\":%s,"
         "\"in_components\":%zu,\"out_components\":%zu,\"pruned_components\":%zu,\"refit_rounds\":%zu,"
         "\"refit_rms_before\":%s,\"refit_rms_after\":%s,\"dropped_degenerate\":%zu,\"dropped_duplicate\":%zu,"
         "\"stop\":\"%s\"}\n",
@@ -216,6 +220,7 @@ int run_simplify(const SimplifyArgs& a) {
         json_number(total.seconds()).c_str(), json_number(peak_rss_mb()).c_str(),
         json_number(r.max_error).c_str(), json_number(r.max_error_relative).c_str(), r.contractions,
         r.virtual_pairs, r.rejected_topology, r.rejected_inversion, r.rejected_error, r.rejected_component,
+        r.rejected_distance, json_number(r.output_to_input_distance).c_str(),
         r.input_components, r.output_components, r.pruned_components, r.refit_rounds,
         json_number(r.refit_rms_before).c_str(), json_number(r.refit_rms_after).c_str(),
         r.dropped_degenerate_faces, r.dropped_duplicate_faces, to_string(r.stop_reason));
@@ -230,6 +235,10 @@ int run_simplify(const SimplifyArgs& a) {
   if (!a.quiet && r.dropped_degenerate_faces + r.dropped_duplicate_faces > 0)
     std::fprintf(stderr, "qem: left out %zu degenerate and %zu duplicate input faces\n",
                  r.dropped_degenerate_faces, r.dropped_duplicate_faces);
+  if (!a.quiet && std::isfinite(opt.max_distance))
+    std::fprintf(stderr, "qem: distance from the output to the input %.4g (sampled; bound %.4g%s), %zu contractions refused for it\n",
+                 r.output_to_input_distance, opt.max_distance, opt.max_distance_is_relative ? " of the diagonal" : "",
+                 r.rejected_distance);
   if (!a.quiet && opt.refit_rounds > 0)
     std::fprintf(stderr, "qem: refit in %zu round%s: RMS distance of the input's vertices %.4g -> %.4g\n",
                  r.refit_rounds, r.refit_rounds == 1 ? "" : "s", r.refit_rms_before, r.refit_rms_after);
@@ -260,6 +269,13 @@ const bool registered = register_command(10, [](CLI::App& app) {
                 "0 = only contractions without error (flat, straight parts)");
   g->add_option("--max-error-rel", args->max_error_rel,
                 "As --max-error, relative to the bounding-box diagonal; 0 = only contractions without error");
+  g->add_option("--max-distance", args->max_distance,
+                "No output point farther than this from the input surface (model units): each contraction's "
+                "new faces are certified against the input (adaptive subdivision, conservative) "
+                "and refused otherwise; the refit keeps it too. Alone: as few faces as the bound allows")
+      ->check(CLI::PositiveNumber);
+  g->add_option("--max-distance-rel", args->max_distance_rel, "As --max-distance, relative to the bounding-box diagonal")
+      ->check(CLI::PositiveNumber);
   add_algorithm_options(sub, args->algorithm);
   sub->add_flag("--ascii", args->ascii, "Write PLY / STL as text instead of binary");
   sub->add_flag("--double", args->double_values, kDoubleOutputHelp);

@@ -5,9 +5,14 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <span>
 
+#include "core/distance_bound.h"
 #include "core/run.h"
 #include "core/settings.h"
+#include "geometry/box.h"
+#include "geometry/frame.h"
 #include "qem/error.h"
 #include "refit/refit_after_simplify.h"
 #include "refit/refit_points.h"
@@ -18,9 +23,13 @@ RefitOptions refit_options_for(const SimplifyOptions& options) {
   RefitOptions r;
   r.rounds = options.refit_rounds;
   r.points_per_vertex = options.refit_points_per_vertex;
-  r.lock_border = options.lock_border;
+  // Exact borders: the refit does not move border vertices either (sliding one along a curved
+  // border would take it off the input's polyline).
+  r.lock_border = options.lock_border || options.exact_border;
   r.max_normal_turn_degrees = options.max_normal_turn_degrees;
   r.threads = options.threads;
+  // max_distance in distance units (a relative one needs the input: simplify resolves it).
+  if (!options.max_distance_is_relative) r.max_distance = options.max_distance;
   return r;
 }
 
@@ -31,6 +40,32 @@ void check_options(const SimplifyOptions& options) {
 
 namespace {
 
+// The bounding-box diagonal of the vertices the faces use (the core's frame: relative options).
+double referenced_diagonal(std::span<const double> positions, std::span<const std::uint32_t> indices) {
+  BoxOfPoints box;
+  for (std::uint32_t v : indices) box.add(&positions[3 * std::size_t(v)]);
+  return frame_of_box(box.box()).scale;
+}
+
+// The largest distance from `approx` to the input surface over 15 samples of each face
+// (core/distance_bound.h), in distance units: what the bound reached.
+double sampled_distance(std::span<const double> positions, std::span<const std::uint32_t> indices, const Mesh& approx) {
+  BoxOfPoints box;
+  for (std::uint32_t v : indices) box.add(&positions[3 * std::size_t(v)]);
+  const Frame frame = frame_of_box(box.box());
+  const core::SurfaceDistance surface = refit_detail::surface_in_frame(positions, indices, frame);
+  const auto at = [&](std::uint32_t v) {
+    const double* p = &approx.positions[3 * std::size_t(v)];
+    return frame.to_frame({p[0], p[1], p[2]});
+  };
+  double most = 0;
+  for (std::size_t f = 0; f < approx.indices.size(); f += 3) {
+    const std::uint32_t* t = &approx.indices[f];
+    most = std::max(most, surface.triangle_sampled_max(at(t[0]), at(t[1]), at(t[2])));
+  }
+  return most * frame.scale;
+}
+
 // The refit of an output with attributes (wedges: the vertices of a seam share a position). It
 // fits the surface welded by position, so that the wedges of one position move together and no
 // crack opens; the positions that hold more than one wedge (UV seams, normal creases, colour and
@@ -39,7 +74,8 @@ namespace {
 // chart). The other vertices move with their values unchanged: moving the values along the
 // gradients of their attribute quadrics measured the same to four digits (docs/attributes.md).
 RefitResult refit_with_seams(const refit_detail::FitPoints& points, SimplifyResult& out, RefitOptions options,
-                             const std::vector<std::uint8_t>& locked, const core::WedgeRefitData& data) {
+                             const std::vector<std::uint8_t>& locked, const core::WedgeRefitData& data,
+                             const core::SurfaceDistance* surface) {
   Mesh& mesh = out.mesh;
   const std::size_t n = mesh.vertex_count();
   std::vector<std::uint32_t> order(n);
@@ -73,7 +109,7 @@ RefitResult refit_with_seams(const refit_detail::FitPoints& points, SimplifyResu
   for (std::uint32_t& v : near)
     if (v != SimplifyResult::kUnmapped) v = welded_of[v];
   options.fixed_vertices = fixed;
-  const RefitResult fit = refit_detail::refit_to_points(points, welded, options, near);
+  const RefitResult fit = refit_detail::refit_to_points(points, welded, options, near, surface);
   for (std::uint32_t v = 0; v < n; ++v)
     std::copy_n(&welded.positions[3 * std::size_t(welded_of[v])], 3, &mesh.positions[3 * std::size_t(v)]);
   return fit;
@@ -83,21 +119,35 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
                                   std::vector<std::uint32_t>* consumed_indices) {
   check_options(options);
   const bool refit = options.refit_rounds > 0;
-  // The refit fits the input's vertices weighted by their share of the area: taken before the
-  // core releases a consumed input's faces.
+  const bool bounded = std::isfinite(options.max_distance);
+  // The refit fits the input's vertices weighted by their share of the area, and its guard (and
+  // the distance bound's report) measures against the input's faces: taken before the core
+  // releases a consumed input's faces.
   std::vector<double> weights;
+  std::vector<std::uint32_t> kept_indices;
   core::RunHooks hooks;
   hooks.observer = observer;
   hooks.consumed_indices = consumed_indices;
   hooks.map_input_vertices = refit;
   core::WedgeRefitData wedge_refit;  // with attributes, for the refit
   if (refit && !input.attributes.empty()) hooks.wedge_refit = &wedge_refit;
-  if (refit) hooks.before_release = [&](MeshView in) { weights = refit_detail::vertex_areas(in); };
+  if (refit || bounded)
+    hooks.before_release = [&](MeshView in) {
+      if (refit) weights = refit_detail::vertex_areas(in);
+      kept_indices.assign(in.indices.begin(), in.indices.end());
+    };
   SimplifyResult out = core::run(input, options, hooks);
+  const std::span<const std::uint32_t> input_faces =
+      consumed_indices ? std::span<const std::uint32_t>(kept_indices) : input.indices;
+  // The frame of the refit and of the distance report: the input's referenced vertices' box.
+  double max_distance = options.max_distance;
+  if (bounded && options.max_distance_is_relative) max_distance *= referenced_diagonal(input.positions, input_faces);
   if (refit && out.contractions > 0 && out.stop_reason != StopReason::Cancelled) {
     if (!consumed_indices) weights = refit_detail::vertex_areas(input);
     const refit_detail::FitPoints points(input.positions, weights);
+    const core::SurfaceDistance surface = refit_detail::surface_in_frame(input.positions, input_faces, points.frame());
     RefitOptions refit_options = refit_options_for(options);
+    refit_options.max_distance = max_distance;
     std::vector<std::uint8_t> fixed;  // the locked vertices stay
     if (!options.vertex_lock.empty()) {
       fixed.assign(out.mesh.vertex_count(), 0);
@@ -105,14 +155,16 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
       refit_options.fixed_vertices = fixed;
     }
     // Its first search for each input vertex's closest face starts at the vertex it went into.
-    const RefitResult fit = out.mesh.attributes.empty()
-                                ? refit_detail::refit_to_points(points, out.mesh, refit_options, out.output_vertex_of_input)
-                                : refit_with_seams(points, out, refit_options, fixed, wedge_refit);
+    const RefitResult fit =
+        out.mesh.attributes.empty()
+            ? refit_detail::refit_to_points(points, out.mesh, refit_options, out.output_vertex_of_input, &surface)
+            : refit_with_seams(points, out, refit_options, fixed, wedge_refit, &surface);
     out.refit_rms_before = fit.rms_before;
     out.refit_rms_after = fit.rms_after;
     out.refit_rounds = fit.rounds;
   }
   if (!options.map_input_vertices) std::vector<std::uint32_t>().swap(out.output_vertex_of_input);
+  if (bounded) out.output_to_input_distance = sampled_distance(input.positions, input_faces, out.mesh);
   return out;
 }
 

@@ -63,6 +63,9 @@ SimplifyOptions low_target(Scheme scheme, unsigned threads) {
   o.scheme = scheme;
   o.threads = threads;
   o.greedy_below_faces = 0;  // passes (and their threads) to the end
+  // GH97's border penalty: under exact borders (the default) a patch's four corners are kept, so
+  // the patches could never contract away and the guard would have nothing to do.
+  o.exact_border = false;
   return o;
 }
 

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cstddef>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -37,6 +38,11 @@ struct RefitOptions {
   /// Per approximation vertex (empty: none), nonzero = it stays where it is (simplify passes its
   /// SimplifyOptions::vertex_lock through). The caller's buffer must outlive the call.
   std::span<const std::uint8_t> fixed_vertices;
+  /// No point of the approximation moves farther than this from the original's surface (distance
+  /// units; +inf = no bound beyond the guard below). Whatever it is, a move that takes a vertex or
+  /// a face centroid farther from the original than the approximation's largest such distance
+  /// before the refit (plus 2 % of it) is undone.
+  double max_distance = std::numeric_limits<double>::infinity();
 };
 
 struct RefitResult {

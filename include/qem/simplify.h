@@ -113,6 +113,12 @@ struct SimplifyOptions {
   /// weighted RMS distance from the new vertex to the planes it represents. +inf = no limit.
   double max_error = std::numeric_limits<double>::infinity();
   bool max_error_is_relative = false;  ///< max_error is a fraction of the bounding-box diagonal
+  /// A bound on the one-sided Hausdorff distance from the output to the input (distance units): no
+  /// point of an output face farther than this from the input surface. Each contraction's new
+  /// faces are certified against the input (src/core/distance_bound.h) and refused otherwise; the
+  /// refit keeps it too. Alone it is a stop criterion: as few faces as the bound allows. +inf = none.
+  double max_distance = std::numeric_limits<double>::infinity();
+  bool max_distance_is_relative = false;  ///< max_distance is a fraction of the bounding-box diagonal
 
   // --- the algorithm --------------------------------------------------------------------------
   Weighting weighting = Weighting::Area;
@@ -120,9 +126,17 @@ struct SimplifyOptions {
   /// Pair threshold t of GH97 §3.2: vertices closer than t are valid pairs too (0 = edges only).
   double threshold = 0;
   bool threshold_is_relative = false;  ///< threshold is a fraction of the bounding-box diagonal
-  /// Penalty weight of the boundary constraint planes (GH97 §6); 0 disables them.
+  /// Weight of the boundary constraint planes (GH97 §6); 0 disables them. With exact_border they
+  /// rank the contractions only; without, they are GH97's penalty and also pull the placement.
   double boundary_weight = 1;
   bool lock_border = false;  ///< boundary vertices never move
+  /// Open borders stay exact: a border vertex never leaves the input's border polylines (it stays,
+  /// or slides along its own polyline to the lowest-error point between the two ends of a border
+  /// edge); border corners (a turn above 45 degrees, border ends and junctions, non-manifold
+  /// edges) are never removed nor moved and keep bit-identical coordinates, and the refit does not
+  /// move border vertices. false: GH97 §6's penalty alone (boundary_weight), the vertices may
+  /// leave the border.
+  bool exact_border = true;
   /// Keep every connected component (vertex-connected, counted on the welded working mesh): a
   /// contraction that would leave a component with fewer than its floor of faces (a closed one 4,
   /// an open one 1, or as many as it has if fewer) is refused. Components that a threshold pair
@@ -193,6 +207,10 @@ struct SimplifyResult {
   std::size_t virtual_pairs = 0;    ///< non-edge pairs found with the threshold t
   /// Candidate contractions popped from the heap and refused (each may be retried later).
   std::size_t rejected_topology = 0, rejected_inversion = 0, rejected_error = 0;
+  std::size_t rejected_distance = 0;  ///< refused by max_distance
+  /// With max_distance: the largest distance from the output to the input over the certified
+  /// samples of every output face (after the refit), in distance units; at most max_distance.
+  double output_to_input_distance = 0;
   /// ... and refused because a connected component would have dropped below its floor
   /// (SimplifyOptions::keep_components).
   std::size_t rejected_component = 0;

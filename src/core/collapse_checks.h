@@ -11,7 +11,8 @@ namespace qem::core {
 
 /// GH97 §6 "preventing mesh inversion": a face around a or b (that survives the contraction) whose
 /// normal turns by more than the limit (cos_max_turn), or that would lose its area, forbids the
-/// contraction.
+/// contraction; so does one that would face away (more than 90 degrees) from the input face it
+/// descends from, which the per-contraction limit alone lets happen over several contractions.
 inline bool flips(const WorkingMesh& m, std::uint32_t a, std::uint32_t b, const Vec3& target, double cos_max_turn) {
   for (std::uint32_t end = 0; end < 2; ++end) {
     const std::uint32_t v = end == 0 ? a : b, other = end == 0 ? b : a;
@@ -25,6 +26,9 @@ inline bool flips(const WorkingMesh& m, std::uint32_t a, std::uint32_t b, const 
       if (!(la > 1e-24 * lb)) return true;
       const double d = dot(before, after);
       if (d <= 0 || d * d < cos_max_turn * cos_max_turn * la * lb) return true;
+      // Against its input face too: turns within the limit add up, contraction after
+      // contraction, until a face has folded over (a height field's face tilted past vertical).
+      if (!m.input_normal[f].none() && !(dot(after, m.input_normal[f].unpack()) > 0)) return true;
     }
   }
   return false;

@@ -9,6 +9,7 @@
 
 #include "core/component_guard.h"
 #include "core/contraction_map.h"
+#include "core/distance_bound.h"
 #include "core/pair_set.h"
 #include "core/quadric.h"
 #include "core/settings.h"
@@ -27,7 +28,8 @@ struct Worker {
   std::vector<std::uint32_t> dead_faces;    // input faces killed by the last contraction, if observed
   std::vector<std::pair<std::uint32_t, std::uint32_t>> wedge_map;  // removed wedge -> survivor's
   std::size_t faces_killed = 0, vertices_removed = 0, contractions = 0;
-  std::size_t blocked_topology = 0, blocked_inversion = 0, blocked_error = 0, blocked_component = 0;
+  std::size_t blocked_topology = 0, blocked_inversion = 0, blocked_error = 0, blocked_distance = 0;
+  std::size_t blocked_component = 0;
   double max_error = 0;  // in the working frame
   std::uint32_t last_kept = 0, last_removed = 0;  // of the last contraction made
 };
@@ -48,6 +50,7 @@ struct Context {
   double max_error = 0;      // largest contraction error made, working frame
   std::size_t next_progress = 0;
   Wedges* wedges = nullptr;  // with attributes only
+  const SurfaceDistance* surface = nullptr;  // the input, with max_distance only (distance_bound.h)
   ComponentGuard* components = nullptr;  // null: components may vanish (GH97 as published)
 
   bool done() const { return settings.reached(mesh); }
@@ -61,10 +64,11 @@ struct Context {
     totals.rejected_topology += w.blocked_topology;
     totals.rejected_inversion += w.blocked_inversion;
     totals.rejected_error += w.blocked_error;
+    totals.rejected_distance += w.blocked_distance;
     totals.rejected_component += w.blocked_component;
     max_error = std::max(max_error, w.max_error);
     w.faces_killed = w.vertices_removed = w.contractions = 0;
-    w.blocked_topology = w.blocked_inversion = w.blocked_error = w.blocked_component = 0;
+    w.blocked_topology = w.blocked_inversion = w.blocked_error = w.blocked_distance = w.blocked_component = 0;
   }
 
   /// Tells the observer the fraction done every few thousand contractions; false if it cancelled.

@@ -153,6 +153,7 @@ void contract(Context& c, Lists& lists, std::uint32_t p, const Quadric& q, const
   m.pos[a] = target;
   c.quadric[a] = q;
   m.boundary[a] |= m.boundary[b];
+  if (!m.corner.empty()) m.corner[a] |= m.corner[b];  // never set on b under exact borders
   ++w.vertices_removed;
   m.aggregated[a] |= m.aggregated[b] | c.pairs.pairs[p].is_virtual;
 
@@ -224,8 +225,17 @@ bool try_contract(Context& c, Lists& lists, std::uint32_t p, Worker& w) {
     ps.block(p);
     return false;
   }
+  // max_distance: the new faces certified against the input (checked last: the costliest).
+  if (c.surface && !contraction_within(*c.surface, c.settings.max_distance, c.mesh, a, b, placed.position)) {
+    ++w.blocked_distance;
+    ps.block(p);
+    return false;
+  }
   w.max_error = std::max(w.max_error, err);
   contract(c, lists, p, q, placed.position, w);
+  // Exact borders: where the survivor lies on the input's border (it slid, or took the place of
+  // the other end; an interior vertex that came to a border vertex takes that one's).
+  if (!c.mesh.border_spot.empty() && placed.spot.from != kNoSlot) c.mesh.border_spot[w.last_kept] = placed.spot;
   ++w.contractions;
   if (c.observe_contractions) report_contraction(c, err, w);
   return true;

@@ -1,14 +1,20 @@
 // Choosing the position of the vertex that replaces a contracted pair (GH97 §4).
 #pragma once
 
+#include "core/border_chains.h"
 #include "core/quadric.h"
 #include "qem/simplify.h"
 
 namespace qem::core {
 
 struct Placed {
+  Placed() = default;
+  Placed(const Vec3& at, double q_error, const BorderSpot& border_spot = {})
+      : position(at), error(q_error), spot(border_spot) {}
   Vec3 position;
   double error = 0;  ///< Q(position)
+  /// Under exact borders, a border vertex slid along its polyline: where (border_chains.h).
+  BorderSpot spot;
 };
 
 /// Places the contraction of (p1, p2) under quadric q according to `policy`.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <optional>
 
+#include "core/border_placement.h"
 #include "core/component_guard.h"
 #include "core/context.h"
 #include "core/fundamental_quadrics.h"
@@ -87,6 +88,11 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   Context c{settings, input, mesh, pairs, quadric, hooks.observer,
             hooks.observer && hooks.observer->wants_contractions(), map ? &*map : nullptr, {}, {}, result};
   if (wedges) c.wedges = &*wedges;
+  SurfaceDistance surface;  // the input surface, for max_distance (distance_bound.h)
+  if (std::isfinite(settings.max_distance)) {
+    surface = SurfaceDistance(live_face_corners(mesh));
+    c.surface = &surface;
+  }
   if (c.done()) {
     if (guard_counts) result.input_components = count_components(mesh);
     result.stop_reason = StopReason::AlreadyBelowTarget;
@@ -101,6 +107,7 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
       settings.threads, [&] { quadric = face_quadrics(mesh, settings.weighting); },
       [&] { edges = unique_edges(mesh.tri, mesh.vertex_faces, mesh.vertex_count()); });
   add_boundary_planes(mesh, edges, settings.boundary_weight, settings.weighting, quadric);  // GH97 §6
+  if (settings.exact_border) mark_border_corners(mesh, edges);
   if (wedges) add_seam_planes(mesh, edges, options.attribute_weights.seam, settings.weighting, quadric);
   pairs = select_pairs(mesh, std::move(edges), settings.threshold);                         // GH97 §3.2
   result.virtual_pairs = pairs.virtual_count;

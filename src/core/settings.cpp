@@ -11,11 +11,12 @@ namespace qem::core {
 
 void validate(const SimplifyOptions& o) {
   const bool any = o.target_faces > 0 || o.target_ratio > 0 || o.target_vertices > 0 || std::isfinite(o.max_error) ||
-                   o.as_far_as_possible;
+                   std::isfinite(o.max_distance) || o.as_far_as_possible;
   if (o.target_ratio < 0 || o.target_ratio > 1 || std::isnan(o.target_ratio))
     throw Error("target ratio must be in [0, 1] (0: unused)");
   if (std::isfinite(o.max_error) && o.max_error < 0) throw Error("max error must not be negative");
   if (std::isnan(o.max_error)) throw Error("max error must be a number");
+  if (!(o.max_distance > 0)) throw Error("max distance must be positive");
   if (!any)
     throw Error(
         "no stop criterion: give a face, ratio, vertex or error target (a face, ratio or vertex target of 0: as far "
@@ -39,11 +40,15 @@ Settings resolve(const SimplifyOptions& o, const WorkingMesh& mesh) {
   s.target_vertices = o.target_vertices;
   s.max_error = std::numeric_limits<double>::infinity();
   if (std::isfinite(o.max_error)) s.max_error = o.max_error_is_relative ? o.max_error : o.max_error / mesh.frame.scale;
+  s.max_distance = std::numeric_limits<double>::infinity();
+  if (std::isfinite(o.max_distance))
+    s.max_distance = o.max_distance_is_relative ? o.max_distance : o.max_distance / mesh.frame.scale;
   s.weighting = o.weighting;
   s.placement = o.placement;
   s.threshold = o.threshold_is_relative ? o.threshold : o.threshold / mesh.frame.scale;
   s.boundary_weight = o.boundary_weight;
   s.lock_border = o.lock_border;
+  s.exact_border = o.exact_border;
   s.inversion = o.inversion;
   s.cos_max_turn = std::cos(o.max_normal_turn_degrees * 3.14159265358979323846 / 180.0);
   s.preserve_topology = o.preserve_topology;
@@ -62,6 +67,7 @@ std::string stop_detail(StopReason reason, const SimplifyResult& r, bool lock_bo
     case StopReason::NoValidPair:
       return "no valid contraction left (" + std::to_string(r.rejected_topology) + " rejected for topology, " +
              std::to_string(r.rejected_inversion) + " for face inversion" +
+             (r.rejected_distance > 0 ? ", " + std::to_string(r.rejected_distance) + " for the distance bound" : "") +
              (r.rejected_component > 0 ? ", " + std::to_string(r.rejected_component) + " to keep components" : "") +
              (lock_border ? ", border locked" : "") + ")";
     case StopReason::AlreadyBelowTarget: return "the input already meets the target";

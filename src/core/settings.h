@@ -14,12 +14,14 @@ struct Settings {
   // --- stop criteria (the first reached wins) ---
   std::size_t target_faces = 0, target_vertices = 0;
   double max_error = 0;  ///< contraction error limit in the working frame (+inf: none)
+  double max_distance = 0;  ///< SimplifyOptions::max_distance in the working frame (+inf: none)
   // --- the rules ---
   Weighting weighting = Weighting::Area;
   Placement placement = Placement::Optimal;
   double threshold = 0;       ///< GH97 §3.2's t in the working frame
   double boundary_weight = 1;
   bool lock_border = false;
+  bool exact_border = true;   ///< border_placement.h
   InversionPolicy inversion = InversionPolicy::Forbid;
   double cos_max_turn = 0;    ///< cosine of the largest normal turn of a surviving face (GH97 §6)
   bool preserve_topology = true;

@@ -8,12 +8,16 @@ bool place_with_wedges(const Context& c, std::uint32_t a, std::uint32_t b, const
   std::vector<std::pair<std::uint32_t, std::uint32_t>> map;
   std::vector<std::uint32_t> partners;
   bool found = false;
+  const BorderTarget border = border_target(c, a, b);  // exact borders (border_placement.h)
+  if (border == BorderTarget::Never) return false;
   for (int direction = 0; direction < 2; ++direction) {
     const std::uint32_t survivor = direction == 0 ? a : b, removed = direction == 0 ? b : a;
     if (m.held(removed, c.settings.lock_border)) continue;  // locked: it must stay
+    if ((border == BorderTarget::AtA && survivor != a) || (border == BorderTarget::AtB && survivor != b)) continue;
     bool crossed = false;
     if (!map_wedges(m, wg, survivor, removed, map, &crossed)) continue;
-    const bool free = wg.single(a) && wg.single(b) && !m.held(survivor, c.settings.lock_border);
+    const bool free = wg.single(a) && wg.single(b) && !m.held(survivor, c.settings.lock_border) &&
+                      border == BorderTarget::Free;
     Quadric total = q;
     double crossing_error = 0;  // a crossing whose survivor stays: its wedges keep their values
     std::uint32_t w = wg.first[survivor];

@@ -156,6 +156,11 @@ WorkingMesh prepare_input(MeshView in, std::vector<std::uint32_t>* internal_out)
   const std::size_t n = m.pos.size();
   m.faces_alive = m.face_source.size();
   m.face_alive.assign(m.faces_alive, 1);
+  m.input_normal.resize(m.faces_alive);
+  for (std::uint32_t f = 0; f < m.faces_alive; ++f) {
+    const std::uint32_t* t = m.face(f);
+    m.input_normal[f] = PackedNormal::pack(cross(m.pos[t[1]] - m.pos[t[0]], m.pos[t[2]] - m.pos[t[0]]));
+  }
   m.vertices_alive = n;
   m.moved.assign(n, 0);
   m.boundary.assign(n, 0);
@@ -178,9 +183,10 @@ void WorkingMesh::squeeze_faces(const std::vector<std::uint32_t>& vertex_to) {
     for (int k = 0; k < 3; ++k) tri[3 * next + k] = vertex_to[tri[3 * f + k]];
     if (!corner_wedge.empty())
       for (int k = 0; k < 3; ++k) corner_wedge[3 * next + k] = corner_wedge[3 * f + k];
+    input_normal[next] = input_normal[f];
     face_source[next++] = face_source[f];
   }
-  tri.resize(3 * next), face_source.resize(next);
+  tri.resize(3 * next), face_source.resize(next), input_normal.resize(next);
   if (!corner_wedge.empty()) corner_wedge.resize(3 * next);
   face_alive.assign(next, 1);
 }
@@ -188,6 +194,8 @@ void WorkingMesh::squeeze_faces(const std::vector<std::uint32_t>& vertex_to) {
 void WorkingMesh::squeeze_vertices(const std::vector<std::uint32_t>& vertex_to, std::size_t count) {
   squeeze_by(vertex_to, count, pos);
   squeeze_by(vertex_to, count, boundary);
+  if (!corner.empty()) squeeze_by(vertex_to, count, corner);
+  if (!border_spot.empty()) squeeze_by(vertex_to, count, border_spot);
   squeeze_by(vertex_to, count, moved);
   squeeze_by(vertex_to, count, aggregated);
   squeeze_by(vertex_to, count, source_vertex);

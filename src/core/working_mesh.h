@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/border_chains.h"
+#include "core/packed_normal.h"
 #include "core/quadric.h"
 #include "core/vertex_lists.h"
 #include "geometry/frame.h"
@@ -26,9 +28,18 @@ struct WorkingMesh {
   std::vector<std::uint32_t> corner_wedge;   ///< with attributes, 3 per working face (wedges.h)
   std::vector<std::uint8_t> face_alive;
   std::vector<std::uint32_t> face_source;    ///< input face of each working face
+  /// The normal of each working face's input face (collapse_checks.h: no face may come to face
+  /// away from it).
+  std::vector<PackedNormal> input_normal;
   std::vector<std::uint32_t> source_vertex;  ///< input vertex of each working vertex
   std::vector<std::uint8_t> moved;           ///< left its input position (else written back exactly)
   std::vector<std::uint8_t> boundary;        ///< on a border edge (GH97 §6), inherited through merges
+  /// Under exact borders, never removed and never moved (border_placement.h); empty otherwise.
+  std::vector<std::uint8_t> corner;
+  /// Under exact borders: the input's border polylines, and where on them each vertex lies
+  /// (border_chains.h; a vertex off the borders has none); empty otherwise.
+  BorderChains chains;
+  std::vector<BorderSpot> border_spot;
   /// Set on both ends of a contracted threshold pair and inherited through merges: an aggregation
   /// joint, non-manifold by design (GH97 §3.2), where the link condition does not apply.
   std::vector<std::uint8_t> aggregated;

@@ -37,6 +37,9 @@ class TriangleBvh {
   /// Appends to `out` the (input) index of every triangle within sqrt(max_d2) of `p`, in no order.
   void within(const double p[3], double max_d2, std::vector<std::uint32_t>& out) const;
 
+  /// The 9 coordinates of (input) triangle `id`.
+  const double* triangle(std::uint32_t id) const { return &tris_[9 * std::size_t(slot_of_[id])]; }
+
   std::size_t triangle_count() const { return ids_.size(); }
   std::size_t node_count() const { return nodes_.size(); }
   bool empty() const { return ids_.empty(); }

@@ -2,7 +2,10 @@
 //
 // One round, in a frame normalised to the bounding-box diagonal (so nothing depends on scale or
 // position):
-//   project   each original vertex p_i (weight w_i, its area share; with points_per_vertex, every
+//   project   (with the original's surface: a point farther from its closest face than
+//             kFarHausdorff times the approximation's largest distance to the original stands for
+//             surface the simplification removed, not for this face: it does not pull)
+//             each original vertex p_i (weight w_i, its area share; with points_per_vertex, every
 //             k-th along the Morton order, carrying the area of its run of k) onto its closest
 //             approximation face t_i, at barycentric coordinates b_i: first a bounding volume
 //             hierarchy query, or, after `simplify`, a walk from the output vertex the point was
@@ -20,7 +23,12 @@
 //             (no vertex jumps off alone to fit a few points), and the anchor holds vertices no
 //             point reaches;
 //   guard     a face whose normal turned by more than the limit undoes its vertices' moves, until
-//             none does (GH97 §6: the refit never folds the surface);
+//             none does (GH97 §6: the refit never folds the surface); with the original's
+//             surface, a moved vertex or face centroid farther from it than the approximation's
+//             largest such distance before the refit (plus kHausdorffMargin of it) undoes its
+//             moves too, as does a face no longer certified within max_distance: the refit never
+//             raises the one-sided Hausdorff distance (approximation to original, over those
+//             samples) by more than the margin, and never breaks the distance bound;
 //   keep      the round only if the fit's error went down; else undo it and stop.
 #include <algorithm>
 #include <cmath>
@@ -29,6 +37,7 @@
 #include <string>
 
 #include "check_mesh.h"
+#include "core/distance_bound.h"
 #include "core/parallel_chunks.h"
 #include "core/spatial_order.h"
 #include "core/valid_pairs.h"
@@ -59,6 +68,17 @@ constexpr double kAnchor = 1e-3;
 /// E; 0.3 keeps it close to the unrefitted output's (docs/benchmarks.md: "Measurements behind the
 /// code", "Tried and dropped").
 constexpr double kMembrane = 0.3;
+/// A point farther from the approximation than this many times the approximation's largest
+/// distance to the original (over its vertices and face centroids, before the refit) pulls
+/// nothing: its surface was contracted away (a spike, a thin part, a vanished component), and
+/// fitting the survivor to it moves the survivor off the original (issue 21: up to 7 % of the
+/// diagonal). Where the surface survived, the original lies about as far from the approximation
+/// as the approximation from the original. (A bound relative to the faces' edge lengths, tried
+/// first, also cut off the points a crude approximation should be pulled to.)
+constexpr double kFarHausdorff = 2;
+/// The refit may raise the sampled one-sided Hausdorff distance (approximation to original, over
+/// vertices and face centroids) by at most this fraction of its value before the refit.
+constexpr double kHausdorffMargin = 0.02;
 
 Vec3 at(const std::vector<double>& x, std::uint32_t v) { return {x[3 * v], x[3 * v + 1], x[3 * v + 2]}; }
 
@@ -205,13 +225,15 @@ void conjugate_gradients(const SparseRows& a, const std::vector<double>& b, std:
 class Refitter {
  public:
   Refitter(const FitPoints& points, Mesh& approx, const RefitOptions& o,
-           std::span<const std::uint32_t> near_vertex)
+           std::span<const std::uint32_t> near_vertex, const core::SurfaceDistance* surface)
       : approx_(approx),
         opt_(o),
         tri_(approx.indices),
         pts_(points),
         near_vertex_(near_vertex),
-        frame_(points.frame()) {
+        frame_(points.frame()),
+        surface_(surface && !surface->empty() ? surface : nullptr),
+        max_distance_(o.max_distance / points.frame().scale) {
     if (pts_.weight.empty() || approx.indices.empty()) return;
     x_.resize(approx.positions.size());
     for (std::size_t v = 0; v < approx.vertex_count(); ++v) {
@@ -244,12 +266,18 @@ class Refitter {
     RefitResult r;
     if (!ready_) return r;
     const std::vector<double> start = x_;
+    if (surface_) {
+      const double h0 = largest_distance(x_);
+      limit_ = h0 * (1 + kHausdorffMargin) + 1e-12;  // 1e-12: rounding, of the diagonal
+      far_ = kFarHausdorff * h0 + 1e-12;
+    }
     Projection proj = project(x_);
     r.rms_before = r.rms_after = std::sqrt(proj.energy / pts_.total_weight) * frame_.scale;
     for (unsigned round = 0; round < opt_.rounds; ++round) {
       std::vector<double> next;
       if (!solve(proj, next)) break;
-      const std::size_t held = hold_turned_faces(next);
+      std::size_t held = hold_turned_faces(next);
+      if (surface_) held += hold_far_from_original(next);
       Projection next_proj = project(next, &proj);
       if (!(next_proj.energy < proj.energy)) break;
       x_ = std::move(next);
@@ -270,7 +298,7 @@ class Refitter {
   }
 
  private:
-  // Border vertices: on an edge that only one face has, found as the simplifier finds them
+  // Border vertices: on an edge that only one face has (or more than two), found as the simplifier finds them
   // (core::unique_edges), so that --lock-border holds the same vertices in both.
   void mark_border() {
     core::VertexLists faces;
@@ -278,7 +306,7 @@ class Refitter {
       for (std::size_t c = 0; c < tri_.size(); ++c) emit(tri_[c], std::uint32_t(c / 3));
     });
     for (const core::Edge& e : core::unique_edges(tri_, faces, fixed_.size()))
-      if (e.faces == 1) fixed_[e.lo] = fixed_[e.hi] = 1;
+      if (e.faces != 2) fixed_[e.lo] = fixed_[e.hi] = 1;  // non-manifold edges too: where sheets meet
   }
 
   // Where each point lands on the approximation with vertices x. The first projection asks a tree
@@ -321,6 +349,7 @@ class Refitter {
                          p.nearest[j] = hit.triangle;
                          d2[j] = hit.d2;  // counted in the error even when the face cannot pull
                          const std::uint32_t* t = &tri_[3 * std::size_t(hit.triangle)];
+                         if (hit.d2 > far_ * far_) continue;  // surface that vanished
                          if (!barycentric({hit.point[0], hit.point[1], hit.point[2]}, at(x, t[0]),
                                           at(x, t[1]), at(x, t[2]), &p.bary[3 * j]))
                            continue;  // a face without area pulls nothing (it cannot be solved for)
@@ -510,6 +539,65 @@ class Refitter {
     return true;
   }
 
+  // The largest distance to the original over the vertices and face centroids of x.
+  double largest_distance(const std::vector<double>& x) const {
+    const std::size_t n = approx_.vertex_count(), nf = tri_.size() / 3;
+    std::vector<double> most(n + nf, 0.0);
+    core::for_chunks(n + nf, kChunk, core::resolve_threads(opt_.threads), [&](std::size_t, std::size_t begin, std::size_t end) {
+      std::uint32_t hint = UINT32_MAX;
+      for (std::size_t i = begin; i < end; ++i) most[i] = surface_->distance(sample(x, i), &hint);
+    });
+    return most.empty() ? 0.0 : *std::max_element(most.begin(), most.end());
+  }
+
+  // Sample i of x: vertex i, or the centroid of face i - vertex count.
+  Vec3 sample(const std::vector<double>& x, std::size_t i) const {
+    const std::size_t n = approx_.vertex_count();
+    if (i < n) return at(x, std::uint32_t(i));
+    const std::uint32_t* t = &tri_[3 * (i - n)];
+    return (1.0 / 3) * (at(x, t[0]) + at(x, t[1]) + at(x, t[2]));
+  }
+
+  // Undoes the moves that take a vertex or a face centroid farther from the original than limit_,
+  // or a face out of max_distance, until none does (each sweep that finds one undoes at least one
+  // move). Returns the vertices held.
+  std::size_t hold_far_from_original(std::vector<double>& next) const {
+    const std::size_t n = approx_.vertex_count(), nf = tri_.size() / 3;
+    const auto moved = [&](std::uint32_t v) {
+      return next[3 * v] != x_[3 * v] || next[3 * v + 1] != x_[3 * v + 1] || next[3 * v + 2] != x_[3 * v + 2];
+    };
+    std::size_t count = 0;
+    std::vector<std::uint8_t> bad(n + nf);
+    for (bool again = true; again;) {
+      again = false;
+      core::for_chunks(n + nf, kChunk, core::resolve_threads(opt_.threads), [&](std::size_t, std::size_t begin, std::size_t end) {
+        std::uint32_t hint = UINT32_MAX;
+        for (std::size_t i = begin; i < end; ++i) {
+          bad[i] = 0;
+          const std::uint32_t* t = i < n ? nullptr : &tri_[3 * (i - n)];
+          if (t ? !(moved(t[0]) || moved(t[1]) || moved(t[2])) : !moved(std::uint32_t(i))) continue;
+          bad[i] = surface_->distance(sample(next, i), &hint) > limit_ ||
+                   (t && std::isfinite(max_distance_) &&
+                    !surface_->triangle_within(at(next, t[0]), at(next, t[1]), at(next, t[2]), max_distance_));
+        }
+      });
+      const auto undo = [&](std::uint32_t v) {
+        if (!moved(v)) return;
+        for (int k = 0; k < 3; ++k) next[3 * v + k] = x_[3 * v + k];
+        ++count, again = true;
+      };
+      for (std::size_t i = 0; i < n + nf; ++i) {
+        if (!bad[i]) continue;
+        if (i < n) {
+          undo(std::uint32_t(i));
+        } else {
+          for (int k = 0; k < 3; ++k) undo(tri_[3 * (i - n) + k]);
+        }
+      }
+    }
+    return count;
+  }
+
   // Undoes the moves of the vertices of every face that turned too far, until none does. Ends:
   // each sweep that finds a face undoes at least one move, and with every move undone nothing turns.
   std::size_t hold_turned_faces(std::vector<double>& next) const {
@@ -540,6 +628,10 @@ class Refitter {
   const FitPoints& pts_;
   std::span<const std::uint32_t> near_vertex_;
   const Frame frame_;      // of the points: x_ = frame_.to_frame(approx_'s positions)
+  const core::SurfaceDistance* surface_;  // the original, in frame_ (null: no distance guard)
+  const double max_distance_;             // RefitOptions::max_distance in frame_
+  double limit_ = HUGE_VAL;               // a sample may not move farther than this from the original
+  double far_ = HUGE_VAL;                 // a point farther than this from the approximation pulls nothing
   std::vector<double> x_;  // approximation vertices, normalised
   std::vector<std::uint8_t> fixed_;
   std::vector<std::uint32_t> ring_start_, ring_faces_;  // faces around each vertex
@@ -572,15 +664,26 @@ void check_options(const RefitOptions& options) {
     throw Error("refit: the points per vertex must be 0 (all) or a positive number");
 }
 
+core::SurfaceDistance surface_in_frame(std::span<const double> positions, std::span<const std::uint32_t> indices,
+                                       const Frame& frame) {
+  std::vector<double> corners(3 * indices.size());
+  for (std::size_t c = 0; c < indices.size(); ++c) {
+    const double* p = &positions[3 * std::size_t(indices[c])];
+    const Vec3 q = frame.to_frame({p[0], p[1], p[2]});
+    corners[3 * c] = q.x, corners[3 * c + 1] = q.y, corners[3 * c + 2] = q.z;
+  }
+  return core::SurfaceDistance(corners);
+}
+
 RefitResult refit_to_points(const FitPoints& points, Mesh& approx, const RefitOptions& options,
-                            std::span<const std::uint32_t> near_vertex) {
+                            std::span<const std::uint32_t> near_vertex, const core::SurfaceDistance* surface) {
   // points_per_vertex: one point for each run of `group` (fewer than one point wanted: one run).
   const double wanted = options.points_per_vertex * double(approx.vertex_count());
   const std::size_t n = points.weight.size();
   std::size_t group = 0;  // 0 or 1: every point
   if (wanted > 0) group = wanted <= 1 ? n : std::size_t(double(n) / wanted);
   const FitPoints sample = group >= 2 ? points.thinned(group) : FitPoints{};
-  Refitter refitter(group >= 2 ? sample : points, approx, options, near_vertex);
+  Refitter refitter(group >= 2 ? sample : points, approx, options, near_vertex, surface);
   return refitter.run();
 }
 
@@ -594,9 +697,11 @@ std::vector<RefitResult> refit(MeshView original, std::span<Mesh* const> approxi
   for (const Mesh* approx : approximations) check_mesh(*approx, "approximation");
   const std::vector<double> weights = refit_detail::vertex_areas(original);
   const refit_detail::FitPoints points(original.positions, weights);
+  const core::SurfaceDistance surface =
+      refit_detail::surface_in_frame(original.positions, original.indices, points.frame());
   std::vector<RefitResult> results;
   for (Mesh* approx : approximations)
-    results.push_back(refit_detail::refit_to_points(points, *approx, options));
+    results.push_back(refit_detail::refit_to_points(points, *approx, options, {}, &surface));
   return results;
 }
 

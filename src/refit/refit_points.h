@@ -6,6 +6,7 @@
 #include <span>
 #include <vector>
 
+#include "core/distance_bound.h"
 #include "geometry/frame.h"
 #include "geometry/vec3.h"
 #include "qem/mesh.h"
@@ -46,7 +47,15 @@ void check_options(const RefitOptions& options);
 /// points. `near_vertex` (optional), per point given to FitPoints: a vertex of `approx` near it
 /// (UINT32_MAX: none), such as the output vertex `simplify` contracted it into; the first search
 /// for its closest face walks from there instead of asking a tree of all faces.
+/// `surface` (optional): the original's surface in the points' frame (surface_in_frame), for the
+/// guard that keeps the approximation as close to the original as it was (and within
+/// options.max_distance).
 RefitResult refit_to_points(const FitPoints& points, Mesh& approx, const RefitOptions& options,
-                            std::span<const std::uint32_t> near_vertex = {});
+                            std::span<const std::uint32_t> near_vertex = {},
+                            const core::SurfaceDistance* surface = nullptr);
+
+/// The surface of an original (positions, triangle indices) in `frame` (FitPoints::frame()).
+core::SurfaceDistance surface_in_frame(std::span<const double> positions, std::span<const std::uint32_t> indices,
+                                       const Frame& frame);
 
 }  // namespace qem::refit_detail

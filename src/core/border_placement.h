@@ -1,0 +1,88 @@
+// Exact borders (the default; SimplifyOptions::exact_border): an open border's vertices never
+// leave the input's border polylines. GH97 §6's border planes are a penalty that the optimal
+// placement trades against the faces' planes, so a border vertex drifts off its border and off
+// the plane of a flat patch; tiles simplified one by one then no longer meet. Here the planes
+// still rank the contractions (they say what cutting a curved border costs), but a contraction
+// that involves a border vertex is placed on the input's border (border_chains.h):
+//   - a border vertex and an interior one: at the border vertex;
+//   - the two ends of a border edge: at the minimiser of the quadric restricted to the input
+//     border between them (each input border edge of that stretch, GH97 §4's segment placement
+//     on each), or at either end, whichever has the lowest error and turns no face by more than
+//     the inversion limit (the next lowest otherwise): a border vertex slides along its own
+//     polyline, and one that stays or lands on another's place keeps bit-identical coordinates;
+//   - two border vertices that do not share a border edge: never (it would join two stretches of
+//     border across the surface);
+//   - a corner (where the border turns by more than kCornerDegrees, where the border is not a
+//     simple chain, or on a non-manifold edge) is never removed nor moved: its pairs are placed
+//     at it, two corners never contract together, and no vertex slides past one.
+// Locked vertices (vertex_lock, --lock-border) count as corners.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "core/context.h"
+#include "core/placement.h"
+#include "core/valid_pairs.h"
+#include "core/working_mesh.h"
+
+namespace qem::core {
+
+/// A border vertex whose two border edges turn by more than this (degrees) is a corner: kept
+/// exactly. A square's, a rectangle's or a hexagon's corners are kept; a polygon of 8 or more
+/// sides is a curve, free to lose vertices. Smaller angles froze whole borders: scanned borders
+/// are jagged, and small holes are polygons of a dozen sides; at 20 degrees plane_holes.obj
+/// (27 holes) could not go below 391 faces and its E at 1 % was 40 times GH97's penalty's
+/// (docs/benchmarks.md, "Borders").
+inline constexpr double kCornerDegrees = 45;
+
+/// A border vertex slides at most this many input border edges per contraction (the stretch
+/// between the two ends is walked edge by edge); a longer stretch is placed at either end.
+inline constexpr std::size_t kMaxBorderWalk = 4096;
+
+/// Marks mesh.corner from the input's unique edges (with face counts): ends of non-manifold
+/// edges, border vertices with other than two border edges, and border turns above kCornerDegrees;
+/// and builds mesh.chains and mesh.border_spot (each border vertex at its own slot).
+void mark_border_corners(WorkingMesh& mesh, const std::vector<Edge>& edges);
+
+/// The placement of border edge (a, b) whose ends may both move (BorderTarget::AtEither): the
+/// lowest-error non-flipping point of the input border between them, ends included (above).
+void place_along_border(const Context& c, std::uint32_t a, std::uint32_t b, const Quadric& q, Placed& placed);
+
+/// Where the contraction of (a, b) may go under exact borders.
+enum class BorderTarget : std::uint8_t { Free, AtA, AtB, AtEither, Never };
+
+namespace border_detail {
+enum class Role : std::uint8_t { Free, Border, Fixed };
+inline Role role(const Context& c, std::uint32_t v) {
+  const WorkingMesh& m = c.mesh;
+  if (m.corner[v] || m.held(v, c.settings.lock_border)) return Role::Fixed;
+  return m.boundary[v] ? Role::Border : Role::Free;
+}
+/// Exactly one live face has both a and b: (a, b) is an edge of the current border.
+inline bool is_border_edge(const WorkingMesh& m, std::uint32_t a, std::uint32_t b) {
+  int shared = 0;
+  for (std::uint32_t f : m.vertex_faces[a])
+    if (m.face_alive[f] && m.face_has(f, b)) ++shared;
+  return shared == 1;
+}
+}  // namespace border_detail
+
+/// The rule above for pair (a, b); Free when exact borders are off or neither end is on a border.
+inline BorderTarget border_target(const Context& c, std::uint32_t a, std::uint32_t b) {
+  using border_detail::Role;
+  if (!c.settings.exact_border) return BorderTarget::Free;
+  const Role ra = border_detail::role(c, a), rb = border_detail::role(c, b);
+  if (ra == Role::Free && rb == Role::Free) return BorderTarget::Free;
+  if (ra == Role::Fixed && rb == Role::Fixed) return BorderTarget::Never;
+  if (ra == Role::Free) return BorderTarget::AtB;
+  if (rb == Role::Free) return BorderTarget::AtA;
+  // Both on a border: only along one of its edges.
+  if (!border_detail::is_border_edge(c.mesh, a, b)) return BorderTarget::Never;
+  if (ra == Role::Fixed) return BorderTarget::AtA;
+  if (rb == Role::Fixed) return BorderTarget::AtB;
+  return BorderTarget::AtEither;
+}
+
+}  // namespace qem::core

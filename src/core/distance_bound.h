@@ -1,0 +1,64 @@
+// SimplifyOptions::max_distance: no output point farther than D from the input surface, checked
+// on each contraction's new faces against a bounding volume hierarchy of the input (as CGAL's
+// bounded-distance placement does for the new vertex, but here for every point of the faces).
+//
+// The check is exact in what it accepts (a certificate, never a guess) and adaptive in its work:
+// for a triangle (or a piece of it), let m be its centroid, T the input triangle closest to m,
+// and R the farthest corner's distance from m.
+//   - the distance to a fixed surface is 1-Lipschitz, so if d(m) + R <= D the piece lies within D;
+//   - the distance to the one triangle T is convex, so its largest value over the piece is at a
+//     corner; the surface is at least as close as T, so if every corner is within D of T, the
+//     whole piece is within D of the surface;
+//   - if d(m) > D, the piece is not within D;
+//   - else the piece splits into four at its edges' midpoints, down to kMaxDepth levels (4^6
+//     pieces at most); a piece still undecided there counts as too far (the contraction is
+//     refused: conservative).
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "core/working_mesh.h"
+#include "geometry/vec3.h"
+#include "measure/bvh.h"
+
+namespace qem::core {
+
+inline constexpr int kMaxDepth = 6;
+
+class SurfaceDistance {
+ public:
+  SurfaceDistance() = default;
+  /// `corners`: 9 doubles per triangle of the surface (a.xyz b.xyz c.xyz).
+  explicit SurfaceDistance(const std::vector<double>& corners) : tree_(corners) {}
+  bool empty() const { return tree_.empty(); }
+
+  /// Distance from p to the surface; `hint` as TriangleBvh::closest (warm start).
+  double distance(const Vec3& p, std::uint32_t* hint) const {
+    const double q[3] = {p.x, p.y, p.z};
+    return std::sqrt(tree_.closest(q, hint).d2);
+  }
+  /// Whether every point of triangle abc is certified within d of the surface (see above).
+  bool triangle_within(const Vec3& a, const Vec3& b, const Vec3& c, double d) const {
+    return piece_within(a, b, c, d, 0);
+  }
+  /// The largest distance to the surface over the corners, edge midpoints and centroid of abc
+  /// and of its four halves-by-edge (a lower bound of the triangle's largest distance).
+  double triangle_sampled_max(const Vec3& a, const Vec3& b, const Vec3& c) const;
+
+ private:
+  bool piece_within(const Vec3& a, const Vec3& b, const Vec3& c, double d, int depth) const;
+
+  measure_detail::TriangleBvh tree_;
+};
+
+/// The corners of the live faces of `mesh` (9 doubles per face), for a SurfaceDistance.
+std::vector<double> live_face_corners(const WorkingMesh& mesh);
+
+/// Whether contracting (a, b) to `target` keeps every new face (the faces of a and b that do not
+/// have both) certified within d of the surface.
+bool contraction_within(const SurfaceDistance& surface, double d, const WorkingMesh& mesh, std::uint32_t a,
+                        std::uint32_t b, const Vec3& target);
+
+}  // namespace qem::core
