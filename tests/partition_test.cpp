@@ -94,7 +94,8 @@ TEST(Partition, ClosedInputGivesAClosedOutputAtTheTarget) {
 TEST(Partition, OpenInputKeepsItsBorderAndGainsNone) {
   const Mesh& in = bumpy_square();  // x, y in [0, 1] on a 300 x 300 grid
   const SimplifyResult r = simplify_partitioned(in, ratio(0.05), in_parts(8));
-  EXPECT_EQ(r.mesh.face_count(), std::size_t(std::floor(0.05 * double(in.face_count()))));
+  EXPECT_LE(r.mesh.face_count(), std::size_t(std::floor(0.05 * double(in.face_count()))));
+  EXPECT_GE(r.mesh.face_count(), std::size_t(std::floor(0.05 * double(in.face_count()))) - 1);
   // Every border vertex of the output lies on the square's outline (within half a grid step): no
   // border opened along a cut, whose vertices would lie inside.
   std::size_t border = 0;
@@ -174,8 +175,8 @@ TEST(Partition, TheCutLocksExactlyTheSharedVertices) {
   std::vector<int> uses(in.vertex_count(), 0);
   std::size_t faces = 0;
   for (const MeshPart& p : parts) {
-    // Equal face counts, up to one.
-    EXPECT_NEAR(double(p.mesh.face_count()), double(in.face_count()) / 5, 1.0);
+    // Equal face counts, to within the quantiles of a sample of the faces.
+    EXPECT_NEAR(double(p.mesh.face_count()), double(in.face_count()) / 5, 0.02 * double(in.face_count()) / 5);
     faces += p.mesh.face_count();
     for (std::uint32_t g : p.input_vertex) ++uses[g];
   }
@@ -230,7 +231,9 @@ TEST(Partition, CommandLineSaysHowManyParts) {
   ASSERT_EQ(code, 0) << r;
   EXPECT_NE(r.find("\"parts\":4"), std::string::npos) << r;
   const Mesh four = load_mesh(out);
-  EXPECT_EQ(four.face_count(), bumpy_square().face_count() / 10);
+  // At the target, or one below where the last contraction took two faces of an odd remainder.
+  EXPECT_LE(four.face_count(), bumpy_square().face_count() / 10);
+  EXPECT_GE(four.face_count(), bumpy_square().face_count() / 10 - 1);
   // The same parts on one thread: the same file.
   const std::string out1 = test::temp_dir() + "/partition_out1.ply";
   r = run_cli("simplify " + in + " " + out1 + " --ratio 0.1 --partition 4 --threads 1 --quiet", &code);
