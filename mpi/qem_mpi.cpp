@@ -154,8 +154,11 @@ int run_root(const Args& a, int ranks) {
   PartitionReport report;
   try {
     cli::refuse_to_overwrite(a.input, a.output, a.force);
-    const SimplifyOptions options = options_of(a);
+    SimplifyOptions options = options_of(a);
     Mesh mesh = cli::load_input(a.input, cli::to_load_options(a.algorithm));
+    // --lock-property: the locks travel inside the parts (MeshPart::locked), so only rank 0 reads them.
+    std::vector<std::uint8_t> lock;
+    cli::apply_lock_property(a.algorithm, a.input, mesh, lock, options);
     if (const std::string why = partition_refusal(mesh, options); !why.empty())
       throw Error(a.input + ": cannot simplify part by part: " + why);
     // At least one part per rank, so that every rank has work.
