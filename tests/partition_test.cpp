@@ -250,3 +250,17 @@ TEST(Partition, CommandLineSaysHowManyParts) {
   EXPECT_NE(code, 0);
   EXPECT_NE(r.find("cannot simplify part by part"), std::string::npos) << r;
 }
+
+TEST(Partition, MorePartsThanFacesAndEmptyParts) {
+  // Four faces into 8 parts; two copies of a face at one centroid put no face in a range.
+  Mesh tet = test::tetrahedron();
+  SimplifyOptions o;
+  o.target_faces = 2;
+  const SimplifyResult r = simplify_partitioned(tet, o, in_parts(8));
+  EXPECT_EQ(r.mesh.face_count(), 4u);  // a closed component keeps a tetrahedron
+  EXPECT_EQ(test::boundary_edges(r.mesh), 0u);
+  Mesh twice = test::concatenated(test::grid(1), test::grid(1));
+  const SimplifyResult g = simplify_partitioned(twice, o, in_parts(3));
+  EXPECT_EQ(test::validity_problem(g.mesh), "");
+  EXPECT_LE(g.mesh.face_count(), 4u);
+}

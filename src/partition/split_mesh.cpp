@@ -202,14 +202,15 @@ std::vector<MeshPart> split_mesh(MeshView input, const SimplifyOptions& options,
     // The part's share of the target, in proportion to its faces (vertices), plus its cut
     // vertices: each keeps about one face of the strip along the cut, which the final pass removes,
     // and which must not be taken out of the part's interior (it would end up coarser than the rest).
+    // At least 1 (0 means unused): a part whose share rounds to nothing goes as far as it can.
     const std::size_t part_faces = end - begin, part_vertices = part.input_vertex.size();
     if (total.faces > 0)
-      part.target_faces = std::size_t(double(total.faces) * double(part_faces) / double(std::max<std::size_t>(1, n))) +
-                          locked_count;
+      part.target_faces = std::max<std::size_t>(
+          1, std::size_t(double(total.faces) * double(part_faces) / double(std::max<std::size_t>(1, n))) + locked_count);
     if (total.vertices > 0)
-      part.target_vertices =
-          std::size_t(double(total.vertices) * double(part_vertices) / double(std::max<std::size_t>(1, referenced))) +
-          locked_count;
+      part.target_vertices = std::max<std::size_t>(
+          1, std::size_t(double(total.vertices) * double(part_vertices) / double(std::max<std::size_t>(1, referenced))) +
+                 locked_count);
   });
   if (report) {
     report->parts = part_count;
