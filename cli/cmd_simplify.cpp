@@ -211,7 +211,7 @@ int run_simplify(const SimplifyArgs& a) {
         "\"rejected_topology\":%zu,\"rejected_inversion\":%zu,\"rejected_error\":%zu,\"rejected_component\":%zu,"
         "\"in_components\":%zu,\"out_components\":%zu,\"pruned_components\":%zu,\"refit_rounds\":%zu,"
         "\"refit_rms_before\":%s,\"refit_rms_after\":%s,\"dropped_degenerate\":%zu,\"dropped_duplicate\":%zu,"
-        "\"parts\":%u,\"split_s\":%s,\"parts_s\":%s,\"final_pass_s\":%s,\"stop\":\"%s\"}\n",
+        "\"parts\":%u,\"split_s\":%s,\"parts_s\":%s,\"final_pass_s\":%s,\"parts_cpu_s\":%s,\"busiest_thread_cpu_s\":%s,\"stop\":\"%s\"}\n",
         in_faces, a.faces.value_or(0), r.mesh.face_count(), r.mesh.vertex_count(), json_number(load_s).c_str(),
         json_number(simplify_s).c_str(), json_number(simplify_cpu_s).c_str(), json_number(write_s).c_str(),
         json_number(total.seconds()).c_str(), json_number(peak_rss_mb()).c_str(),
@@ -221,7 +221,8 @@ int run_simplify(const SimplifyArgs& a) {
         json_number(r.refit_rms_before).c_str(), json_number(r.refit_rms_after).c_str(),
         r.dropped_degenerate_faces, r.dropped_duplicate_faces, parts,
         json_number(partition_report.split_seconds).c_str(), json_number(partition_report.parts_seconds).c_str(),
-        json_number(partition_report.final_seconds).c_str(), to_string(r.stop_reason));
+        json_number(partition_report.final_seconds).c_str(), json_number(partition_report.parts_cpu_seconds).c_str(),
+        json_number(partition_report.busiest_thread_cpu_seconds).c_str(), to_string(r.stop_reason));
   }
   if (!a.quiet)
     std::fprintf(stderr,

@@ -71,7 +71,11 @@ struct PartitionReport {
   unsigned parts = 0;
   std::size_t shared_vertices = 0;  ///< input vertices on a cut (locked in the parts)
   std::size_t merged_faces = 0;     ///< faces of the welded parts, the final pass's input
-  double split_seconds = 0, parts_seconds = 0, final_seconds = 0;
+  double split_seconds = 0, parts_seconds = 0, final_seconds = 0;  ///< wall
+  /// CPU seconds of the parts (default runner only): all of them, and those of the thread that had
+  /// the most. On a loaded machine, where wall times say little, their difference shows how much
+  /// the threads shared the work.
+  double parts_cpu_seconds = 0, busiest_thread_cpu_seconds = 0;
 };
 
 /// Parts for an input of `faces` faces when the caller leaves the choice: 1 (no partition) below

@@ -5,8 +5,11 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <ctime>
+#include <map>
 #include <mutex>
 #include <numeric>
+#include <thread>
 
 #include "core/parallel_chunks.h"
 #include "partition/partition_targets.h"
@@ -47,24 +50,35 @@ std::size_t count_input_components(MeshView input) {
   return count;
 }
 
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
 void run_parts_on_threads(std::span<const MeshPart> parts, const SimplifyOptions& options,
                           std::span<MeshPartResult> results,
-                          const std::function<bool(unsigned, unsigned)>& progress) {
+                          const std::function<bool(unsigned, unsigned)>& progress, PartitionReport& report) {
   // One part per thread, each single-threaded: the parts are the parallelism.
   SimplifyOptions one = options;
   one.threads = 1;
   std::atomic<unsigned> done{0};
   std::atomic<bool> cancelled{false};
-  std::mutex report;
+  std::mutex report_lock;
+  std::map<std::thread::id, double> cpu_of_thread;
   core::for_chunks(parts.size(), 1, core::resolve_threads(options.threads), [&](std::size_t p, std::size_t, std::size_t) {
     if (cancelled) return;
+    const double cpu0 = thread_cpu_seconds();
     results[p] = simplify_part(parts[p], one);
+    const double cpu = thread_cpu_seconds() - cpu0;
     const unsigned d = ++done;
-    if (progress) {
-      std::lock_guard<std::mutex> lock(report);
-      if (!progress(d, unsigned(parts.size()))) cancelled = true;
-    }
+    std::lock_guard<std::mutex> lock(report_lock);
+    cpu_of_thread[std::this_thread::get_id()] += cpu;
+    report.parts_cpu_seconds += cpu;
+    if (progress && !progress(d, unsigned(parts.size()))) cancelled = true;
   });
+  for (const auto& [thread, cpu] : cpu_of_thread)
+    report.busiest_thread_cpu_seconds = std::max(report.busiest_thread_cpu_seconds, cpu);
   if (cancelled) throw Error("cancelled");
 }
 
@@ -232,7 +246,7 @@ SimplifyResult simplify_partitioned(MeshView input, const SimplifyOptions& optio
     if (partition.progress && !partition.progress(unsigned(parts.size()), unsigned(parts.size())))
       throw Error("cancelled");
   } else {
-    run_parts_on_threads(parts, options, results, partition.progress);
+    run_parts_on_threads(parts, options, results, partition.progress, rep);
   }
   rep.parts_seconds = seconds_since(start);
   return finish_partitioned(input, options, parts, results, &rep);
