@@ -11,6 +11,7 @@
 #include "cli_util.h"
 #include "command.h"
 #include "out_of_core_cli.h"
+#include "partition_cli.h"
 #include "qem/error.h"
 #include "qem/gltf.h"
 #include "qem/gltf_simplify.h"
@@ -33,6 +34,7 @@ struct SimplifyArgs {
   bool per_mesh = false;       // --per-mesh (glTF documents)
   std::string record;          // --record: the contraction sequence (docs/record-format.md)
   OutOfCoreArgs out_of_core;   // --memory-limit, --temp-dir
+  PartitionArgs partition;     // --partition
 };
 
 // Shows the progress on a terminal and, with --record, keeps the contractions.
@@ -186,12 +188,15 @@ int run_simplify(const SimplifyArgs& a) {
   const double cpu0 = process_cpu_seconds();
   Watcher watcher(show_progress, !a.record.empty());
   const std::size_t in_faces = mesh.face_count();
+  const unsigned parts = choose_parts(a.partition, mesh, opt, !a.record.empty());
+  PartitionReport partition_report;
   // Without a record the input's faces are not needed afterwards: let the simplifier free them.
-  SimplifyResult r =
-      a.record.empty() ? simplify(std::move(mesh), opt, &watcher) : simplify(mesh, opt, &watcher);
+  SimplifyResult r = parts > 1            ? run_partitioned(mesh, opt, parts, show_progress, &partition_report)
+                     : a.record.empty() ? simplify(std::move(mesh), opt, &watcher)
+                                        : simplify(mesh, opt, &watcher);
   const double simplify_s = t_simplify.seconds();
   const double simplify_cpu_s = process_cpu_seconds() - cpu0;
-  if (show_progress) std::fprintf(stderr, "\n");
+  if (show_progress && parts <= 1) std::fprintf(stderr, "\n");
 
   Stopwatch t_write;
   SaveOptions save;
@@ -214,7 +219,7 @@ int run_simplify(const SimplifyArgs& a) {
         "\"rejected_distance\":%zu,\"output_to_input_distance\":%s,"
         "\"in_components\":%zu,\"out_components\":%zu,\"pruned_components\":%zu,\"refit_rounds\":%zu,"
         "\"refit_rms_before\":%s,\"refit_rms_after\":%s,\"dropped_degenerate\":%zu,\"dropped_duplicate\":%zu,"
-        "\"stop\":\"%s\"}\n",
+        "\"parts\":%u,\"split_s\":%s,\"parts_s\":%s,\"final_pass_s\":%s,\"parts_cpu_s\":%s,\"busiest_thread_cpu_s\":%s,\"stop\":\"%s\"}\n",
         in_faces, a.faces.value_or(0), r.mesh.face_count(), r.mesh.vertex_count(), json_number(load_s).c_str(),
         json_number(simplify_s).c_str(), json_number(simplify_cpu_s).c_str(), json_number(write_s).c_str(),
         json_number(total.seconds()).c_str(), json_number(peak_rss_mb()).c_str(),
@@ -223,7 +228,10 @@ int run_simplify(const SimplifyArgs& a) {
         r.rejected_distance, json_number(r.output_to_input_distance).c_str(),
         r.input_components, r.output_components, r.pruned_components, r.refit_rounds,
         json_number(r.refit_rms_before).c_str(), json_number(r.refit_rms_after).c_str(),
-        r.dropped_degenerate_faces, r.dropped_duplicate_faces, to_string(r.stop_reason));
+        r.dropped_degenerate_faces, r.dropped_duplicate_faces, parts,
+        json_number(partition_report.split_seconds).c_str(), json_number(partition_report.parts_seconds).c_str(),
+        json_number(partition_report.final_seconds).c_str(), json_number(partition_report.parts_cpu_seconds).c_str(),
+        json_number(partition_report.busiest_thread_cpu_seconds).c_str(), to_string(r.stop_reason));
   }
   if (!a.quiet)
     std::fprintf(stderr,
@@ -232,6 +240,12 @@ int run_simplify(const SimplifyArgs& a) {
                  r.input_faces, r.mesh.face_count(), r.mesh.vertex_count(), r.input_components, r.output_components,
                  r.pruned_components > 0 ? (" (" + std::to_string(r.pruned_components) + " pruned)").c_str() : "",
                  r.max_error, r.max_error_relative, total.seconds(), r.stop_detail.c_str());
+  if (!a.quiet && parts > 1)
+    std::fprintf(stderr,
+                 "qem: in %u parts (%zu vertices on the cuts, locked in the parts: %.3f s), then one pass over "
+                 "the %zu welded faces (%.3f s)\n",
+                 parts, partition_report.shared_vertices, partition_report.parts_seconds, partition_report.merged_faces,
+                 partition_report.final_seconds);
   if (!a.quiet && r.dropped_degenerate_faces + r.dropped_duplicate_faces > 0)
     std::fprintf(stderr, "qem: left out %zu degenerate and %zu duplicate input faces\n",
                  r.dropped_degenerate_faces, r.dropped_duplicate_faces);
@@ -292,6 +306,7 @@ const bool registered = register_command(10, [](CLI::App& app) {
       "Also write the contraction sequence to this file, so `qem replay` / `qem lod` can rebuild "
       "any face count between the output's and the input's (docs/record-format.md); no default refit then");
   add_out_of_core_options(sub, args->out_of_core);
+  add_partition_option(sub, args->partition);
   return [args] { return run_simplify(*args); };
 });
 

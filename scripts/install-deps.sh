@@ -12,7 +12,8 @@ $SUDO apt-get update
 # (glTF 2.0 read and write with pass-through);
 # tests: GoogleTest, Google Benchmark; clang + libclang-rt for the libFuzzer targets; chromium for
 # the viewer's browser test; the Python module: Python headers, pybind11, numpy, setuptools and pip
-# (`pip install --no-build-isolation .`), pytest, Open3D (interoperability test, bench/python_peers.py).
+# (`pip install --no-build-isolation .`), pytest, Open3D (interoperability test, bench/python_peers.py);
+# OpenMPI for qem-mpi, the partitioned run across MPI ranks (docs/parallel.md) and its test.
 $SUDO apt-get install -y --no-install-recommends \
   build-essential cmake g++ python3 pkg-config \
   libeigen3-dev libcli11-dev libfast-float-dev libnanoflann-dev \
@@ -21,6 +22,7 @@ $SUDO apt-get install -y --no-install-recommends \
   clang libclang-rt-14-dev \
   python3-dev pybind11-dev python3-pybind11 python3-numpy python3-setuptools python3-pip \
   python3-pytest python3-open3d \
+  libopenmpi-dev openmpi-bin \
   chromium
 # The viewer's npm packages (three, esbuild, playwright-core) from web/package-lock.json.
 bash "$(dirname "$0")/install-web-deps.sh"

@@ -1,0 +1,255 @@
+// The partitioned run of qem/partition.h: the parts simplified side by side with their cuts locked,
+// welded on the cut vertices, and one in-core pass over the merged mesh with the cuts unlocked
+// (meshoptimizer's clusterlod recursion, one level: "merge neighbours, simplify again with the old
+// borders unlocked").
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <ctime>
+#include <map>
+#include <mutex>
+#include <numeric>
+#include <thread>
+
+#include "core/parallel_chunks.h"
+#include "partition/partition_targets.h"
+#include "qem/error.h"
+#include "qem/partition.h"
+#include "refit/refit_after_simplify.h"
+#include "refit/refit_points.h"
+
+namespace qem {
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Connected components of the input (faces joined through shared vertices), as simplify counts
+// them on its input: union-find over the vertices of the non-degenerate faces.
+std::size_t count_input_components(MeshView input) {
+  std::vector<std::uint32_t> parent(input.vertex_count());
+  std::iota(parent.begin(), parent.end(), 0u);
+  const auto find = [&](std::uint32_t v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  std::vector<std::uint8_t> used(input.vertex_count(), 0);
+  for (std::size_t f = 0; f < input.face_count(); ++f) {
+    const std::uint32_t* t = &input.indices[3 * f];
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
+    for (int k = 0; k < 3; ++k) used[t[k]] = 1;
+    for (int k = 1; k < 3; ++k) {
+      const std::uint32_t a = find(t[0]), b = find(t[k]);
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  }
+  std::size_t count = 0;
+  for (std::uint32_t v = 0; v < parent.size(); ++v) count += used[v] && find(v) == v;
+  return count;
+}
+
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+void run_parts_on_threads(std::span<const MeshPart> parts, const SimplifyOptions& options,
+                          std::span<MeshPartResult> results,
+                          const std::function<bool(unsigned, unsigned)>& progress, PartitionReport& report) {
+  // One part per thread, each single-threaded: the parts are the parallelism.
+  SimplifyOptions one = options;
+  one.threads = 1;
+  std::atomic<unsigned> done{0};
+  std::atomic<bool> cancelled{false};
+  std::mutex report_lock;
+  std::map<std::thread::id, double> cpu_of_thread;
+  core::for_chunks(parts.size(), 1, core::resolve_threads(options.threads), [&](std::size_t p, std::size_t, std::size_t) {
+    if (cancelled) return;
+    const double cpu0 = thread_cpu_seconds();
+    results[p] = simplify_part(parts[p], one);
+    const double cpu = thread_cpu_seconds() - cpu0;
+    const unsigned d = ++done;
+    std::lock_guard<std::mutex> lock(report_lock);
+    cpu_of_thread[std::this_thread::get_id()] += cpu;
+    report.parts_cpu_seconds += cpu;
+    if (progress && !progress(d, unsigned(parts.size()))) cancelled = true;
+  });
+  for (const auto& [thread, cpu] : cpu_of_thread)
+    report.busiest_thread_cpu_seconds = std::max(report.busiest_thread_cpu_seconds, cpu);
+  if (cancelled) throw Error("cancelled");
+}
+
+}  // namespace
+
+MeshPartResult simplify_part(const MeshPart& part, const SimplifyOptions& options) {
+  SimplifyOptions o = options;
+  o.target_faces = part.target_faces;
+  o.target_ratio = 0;
+  o.target_vertices = part.target_vertices;
+  o.vertex_lock = part.locked;
+  o.refit_rounds = 0;  // the refit fits the final result to the whole input
+  o.map_input_vertices = true;
+  SimplifyResult r = simplify(MeshView(part.mesh), o);
+  MeshPartResult out;
+  out.mesh = std::move(r.mesh);
+  out.vertex_source = std::move(r.vertex_source);
+  out.face_source = std::move(r.face_source);
+  out.output_vertex_of_input = std::move(r.output_vertex_of_input);
+  out.input_faces = r.input_faces;
+  out.contractions = r.contractions;
+  out.rejected_topology = r.rejected_topology, out.rejected_inversion = r.rejected_inversion;
+  out.rejected_error = r.rejected_error, out.rejected_component = r.rejected_component;
+  out.dropped_duplicate_faces = r.dropped_duplicate_faces;
+  out.max_error = r.max_error;
+  return out;
+}
+
+SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options, std::span<const MeshPart> parts,
+                                  std::span<const MeshPartResult> results, PartitionReport* report) {
+  if (parts.size() != results.size()) throw Error("finish_partitioned: one result per part is needed");
+  constexpr std::uint32_t kNone = SimplifyResult::kUnmapped;
+  // Weld: a vertex of a part's output that started as a cut vertex never moved and was never
+  // removed (it was locked), so the parts' copies are one vertex, found through its input index.
+  Mesh merged;
+  std::vector<std::uint32_t> merged_source;  // per merged vertex: its input vertex
+  std::vector<std::uint32_t> merged_face_source;
+  std::vector<std::uint32_t> welded(input.vertex_count(), kNone);  // cut vertex -> merged vertex
+  std::vector<std::vector<std::uint32_t>> merged_of(parts.size());  // per part output vertex
+  std::size_t nondegenerate = 0, part_dups = 0, contractions = 0;
+  SimplifyResult result;
+  double max_error = 0;
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    const MeshPart& part = parts[p];
+    const MeshPartResult& r = results[p];
+    if (r.vertex_source.size() != r.mesh.vertex_count() || r.face_source.size() != r.mesh.face_count() ||
+        r.output_vertex_of_input.size() != part.input_vertex.size())
+      throw Error("finish_partitioned: part " + std::to_string(p) + "'s result does not match the part");
+    nondegenerate += part.mesh.face_count();
+    part_dups += r.dropped_duplicate_faces;
+    contractions += r.contractions;
+    result.rejected_topology += r.rejected_topology, result.rejected_inversion += r.rejected_inversion;
+    result.rejected_error += r.rejected_error, result.rejected_component += r.rejected_component;
+    max_error = std::max(max_error, r.max_error);
+    std::vector<std::uint32_t>& to_merged = merged_of[p];
+    to_merged.resize(r.mesh.vertex_count());
+    for (std::size_t u = 0; u < r.mesh.vertex_count(); ++u) {
+      const std::uint32_t g = part.input_vertex.at(r.vertex_source[u]);
+      const bool cut = part.locked[r.vertex_source[u]] != 0;
+      if (cut && welded[g] != kNone) {
+        to_merged[u] = welded[g];
+        continue;
+      }
+      to_merged[u] = std::uint32_t(merged_source.size());
+      if (cut) welded[g] = to_merged[u];
+      merged_source.push_back(g);
+      merged.positions.insert(merged.positions.end(), &r.mesh.positions[3 * u], &r.mesh.positions[3 * u] + 3);
+    }
+    for (std::size_t f = 0; f < r.mesh.face_count(); ++f) {
+      for (int k = 0; k < 3; ++k) merged.indices.push_back(to_merged[r.mesh.indices[3 * f + k]]);
+      merged_face_source.push_back(part.input_face.at(r.face_source[f]));
+    }
+  }
+  if (report) report->merged_faces = merged.face_count();
+
+  // The final pass: the same rules and target over the merged mesh, the cuts no longer locked
+  // (the caller's locks still are).
+  const partition_detail::Targets total = partition_detail::resolve_targets(options, nondegenerate);
+  SimplifyOptions o = options;
+  o.target_faces = total.faces;
+  o.target_ratio = 0;
+  o.target_vertices = total.vertices;
+  o.refit_rounds = 0;
+  o.map_input_vertices = true;
+  std::vector<std::uint8_t> lock;
+  if (!options.vertex_lock.empty()) {
+    lock.resize(merged_source.size());
+    for (std::size_t v = 0; v < lock.size(); ++v) lock[v] = options.vertex_lock[merged_source[v]];
+    o.vertex_lock = lock;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  SimplifyResult last = simplify(std::move(merged), o);
+  if (report) report->final_seconds = seconds_since(start);
+
+  result.mesh = std::move(last.mesh);
+  result.input_faces = nondegenerate - part_dups - last.dropped_duplicate_faces;
+  result.dropped_degenerate_faces = input.face_count() - nondegenerate;
+  result.dropped_duplicate_faces = part_dups + last.dropped_duplicate_faces;
+  result.contractions = contractions + last.contractions;
+  result.rejected_topology += last.rejected_topology, result.rejected_inversion += last.rejected_inversion;
+  result.rejected_error += last.rejected_error, result.rejected_component += last.rejected_component;
+  result.input_components = count_input_components(input);
+  result.output_components = last.output_components;
+  result.stop_reason = last.stop_reason;
+  result.stop_detail = last.stop_detail;
+  result.max_error = std::max(max_error, last.max_error);
+  const double diagonal = bounding_box(input).diagonal();
+  result.max_error_relative = diagonal > 0 ? result.max_error / diagonal : 0;
+  // Provenance in the input's numbering.
+  result.vertex_source.resize(last.vertex_source.size());
+  for (std::size_t v = 0; v < last.vertex_source.size(); ++v) result.vertex_source[v] = merged_source[last.vertex_source[v]];
+  result.face_source.resize(last.face_source.size());
+  for (std::size_t f = 0; f < last.face_source.size(); ++f) result.face_source[f] = merged_face_source[last.face_source[f]];
+  // Where each input vertex went: into a part's output vertex, that one into the final output.
+  std::vector<std::uint32_t> went(input.vertex_count(), kNone);
+  std::vector<std::uint8_t> seen(input.vertex_count(), 0);
+  for (std::size_t p = 0; p < parts.size(); ++p)
+    for (std::size_t l = 0; l < parts[p].input_vertex.size(); ++l) {
+      const std::uint32_t g = parts[p].input_vertex[l];
+      if (seen[g]) continue;
+      seen[g] = 1;
+      const std::uint32_t u = results[p].output_vertex_of_input[l];
+      if (u != kNone) went[g] = last.output_vertex_of_input[merged_of[p].at(u)];
+    }
+  std::size_t referenced = 0;
+  for (std::uint8_t s : seen) referenced += s;
+  result.input_vertices = referenced;
+
+  // The refit fits the result to the whole input, as simplify's own refit does.
+  if (options.refit_rounds > 0 && result.contractions > 0) {
+    const refit_detail::FitPoints points(input.positions, refit_detail::vertex_areas(input));
+    RefitOptions refit_options = refit_options_for(options);
+    std::vector<std::uint8_t> fixed;
+    if (!options.vertex_lock.empty()) {
+      fixed.assign(result.mesh.vertex_count(), 0);
+      for (std::size_t v = 0; v < fixed.size(); ++v) fixed[v] = options.vertex_lock[result.vertex_source[v]];
+      refit_options.fixed_vertices = fixed;
+    }
+    const RefitResult fit = refit_detail::refit_to_points(points, result.mesh, refit_options, went);
+    result.refit_rms_before = fit.rms_before;
+    result.refit_rms_after = fit.rms_after;
+    result.refit_rounds = fit.rounds;
+  }
+  if (options.map_input_vertices) result.output_vertex_of_input = std::move(went);
+  return result;
+}
+
+SimplifyResult simplify_partitioned(MeshView input, const SimplifyOptions& options, const PartitionOptions& partition,
+                                    PartitionReport* report) {
+  check_options(options);
+  PartitionReport local_report;
+  PartitionReport& rep = report ? *report : local_report;
+  const unsigned part_count = partition.parts > 0 ? partition.parts : automatic_parts(input.face_count());
+  if (part_count <= 1) {
+    rep.parts = 1;
+    return simplify(input, options);
+  }
+  auto start = std::chrono::steady_clock::now();
+  const std::vector<MeshPart> parts = split_mesh(input, options, part_count, &rep);
+  rep.split_seconds = seconds_since(start);
+  start = std::chrono::steady_clock::now();
+  std::vector<MeshPartResult> results(parts.size());
+  if (partition.run_parts) {
+    partition.run_parts(parts, options, results);
+    if (partition.progress && !partition.progress(unsigned(parts.size()), unsigned(parts.size())))
+      throw Error("cancelled");
+  } else {
+    run_parts_on_threads(parts, options, results, partition.progress, rep);
+  }
+  rep.parts_seconds = seconds_since(start);
+  return finish_partitioned(input, options, parts, results, &rep);
+}
+
+}  // namespace qem
