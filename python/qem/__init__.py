@@ -219,7 +219,7 @@ def _attribute_list(attributes):
 def _options(*, target_faces, target_ratio, target_vertices, max_error, max_error_relative, threshold,
              threshold_relative, weighting, placement, boundary_weight, lock_border, inversion, max_turn,
              allow_non_manifold, scheme, refit, threads, record, keep_components=True, prune=None,
-             prune_relative=None):
+             prune_relative=None, exact_border=True):
     o = _qem.SimplifyOptions()
 
     def count(name, value):
@@ -283,6 +283,7 @@ def _options(*, target_faces, target_ratio, target_vertices, max_error, max_erro
         setattr(o, name, value)
     o.boundary_weight = number("boundary_weight", boundary_weight)
     o.lock_border = bool(lock_border)
+    o.exact_border = bool(exact_border)
     o.max_normal_turn_degrees = number("max_turn", max_turn)
     o.preserve_topology = not allow_non_manifold
     if isinstance(threads, bool) or not isinstance(threads, int) or threads < 0:
@@ -324,7 +325,7 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
              boundary_weight: float = 1.0, lock_border: bool = False, inversion: str = "forbid",
              max_turn: float = 75.0, allow_non_manifold: bool = False, scheme: str = "passes",
              refit="light", threads: int = 0, keep_components: bool = True, prune: Optional[float] = None,
-             prune_relative: Optional[float] = None, attributes: Optional[dict] = None,
+             prune_relative: Optional[float] = None, exact_border: bool = True, attributes: Optional[dict] = None,
              attribute_weights: Optional[dict] = None, vertex_lock=None, return_mapping: bool = False,
              record: bool = False, progress: Optional[Callable[[float], Optional[bool]]] = None) -> SimplifyResult:
     """Simplifies a triangle mesh by quadric-error pair contraction (Garland & Heckbert 1997).
@@ -338,13 +339,17 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
       max_error: never make a contraction whose error exceeds this distance (model units): the
         weighted RMS distance of the new vertex to the planes it stands for.
       max_error_relative: the same as a fraction of the bounding-box diagonal.
-    The algorithm (the command line's defaults, so the same options give the same bytes as `qem simplify`):
+    The algorithm (the command line's defaults, so the same options give the same bytes as `qem simplify`;
+    the one difference: this is always the in-core run, `--partition off`, while the command line cuts
+    meshes of 1M faces or more into parts by default, docs/parallel.md):
       threshold: vertices closer than this (model units) are pairs too, so separate parts can join
         (GH97 §3.2; 0 = edges only); threshold_relative: the same over the bounding-box diagonal.
       weighting: "area" (HG99), "uniform" (GH97), "angle".
       placement: "optimal", "segment", "midpoint", "endpoints".
       boundary_weight: weight of the planes that hold open borders in place (0 = none).
       lock_border: border vertices never move.
+      exact_border: border vertices stay on the input's border lines (at input vertices or sliding
+        along input border edges; corners fixed); False = GH97's penalty planes alone (boundary_weight).
       inversion: "forbid", "penalize" or "off": contractions that turn a face by more than max_turn degrees.
       allow_non_manifold: skip the link condition (edge collapses may make non-manifold edges).
       scheme: "passes" (fast) or "greedy" (GH97's heap: strictly cheapest first).
@@ -390,7 +395,7 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
                        boundary_weight=boundary_weight, lock_border=lock_border, inversion=inversion,
                        max_turn=max_turn, allow_non_manifold=allow_non_manifold, scheme=scheme, refit=refit,
                        threads=threads, record=record, keep_components=keep_components, prune=prune,
-                       prune_relative=prune_relative)
+                       prune_relative=prune_relative, exact_border=exact_border)
     # The light default follows the command line here too: not on a mesh with attributes, where it
     # lowers E but raises the UV and normal errors a little (docs/attributes.md, "Seams, locks and
     # the refit"); "full" or (rounds, points) still refits them, holding every seam position.
@@ -552,7 +557,7 @@ def lod(vertices, faces, *, ratios=None, target_faces=None, refit="light", **opt
     defaults = dict(threshold=0.0, threshold_relative=None, weighting="area", placement="optimal",
                     boundary_weight=1.0, lock_border=False, inversion="forbid", max_turn=75.0,
                     allow_non_manifold=False, scheme="passes", threads=0, keep_components=True, prune=None,
-                    prune_relative=None)
+                    prune_relative=None, exact_border=True)
     unknown = set(options) - set(defaults)
     if unknown:
         raise TypeError(f"lod() got unexpected keyword arguments: {', '.join(sorted(unknown))}")

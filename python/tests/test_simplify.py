@@ -169,18 +169,20 @@ def test_option_names_are_the_librarys():
 
 def test_components_and_target_zero():
     # Two separate open squares, one tiny: kept by default, removed by prune, and a target of 0
-    # goes as far as the checks allow (each square down to one face).
+    # goes as far as the checks allow (each square down to one face). With GH97's penalty borders
+    # (exact_border=False): exact borders hold a square's four corners, so it never comes near
+    # vanishing and the component guard would have nothing to refuse.
     square = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0.5, 0.5, 0.1]], float)
     quad = np.array([[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]])
     v = np.vstack([square, square * 0.01 + [3, 0, 0]])
     f = np.vstack([quad, quad + 5])
-    r = qem.simplify(v, f, target_faces=0, refit="none")
+    r = qem.simplify(v, f, target_faces=0, refit="none", exact_border=False)
     assert r.input_components == 2 and r.output_components == 2 and r.pruned_components == 0
     assert r.stop_reason == "no valid contraction left" and r.rejected_component > 0
     assert len(r.faces) == 2
-    r = qem.simplify(v, f, target_faces=0, prune=0.1, refit="none")
+    r = qem.simplify(v, f, target_faces=0, prune=0.1, refit="none", exact_border=False)
     assert r.pruned_components == 1 and r.output_components == 1
-    gone = qem.simplify(v, f, target_faces=0, keep_components=False, refit="none")
+    gone = qem.simplify(v, f, target_faces=0, keep_components=False, refit="none", exact_border=False)
     assert len(gone.faces) == 0
     with pytest.raises(ValueError):
         qem.simplify(v, f, target_faces=-1)
