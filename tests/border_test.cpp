@@ -46,8 +46,10 @@ double bumps(double x, double y) {
   return 4 * x * (1 - x) * y * (1 - y) * (0.05 + 0.03 * std::sin(9 * x) * std::cos(7 * y));
 }
 
+// Exact borders (not the default: SimplifyOptions::exact_border) with the given refit.
 SimplifyOptions defaults_with_refit(unsigned rounds, double points_per_vertex) {
   SimplifyOptions o;
+  o.exact_border = true;
   o.refit_rounds = rounds;
   o.refit_points_per_vertex = points_per_vertex;
   return o;
@@ -203,6 +205,7 @@ TEST(Borders, SlidBorderVertexLiesOnAnInputBorderEdge) {
   std::set<Point> inputs;
   for (std::size_t v = 0; v < in.vertex_count(); ++v) inputs.insert(vertex(in, v));
   SimplifyOptions o;
+  o.exact_border = true;
   o.target_ratio = 0.05;
   o.refit_rounds = 0;
   const SimplifyResult r = simplify(in, o);
