@@ -110,32 +110,38 @@ Mesh uv_cube(int n, double relief, bool flat_normals, int block = 0) {
   return m;
 }
 
-// A wavy n x n grid over the unit square cut into `block` x `block` cell charts: every chart has
-// its own vertices and UVs, so chart boundaries are seams and the points where four charts meet
-// hold four wedges.
-Mesh chart_grid(int n, int block) {
+// A wavy n x n grid over the unit square whose cell (i, j) lies in UV chart chart(i, j) (two
+// numbers): every chart has its own vertices and UVs (shifted in the atlas by its numbers, so
+// neighbouring charts' UVs differ), so chart boundaries are seams and the points where k charts
+// meet hold k wedges.
+template <class ChartOf>
+Mesh chart_grid(int n, ChartOf chart) {
   Mesh m;
   VertexAttribute uv{"TEXCOORD_0", AttributeKind::TexCoord, 2, {}};
-  std::map<std::array<int, 4>, std::uint32_t> ids;  // (i, j, chart i, chart j)
-  auto vertex = [&](int i, int j, int ci, int cj) {
-    auto [it, fresh] = ids.try_emplace({i, j, ci, cj}, std::uint32_t(m.vertex_count()));
+  std::map<std::array<int, 4>, std::uint32_t> ids;  // (i, j, chart)
+  auto vertex = [&](int i, int j, std::pair<int, int> c) {
+    auto [it, fresh] = ids.try_emplace({i, j, c.first, c.second}, std::uint32_t(m.vertex_count()));
     if (fresh) {
       const double x = double(i) / n, y = double(j) / n;
       m.positions.insert(m.positions.end(), {x, y, 0.08 * std::sin(5 * x) * std::cos(4 * y)});
-      // Each chart mapped with a gap into the atlas: neighbouring charts' UVs differ.
-      uv.values.insert(uv.values.end(), {0.9 * x + 0.05 * ci, 0.9 * y + 0.03 * cj});
+      uv.values.insert(uv.values.end(), {0.9 * x + 0.05 * c.first, 0.9 * y + 0.03 * c.second});
     }
     return it->second;
   };
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j) {
-      const int ci = i / block, cj = j / block;
-      const std::uint32_t a = vertex(i, j, ci, cj), b = vertex(i + 1, j, ci, cj), c = vertex(i + 1, j + 1, ci, cj),
-                          d = vertex(i, j + 1, ci, cj);
-      m.indices.insert(m.indices.end(), {a, b, c, a, c, d});
+      const std::pair<int, int> c = chart(i, j);
+      const std::uint32_t a = vertex(i, j, c), b = vertex(i + 1, j, c), d = vertex(i + 1, j + 1, c),
+                          e = vertex(i, j + 1, c);
+      m.indices.insert(m.indices.end(), {a, b, d, a, d, e});
     }
   m.attributes = {uv};
   return m;
+}
+
+// Cut into `block` x `block` cell charts.
+Mesh chart_grid(int n, int block) {
+  return chart_grid(n, [block](int i, int j) { return std::pair{i / block, j / block}; });
 }
 
 // Boundary edges of m welded by position: on these closed meshes, the cracks a simplification
@@ -367,6 +373,27 @@ TEST(Seams, ProtectedVerticesKeepTheirSeamsInPermissiveMode) {
   const std::vector<std::uint8_t> short_list(3, 1);
   o.vertex_protect = short_list;
   EXPECT_THROW(simplify(in, o), Error);
+}
+
+TEST(Seams, AChartWhoseFacesAllDiedIsNoSeam) {
+  // One-cell UV islands in a grid: once an island's two faces are gone, its corners hold one wedge
+  // each and must be ordinary vertices again (removable, placed freely). A dead wedge left in its
+  // vertex's ring kept them seams, which refused every collapse that removes them: the run stopped
+  // at 10 faces here, where the grid without islands goes on to its last face.
+  const Mesh islands = chart_grid(6, [](int i, int j) {
+    return i % 3 == 1 && j % 3 == 1 ? std::pair{i + 1, j + 1} : std::pair{0, 0};
+  });
+  const Mesh plain = chart_grid(6, 6);
+  ASSERT_EQ(islands.vertex_count(), plain.vertex_count() + 4 * 4) << "four islands of four wedges";
+  SimplifyOptions o;
+  o.as_far_as_possible = true;
+  for (Scheme scheme : {Scheme::Passes, Scheme::Greedy}) {
+    SCOPED_TRACE(to_string(scheme));
+    o.scheme = scheme;
+    const SimplifyResult r = simplify(islands, o), reference = simplify(plain, o);
+    EXPECT_EQ(r.mesh.face_count(), reference.mesh.face_count());
+    EXPECT_EQ(open_edges_welded(r.mesh), open_edges_welded(reference.mesh));
+  }
 }
 
 namespace {

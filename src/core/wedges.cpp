@@ -177,6 +177,20 @@ void Wedges::merge(std::uint32_t survivor, std::uint32_t removed, bool moved, co
         }
 }
 
+void Wedges::drop_unused(std::vector<std::uint32_t>& emptied) {
+  for (std::uint32_t w : emptied) {
+    if (corners[w] != 0 || merged_into[w] != kNoVertex || vertex[w] == kNoVertex) continue;
+    std::uint32_t& head = first[vertex[w]];
+    if (head == kNoVertex || next[w] == w) continue;  // a removed vertex, or its last wedge
+    std::uint32_t before = w;
+    while (next[before] != w) before = next[before];
+    next[before] = next[w];
+    next[w] = w;
+    if (head == w) head = before;
+  }
+  emptied.clear();
+}
+
 void Wedges::renumber(const std::vector<std::uint32_t>& vertex_to, std::size_t count) {
   for (std::uint32_t& v : vertex) v = v == kNoVertex ? kNoVertex : vertex_to[v];
   squeeze_by(vertex_to, count, first);
@@ -269,6 +283,8 @@ Wedges build_wedges(MeshView in, const std::vector<std::uint32_t>& internal, Wor
     for (std::uint32_t w = 0; w < wg.count(); ++w)
       if (options.vertex_protect[wg.source[w]]) wg.protect[wg.vertex[w]] = 1;
   }
+  wg.corners.assign(wg.count(), 0);
+  for (std::uint32_t w : m.corner_wedge) ++wg.corners[w];
   wg.quadric.assign(wg.count() * std::size_t(wg.quadric_width), 0);
   for (std::uint32_t f = 0; f < m.face_source.size(); ++f) {
     const std::uint32_t* t = m.face(f);
