@@ -139,7 +139,7 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
           target, static_cast<std::size_t>(std::floor(double(total_faces) * double(options.target_vertices) /
                                                       double(total_vertices))));
     const bool face_target = target != std::numeric_limits<std::size_t>::max();
-    report.target_faces = face_target ? target : total_faces;
+    report.target_faces = face_target ? target : options.as_far_as_possible ? 0 : total_faces;
 
     if (jobs.size() == 1) {
       // One primitive: the scene's target is its own, and there is nothing to share.

@@ -110,6 +110,19 @@ Scene two_spheres() {
   return s;
 }
 
+/// 200 separate tetrahedra of 0.05 (800 faces, which no contraction may touch: each would lose its
+/// topology) in one mesh, and a unit sphere of 5120 faces in another.
+Scene dead_end_scene() {
+  Scene s;
+  qem::Mesh tetras;
+  for (int k = 0; k < 200; ++k)
+    tetras = qem::test::concatenated(
+        tetras, qem::test::transformed(qem::test::tetrahedron(), 0.05, k % 20, k / 20.0, 0));
+  s.node(s.mesh(tetras, false), 1);
+  s.node(s.mesh(qem::test::icosphere(4)), 1);
+  return s;
+}
+
 TEST(GltfSimplify, WorldScaleFollowsTheNodes) {
   Scene s = two_spheres();
   s.node(1, 30);  // the second mesh instanced again, smaller: its largest scale counts
@@ -214,14 +227,7 @@ TEST(GltfSimplify, PrimitivesAtADeadEndLeaveTheReductionToTheOthers) {
   // 200 separate tetrahedra: no contraction keeps their topology, so their 800 faces stay; the
   // sphere must then go below the watched run's floor (a quarter of the scene's ratio) to come
   // as close to the target as it can.
-  Scene s;
-  qem::Mesh tetras;
-  for (int k = 0; k < 200; ++k)
-    tetras = qem::test::concatenated(
-        tetras, qem::test::transformed(qem::test::tetrahedron(), 0.05, k % 20, k / 20.0, 0));
-  s.node(s.mesh(tetras, false), 1);
-  s.node(s.mesh(qem::test::icosphere(4)), 1);
-  qem::GltfDocument doc = qem::GltfDocument::parse(s.text(), "dead_end.gltf");
+  qem::GltfDocument doc = qem::GltfDocument::parse(dead_end_scene().text(), "dead_end.gltf");
   qem::SimplifyOptions opt;
   opt.target_ratio = 0.1;  // 592 of 5920 faces
   const qem::GltfSimplifyReport r = qem::simplify_document(doc, opt);
@@ -305,6 +311,34 @@ TEST(GltfSimplifyCli, KeepsTheDocumentAndNotesKeptPrimitives) {
   // --per-mesh on a non-glTF output is refused.
   EXPECT_NE(run_qem("simplify '" + in + "' '" + dir + "/x.ply' --ratio 0.5 --per-mesh", &err), 0);
   EXPECT_NE(err.find("--per-mesh"), std::string::npos) << err;
+}
+
+TEST(GltfSimplifyCli, AsFarAsPossibleIsNoMissedTarget) {
+  // --faces 0 asks every primitive to go as far as the checks allow: stopping where no contraction
+  // is left is what was asked, not a target missed. With a target that a dead end keeps the scene
+  // from (200 tetrahedra that no contraction may touch, and a sphere), the summary says it missed.
+  Scene s = two_spheres();
+  const std::string dir = qem::test::temp_dir();
+  const std::string in = write(dir + "/far.gltf", s.text()), out = dir + "/far_out.glb";
+  std::string err;
+  ASSERT_EQ(run_qem("simplify '" + in + "' '" + out + "' --faces 0", &err), 0) << err;
+  EXPECT_EQ(err.find("stopped before"), std::string::npos) << err;
+  EXPECT_NE(err.find("2 primitives went as far as the checks allow"), std::string::npos) << err;
+  const std::string out_json = dir + "/far.json";
+  ASSERT_EQ(std::system((std::string(QEM_CLI_PATH) + " simplify '" + in + "' '" + out + "' --faces 0 --json -q > '" +
+                         out_json + "' 2> /dev/null")
+                            .c_str()),
+            0);
+  const json report = json::parse(qem::test::slurp(out_json));
+  EXPECT_EQ(report["stopped_early"], 0);
+  EXPECT_EQ(report["target_faces"], 0);
+  for (const json& each : report["each"]) EXPECT_EQ(each["stop"], "no valid contraction left");
+
+  const std::string in2 = write(dir + "/dead_end.gltf", dead_end_scene().text());
+  ASSERT_EQ(run_qem("simplify '" + in2 + "' '" + out + "' --ratio 0.1 --force", &err), 0) << err;
+  EXPECT_NE(err.find("1 primitive stopped before the scene's target"), std::string::npos) << err;
+  ASSERT_EQ(run_qem("simplify '" + in2 + "' '" + out + "' --faces 0 --force", &err), 0) << err;
+  EXPECT_EQ(err.find("stopped before"), std::string::npos) << err;
 }
 
 TEST(GltfSimplifyCli, CompressedGeometryIsRefusedWithNoOutput) {
