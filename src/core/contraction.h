@@ -166,7 +166,7 @@ void contract(Context& c, Lists& lists, std::uint32_t p, const Quadric& q, const
   if (c.components) c.components->faces_died(a, w.faces_killed - killed_before);
   merge_pairs(c, lists, p, a, b, w);
   if (c.wedges) {
-    c.wedges->merge(a, b, moves, target, w.wedge_map);
+    c.wedges->merge(a, b, moves, target, w.wedge_map, m, w.faces);
     c.wedges->drop_unused(w.emptied_wedges);  // a seam whose faces on one side all died is gone
   }
   lists.contracted(a, b, w.faces, w.pairs);

@@ -62,11 +62,13 @@ struct Wedges {
   /// Sets w's interpolated channels to their optimum at p (after the merge).
   void update_values(std::uint32_t w, const Vec3& p);
   /// `removed` went into `survivor`, now at p: each removed wedge's quadric joins its partner's
-  /// (map from map_wedges), and, if the survivor moved, its wedges take their optimal values at p.
-  /// A survivor that stays (a seam, a border, an endpoint placement) keeps its values, as it keeps
-  /// its position: a seam's UVs stay exactly on the chart's edge.
+  /// (map from map_wedges), and, if the survivor moved, its wedges take their optimal values at p,
+  /// UVs within the box of the UVs of its neighbours on `faces` (the survivor's live faces, corners
+  /// already mapped). A survivor that stays (a seam, a border, an endpoint placement) keeps its
+  /// values, as it keeps its position: a seam's UVs stay exactly on the chart's edge.
   void merge(std::uint32_t survivor, std::uint32_t removed, bool moved, const Vec3& p,
-             const std::vector<std::pair<std::uint32_t, std::uint32_t>>& map);
+             const std::vector<std::pair<std::uint32_t, std::uint32_t>>& map, const WorkingMesh& m,
+             const std::vector<std::uint32_t>& faces);
   /// A face corner moved from wedge `from` to wedge `to` (`to` == kNoVertex: the face died).
   /// A wedge left with no corner is added to `emptied`, for drop_unused.
   void move_corner(std::uint32_t from, std::uint32_t to, std::vector<std::uint32_t>& emptied) {
