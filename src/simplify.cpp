@@ -80,7 +80,8 @@ RefitResult refit_with_seams(const refit_detail::FitPoints& points, SimplifyResu
 }
 
 SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options, SimplifyObserver* observer,
-                                  std::vector<std::uint32_t>* consumed_indices) {
+                                  std::vector<std::uint32_t>* consumed_indices,
+                                  std::vector<VertexAttribute>* consumed_attributes) {
   check_options(options);
   const bool refit = options.refit_rounds > 0;
   // The refit fits the input's vertices weighted by their share of the area: taken before the
@@ -89,6 +90,7 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
   core::RunHooks hooks;
   hooks.observer = observer;
   hooks.consumed_indices = consumed_indices;
+  hooks.consumed_attributes = consumed_attributes;
   hooks.map_input_vertices = refit;
   core::WedgeRefitData wedge_refit;  // with attributes, for the refit
   if (refit && !input.attributes.empty()) hooks.wedge_refit = &wedge_refit;
@@ -119,11 +121,11 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
 }  // namespace
 
 SimplifyResult simplify(MeshView input, const SimplifyOptions& options, SimplifyObserver* observer) {
-  return simplify_and_refit(input, options, observer, nullptr);
+  return simplify_and_refit(input, options, observer, nullptr, nullptr);
 }
 
 SimplifyResult simplify(Mesh&& input, const SimplifyOptions& options, SimplifyObserver* observer) {
-  SimplifyResult out = simplify_and_refit(input, options, observer, &input.indices);
+  SimplifyResult out = simplify_and_refit(input, options, observer, &input.indices, &input.attributes);
   out.mesh.material_names = std::move(input.material_names);
   out.mesh.material_library = std::move(input.material_library);
   return out;

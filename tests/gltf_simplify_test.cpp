@@ -22,24 +22,6 @@ namespace {
 
 using json = nlohmann::json;
 
-std::string base64(const std::string& in) {
-  static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  std::size_t i = 0;
-  for (; i + 2 < in.size(); i += 3) {
-    unsigned v = (unsigned char)in[i] << 16 | (unsigned char)in[i + 1] << 8 | (unsigned char)in[i + 2];
-    for (int s = 18; s >= 0; s -= 6) out += k[(v >> s) & 63];
-  }
-  if (i + 1 == in.size()) {
-    unsigned v = (unsigned char)in[i] << 16;
-    out += {k[(v >> 18) & 63], k[(v >> 12) & 63], '=', '='};
-  } else if (i + 2 == in.size()) {
-    unsigned v = (unsigned char)in[i] << 16 | (unsigned char)in[i + 1] << 8;
-    out += {k[(v >> 18) & 63], k[(v >> 12) & 63], k[(v >> 6) & 63], '='};
-  }
-  return out;
-}
-
 /// A glTF document assembled in code: meshes of float POSITION (+ NORMAL) and uint32 indices,
 /// each placed by a node with a uniform scale, one embedded buffer.
 struct Scene {
@@ -93,12 +75,7 @@ struct Scene {
     doc["nodes"].push_back({{"mesh", mesh}, {"scale", {scale, scale, scale}}});
     doc["scenes"][0]["nodes"].push_back(doc["nodes"].size() - 1);
   }
-  std::string text() const {
-    json d = doc;
-    d["buffers"][0]["byteLength"] = bin.size();
-    d["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64(bin);
-    return d.dump();
-  }
+  std::string text() const { return qem::test::gltf_text(doc, bin); }
 };
 
 /// Two spheres of 5120 faces: a unit one at scale 1 and one of local radius 0.1 drawn at scale 100
