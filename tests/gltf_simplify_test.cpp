@@ -213,6 +213,51 @@ TEST(GltfSimplify, PrimitivesAtADeadEndLeaveTheReductionToTheOthers) {
   EXPECT_EQ(r.primitives[1].stop_reason, qem::StopReason::NoValidPair);
 }
 
+TEST(GltfSimplify, PrimitivesOfOneMeshStayJoined) {
+  // A sphere split into two primitives of one mesh (two materials, each with its own copy of the
+  // vertices on the line where they meet, as exporters write them). Simplified apart, each would
+  // move or remove its side of the line: a crack. The shared vertices stay, so welded by position
+  // the output is as closed as the input, in both modes.
+  const qem::Mesh sphere = qem::test::icosphere(4);
+  Scene s;
+  s.doc["meshes"].push_back({{"primitives", json::array()}});
+  for (int half = 0; half < 2; ++half) {
+    qem::Mesh part;
+    std::vector<std::uint32_t> id(sphere.vertex_count(), UINT32_MAX);
+    for (std::size_t f = 0; f < sphere.face_count(); ++f) {
+      double z = 0;
+      for (int k = 0; k < 3; ++k) z += sphere.positions[3 * sphere.indices[3 * f + k] + 2];
+      if ((z > 0.3) != (half == 0)) continue;
+      for (int k = 0; k < 3; ++k) {
+        std::uint32_t& v = id[sphere.indices[3 * f + k]];
+        if (v == UINT32_MAX) {
+          v = std::uint32_t(part.vertex_count());
+          const double* p = &sphere.positions[3 * sphere.indices[3 * f + k]];
+          part.positions.insert(part.positions.end(), {p[0], p[1], p[2]});
+        }
+        part.indices.push_back(v);
+      }
+    }
+    const int m = s.mesh(part);
+    s.doc["meshes"][0]["primitives"].push_back(s.doc["meshes"][m]["primitives"][0]);
+  }
+  s.doc["meshes"].erase(2), s.doc["meshes"].erase(1);
+  s.node(0, 1);
+  ASSERT_EQ(qem::test::open_edges_welded(qem::GltfDocument::parse(s.text(), "halves.gltf").scene_mesh()), 0u);
+  for (bool per_mesh : {false, true}) {
+    SCOPED_TRACE(per_mesh ? "per mesh" : "shared budget");
+    qem::GltfDocument doc = qem::GltfDocument::parse(s.text(), "halves.gltf");
+    qem::SimplifyOptions opt;
+    opt.target_ratio = 0.1;
+    qem::GltfSimplifyOptions gltf_options;
+    gltf_options.per_primitive = per_mesh;
+    const qem::GltfSimplifyReport r = qem::simplify_document(doc, opt, gltf_options);
+    EXPECT_EQ(r.simplified, 2u);
+    EXPECT_LT(r.faces_out, r.faces_in / 5);
+    EXPECT_EQ(qem::test::open_edges_welded(doc.scene_mesh()), 0u) << "a crack opened between the primitives";
+  }
+}
+
 TEST(GltfSimplify, MorphTargetPrimitiveIsKeptUnchanged) {
   Scene s = two_spheres();
   // Mesh 0 gets a morph target (its normals' accessor serves as the offsets).
