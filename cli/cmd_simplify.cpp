@@ -120,9 +120,9 @@ int run_simplify_gltf(const SimplifyArgs& a, const SimplifyOptions& opt) {
                  "qem: %zu primitive%s %s: no contraction left that keeps the topology, the borders and "
                  "the face orientations\n",
                  at_dead_end, at_dead_end == 1 ? "" : "s",
-                 stopped_early == 0              ? "went as far as the checks allow"
-                 : a.per_mesh                    ? "stopped before its target"
-                                                 : "stopped before the scene's target");
+                 stopped_early == 0 ? "went as far as the checks allow"
+                 : a.per_mesh       ? "stopped before its target"
+                                    : "stopped before the scene's target");
   return 0;
 }
 

@@ -241,17 +241,19 @@ TEST(Attributes, SeamPlanesKeepACurvedSeamsShape) {
 TEST(Attributes, LinearUvsFollowTheMovedVertex) {
   // UVs that are a linear function of the position (u = x, v = y on a wavy height field): Hoppe's
   // optimum at a new position is that function (to second order off the faces' planes), also
-  // where the optimal placement leaves the collapsed edge (it does on a curved surface). Clamping them to the box of the two merged
-  // ends' UVs pulled such vertices' UVs off it; the box of the neighbours' UVs does not.
-  Mesh in = test::height_field(24, [](double x, double y) { return 0.1 * std::sin(6 * x) * std::cos(5 * y); });
+  // where the optimal placement leaves the collapsed edge (it does on a curved surface). Clamping
+  // them to the box of the two merged ends' UVs pulled such vertices' UVs off it; the box of the
+  // neighbours' UVs does not.
+  Mesh in =
+      test::height_field(24, [](double x, double y) { return 0.1 * std::sin(6 * x) * std::cos(5 * y); });
   VertexAttribute uv{"TEXCOORD_0", AttributeKind::TexCoord, 2, {}};
   for (std::size_t v = 0; v < in.vertex_count(); ++v)
     uv.values.insert(uv.values.end(), {in.positions[3 * v], in.positions[3 * v + 1]});
   in.attributes = {uv};
   SimplifyOptions o;
   o.target_ratio = 0.1;
-  o.refit_rounds = 0;     // the refit moves vertices and keeps their values
-  o.lock_border = true;   // the border's vertices would leave the chart, where the box holds them
+  o.refit_rounds = 0;    // the refit moves vertices and keeps their values
+  o.lock_border = true;  // the border's vertices would leave the chart, where the box holds them
   const SimplifyResult r = simplify(in, o);
   ASSERT_LE(r.mesh.face_count(), 116u);
   const VertexAttribute& out = attribute(r.mesh, AttributeKind::TexCoord);

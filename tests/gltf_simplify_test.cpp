@@ -347,8 +347,8 @@ TEST(GltfSimplifyCli, AsFarAsPossibleIsNoMissedTarget) {
   EXPECT_EQ(err.find("stopped before"), std::string::npos) << err;
   EXPECT_NE(err.find("2 primitives went as far as the checks allow"), std::string::npos) << err;
   const std::string out_json = dir + "/far.json";
-  ASSERT_EQ(std::system((std::string(QEM_CLI_PATH) + " simplify '" + in + "' '" + out + "' --faces 0 --json -q > '" +
-                         out_json + "' 2> /dev/null")
+  ASSERT_EQ(std::system((std::string(QEM_CLI_PATH) + " simplify '" + in + "' '" + out +
+                         "' --faces 0 --json -q > '" + out_json + "' 2> /dev/null")
                             .c_str()),
             0);
   const json report = json::parse(qem::test::slurp(out_json));

@@ -1,9 +1,6 @@
 #include "test_meshes.h"
 
 #include <gtest/gtest.h>
-
-#include <nlohmann/json.hpp>
-
 #include <unistd.h>
 
 #include <algorithm>
@@ -13,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 namespace qem::test {
@@ -181,28 +179,28 @@ Mesh uv_cube(int n, double relief, bool flat_normals, int block) {
       auto [it, fresh] = ids.try_emplace({side, i, j, ci, cj}, std::uint32_t(m.vertex_count()));
       if (!fresh) return it->second;
       const double s = -1 + 2.0 * i / n, t = -1 + 2.0 * j / n;
-        double p[3];
-        p[axis] = sign * (1 + relief * (1 - s * s) * (1 - t * t) * std::cos(2 * s + t));
-        p[(axis + 1) % 3] = sign * s;  // the side's orientation follows its outward normal
-        p[(axis + 2) % 3] = t;
-        m.positions.insert(m.positions.end(), {p[0], p[1], p[2]});
-        // Each chart shifted in the atlas, so that neighbouring charts' UVs differ.
-        uv.values.insert(uv.values.end(), {(side % 3 + 0.05 + 0.9 * (s + 1) / 2) / 3 + 0.01 * ci,
-                                           (side / 3 + 0.05 + 0.9 * (t + 1) / 2) / 2 + 0.01 * cj});
-        double nn[3] = {0, 0, 0};
-        nn[axis] = sign;
-        const double len = std::hypot(p[0], p[1], p[2]);
-        if (flat_normals)
-          normal.values.insert(normal.values.end(), {nn[0], nn[1], nn[2]});
-        else
-          normal.values.insert(normal.values.end(), {p[0] / len, p[1] / len, p[2] / len});
+      double p[3];
+      p[axis] = sign * (1 + relief * (1 - s * s) * (1 - t * t) * std::cos(2 * s + t));
+      p[(axis + 1) % 3] = sign * s;  // the side's orientation follows its outward normal
+      p[(axis + 2) % 3] = t;
+      m.positions.insert(m.positions.end(), {p[0], p[1], p[2]});
+      // Each chart shifted in the atlas, so that neighbouring charts' UVs differ.
+      uv.values.insert(uv.values.end(), {(side % 3 + 0.05 + 0.9 * (s + 1) / 2) / 3 + 0.01 * ci,
+                                         (side / 3 + 0.05 + 0.9 * (t + 1) / 2) / 2 + 0.01 * cj});
+      double nn[3] = {0, 0, 0};
+      nn[axis] = sign;
+      const double len = std::hypot(p[0], p[1], p[2]);
+      if (flat_normals)
+        normal.values.insert(normal.values.end(), {nn[0], nn[1], nn[2]});
+      else
+        normal.values.insert(normal.values.end(), {p[0] / len, p[1] / len, p[2] / len});
       return it->second;
     };
     for (int i = 0; i < n; ++i)
       for (int j = 0; j < n; ++j) {
         const int ci = block > 0 ? i / block : 0, cj = block > 0 ? j / block : 0;
-        const std::uint32_t a = vertex(i, j, ci, cj), b = vertex(i + 1, j, ci, cj), c = vertex(i + 1, j + 1, ci, cj),
-                            d = vertex(i, j + 1, ci, cj);
+        const std::uint32_t a = vertex(i, j, ci, cj), b = vertex(i + 1, j, ci, cj),
+                            c = vertex(i + 1, j + 1, ci, cj), d = vertex(i, j + 1, ci, cj);
         m.indices.insert(m.indices.end(), {a, b, c, a, c, d});
         if (block > 0) m.face_materials.insert(m.face_materials.end(), 2, std::uint32_t(side % 2));
       }
@@ -322,7 +320,8 @@ void erase_gltf_defaults(nlohmann::json& j) {
     erase_default(m, "doubleSided", false);
     for (const char* t : {"normalTexture", "occlusionTexture", "emissiveTexture"})
       if (m.contains(t))
-        erase_default(m[t], "texCoord", 0), erase_default(m[t], "scale", 1), erase_default(m[t], "strength", 1);
+        erase_default(m[t], "texCoord", 0), erase_default(m[t], "scale", 1),
+            erase_default(m[t], "strength", 1);
     if (m.contains("pbrMetallicRoughness")) {
       nlohmann::json& pbr = m["pbrMetallicRoughness"];
       erase_default(pbr, "baseColorFactor", nlohmann::json::array({1.0, 1.0, 1.0, 1.0}));

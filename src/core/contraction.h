@@ -26,7 +26,8 @@ namespace qem::core {
 inline void kill_face(Context& c, std::uint32_t f, Worker& w) {
   c.mesh.face_alive[f] = 0;
   if (c.wedges)
-    for (int k = 0; k < 3; ++k) c.wedges->move_corner(c.mesh.corner_wedge[3 * std::size_t(f) + k], kNoVertex, w.emptied_wedges);
+    for (int k = 0; k < 3; ++k)
+      c.wedges->move_corner(c.mesh.corner_wedge[3 * std::size_t(f) + k], kNoVertex, w.emptied_wedges);
   ++w.faces_killed;
   if (c.observe_contractions) w.dead_faces.push_back(c.mesh.face_source[f]);
 }

@@ -183,7 +183,8 @@ void Wedges::merge(std::uint32_t survivor, std::uint32_t removed, bool moved, co
         for (std::uint32_t f : faces) {
           const std::uint32_t* t = m.face(f);
           const std::uint32_t* cw = &m.corner_wedge[3 * std::size_t(f)];
-          if (!((t[0] == survivor && cw[0] == w) || (t[1] == survivor && cw[1] == w) || (t[2] == survivor && cw[2] == w)))
+          if (!((t[0] == survivor && cw[0] == w) || (t[1] == survivor && cw[1] == w) ||
+                (t[2] == survivor && cw[2] == w)))
             continue;
           for (int k = 0; k < 3; ++k) {
             if (t[k] == survivor) continue;
