@@ -15,9 +15,9 @@ Inputs: each tool reads the file itself where it can. The peer script reads .glb
 but no vertex colours and no materials in OBJ and no attributes in PLY, so the PLY assets and the
 vertex-coloured OBJ are given to the peers as a .glb written here from qem's lossless OBJ copy
 (one primitive per material, i.e. per face colour; COLOR_0, NORMAL, TEXCOORD_0 as float). qem and
-both metrics always read the original file. On .glb files qem simplifies the merged scene (the
-target shared by all primitives) and writes it as one .glb; the peers simplify each primitive to
-the same fraction and keep the document.
+both metrics always read the original file. On .glb files qem keeps the document (one error budget
+shared by the primitives); the peers simplify each primitive to the same fraction and keep the
+document.
 """
 import argparse
 import json
@@ -242,7 +242,7 @@ def line(row, tools):
     # check: the largest relative difference between qem measure and attr_metric.py over the
     # attribute errors of qem's and meshopt's outputs (sampling noise is a few %).
     diffs = []
-    # attr_metric.py reads glTF in mesh space and qem's merged .glb is in scene space: no check there.
+    # .glb: only meshoptimizer's output is cross-checked (as when qem's was one merged scene-space mesh).
     for r in ((m,) if row['asset'].endswith('.glb') else (q, m)):
         for k in ('uv_rms', 'normal_rms_deg', 'color_rms'):
             a, b = r.get(k), r.get('py_' + k)

@@ -80,12 +80,14 @@ int run_simplify_gltf(const SimplifyArgs& a, const SimplifyOptions& opt) {
   for (const std::string& n : doc.notes()) std::fprintf(stderr, "qem: note: %s\n", n.c_str());
   std::size_t out_vertices = 0;
   for (const GltfPrimitiveInfo& p : doc.primitives()) out_vertices += p.vertex_count;
-  // Primitives that ran out of allowed contractions (locked borders, topology, inversion) before
-  // their target: the scene's target may then be missed, which the summary says.
-  std::size_t stopped_early = 0;
+  // Primitives that ran out of allowed contractions (locked borders, topology, inversion): before
+  // their target, so that the scene's target may be missed, which the summary says; or, asked to go
+  // as far as the checks allow (a target of 0), where they were asked to stop.
+  std::size_t at_dead_end = 0;
   for (const GltfPrimitiveOutcome& o : r.primitives)
-    stopped_early +=
+    at_dead_end +=
         o.status == GltfPrimitiveOutcome::Status::Simplified && o.stop_reason == StopReason::NoValidPair;
+  const std::size_t stopped_early = opt.as_far_as_possible ? 0 : at_dead_end;
   if (a.json) {
     // Each primitive: where it is in the document, what happened to it, its error in world units.
     std::string each;
@@ -120,12 +122,14 @@ int run_simplify_gltf(const SimplifyArgs& a, const SimplifyOptions& opt) {
                  "they were), max error %.4g in world units, %.3f s; the rest of the document is unchanged\n",
                  r.faces_in, r.faces_out, r.primitives.size(), r.simplified, r.unchanged, r.kept,
                  r.max_world_error, total.seconds());
-  if (!a.quiet && stopped_early > 0)
-    std::fprintf(
-        stderr,
-        "qem: %zu primitive%s stopped before %s target: no contraction left that keeps the topology, "
-        "the borders and the face orientations\n",
-        stopped_early, stopped_early == 1 ? "" : "s", a.per_mesh ? "its" : "the scene's");
+  if (!a.quiet && at_dead_end > 0)
+    std::fprintf(stderr,
+                 "qem: %zu primitive%s %s: no contraction left that keeps the topology, the borders and "
+                 "the face orientations\n",
+                 at_dead_end, at_dead_end == 1 ? "" : "s",
+                 stopped_early == 0 ? "went as far as the checks allow"
+                 : a.per_mesh       ? "stopped before its target"
+                                    : "stopped before the scene's target");
   return 0;
 }
 

@@ -3,11 +3,13 @@
 #include "qem/gltf_simplify.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <exception>
 #include <functional>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <optional>
 #include <thread>
@@ -109,6 +111,35 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
   std::vector<Mesh> meshes(jobs.size());
   for (std::size_t j = 0; j < jobs.size(); ++j) meshes[j] = doc.mesh(jobs[j]);
 
+  // The primitives of one mesh are simplified apart, but they are one surface split by material:
+  // where they meet, each keeps the vertices it shares with another (same position), so that
+  // their common border stays closed instead of opening a crack between them. (Unless the caller
+  // locks vertices itself: its vertex_lock then applies to every primitive as given.)
+  std::vector<std::vector<std::uint8_t>> shared(jobs.size());
+  if (options.vertex_lock.empty()) {
+    std::map<std::pair<std::size_t, std::array<double, 3>>, std::size_t> owner;  // (mesh, position) -> job
+    constexpr std::size_t kSeveral = std::numeric_limits<std::size_t>::max();
+    const auto at = [&](std::size_t j, std::size_t v) {
+      const double* p = &meshes[j].positions[3 * v];
+      return std::pair{info[jobs[j]].mesh, std::array<double, 3>{p[0], p[1], p[2]}};
+    };
+    for (std::size_t j = 0; j < jobs.size(); ++j)
+      for (std::size_t v = 0; v < meshes[j].vertex_count(); ++v) {
+        auto [it, fresh] = owner.try_emplace(at(j, v), j);
+        if (!fresh && it->second != j) it->second = kSeveral;
+      }
+    for (std::size_t j = 0; j < jobs.size(); ++j) {
+      std::vector<std::uint8_t> lock(meshes[j].vertex_count(), 0);
+      bool any = false;
+      for (std::size_t v = 0; v < lock.size(); ++v) any |= lock[v] = owner[at(j, v)] == kSeveral;
+      if (any) shared[j] = std::move(lock);
+    }
+  }
+  const auto with_shared_locks = [&](SimplifyOptions o, std::size_t j) {
+    if (!shared[j].empty()) o.vertex_lock = shared[j];
+    return o;
+  };
+
   // The error limit in world units (relative: of the scene's diagonal, in shared mode).
   double world_max_error = options.max_error;
   if (options.max_error_is_relative && std::isfinite(world_max_error) && !gltf_options.per_primitive)
@@ -119,7 +150,7 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
   std::vector<ErrorCurve> curves;
   if (gltf_options.per_primitive) {
     for (std::size_t j = 0; j < jobs.size(); ++j) {
-      SimplifyOptions o = options;
+      SimplifyOptions o = with_shared_locks(options, j);
       o.threads = inner_threads;
       if (!o.max_error_is_relative) o.max_error = local_error(o.max_error, info[jobs[j]].world_scale);
       final_options[j] = o;
@@ -139,11 +170,11 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
           target, static_cast<std::size_t>(std::floor(double(total_faces) * double(options.target_vertices) /
                                                       double(total_vertices))));
     const bool face_target = target != std::numeric_limits<std::size_t>::max();
-    report.target_faces = face_target ? target : total_faces;
+    report.target_faces = face_target ? target : options.as_far_as_possible ? 0 : total_faces;
 
     if (jobs.size() == 1) {
       // One primitive: the scene's target is its own, and there is nothing to share.
-      SimplifyOptions o = options;
+      SimplifyOptions o = with_shared_locks(options, 0);
       o.target_ratio = 0, o.target_vertices = 0;
       o.target_faces = face_target ? std::max<std::size_t>(1, target) : 0;
       o.max_error = local_error(world_max_error, info[jobs[0]].world_scale);
@@ -157,7 +188,7 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
           face_target && total_faces > 0 ? 0.25 * double(target) / double(total_faces) : 0;
       auto watch = [&](std::size_t j, std::size_t floor_faces) {
         curves[j] = ErrorCurve(info[jobs[j]].world_scale);
-        SimplifyOptions o = options;
+        SimplifyOptions o = with_shared_locks(options, j);
         o.target_ratio = 0, o.target_vertices = 0;
         o.target_faces = std::max<std::size_t>(1, floor_faces);
         o.max_error = local_error(world_max_error, info[jobs[j]].world_scale);
@@ -236,7 +267,7 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
       // same error limit, which blocks the same pairs.
       for (std::size_t j = 0; j < jobs.size(); ++j) {
         if (faces[j] >= curves[j].initial) continue;  // nothing to do: left as it is
-        SimplifyOptions o = options;
+        SimplifyOptions o = with_shared_locks(options, j);
         o.target_ratio = 0, o.target_vertices = 0;
         o.target_faces = std::max<std::size_t>(1, faces[j]);
         o.max_error = local_error(world_max_error, info[jobs[j]].world_scale);

@@ -116,7 +116,8 @@ RefitResult refit_with_seams(const refit_detail::FitPoints& points, SimplifyResu
 }
 
 SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options, SimplifyObserver* observer,
-                                  std::vector<std::uint32_t>* consumed_indices) {
+                                  std::vector<std::uint32_t>* consumed_indices,
+                                  std::vector<VertexAttribute>* consumed_attributes) {
   check_options(options);
   const bool refit = options.refit_rounds > 0;
   const bool bounded = std::isfinite(options.max_distance);
@@ -128,6 +129,7 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
   core::RunHooks hooks;
   hooks.observer = observer;
   hooks.consumed_indices = consumed_indices;
+  hooks.consumed_attributes = consumed_attributes;
   hooks.map_input_vertices = refit;
   core::WedgeRefitData wedge_refit;  // with attributes, for the refit
   if (refit && !input.attributes.empty()) hooks.wedge_refit = &wedge_refit;
@@ -171,11 +173,11 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
 }  // namespace
 
 SimplifyResult simplify(MeshView input, const SimplifyOptions& options, SimplifyObserver* observer) {
-  return simplify_and_refit(input, options, observer, nullptr);
+  return simplify_and_refit(input, options, observer, nullptr, nullptr);
 }
 
 SimplifyResult simplify(Mesh&& input, const SimplifyOptions& options, SimplifyObserver* observer) {
-  SimplifyResult out = simplify_and_refit(input, options, observer, &input.indices);
+  SimplifyResult out = simplify_and_refit(input, options, observer, &input.indices, &input.attributes);
   out.mesh.material_names = std::move(input.material_names);
   out.mesh.material_library = std::move(input.material_library);
   return out;

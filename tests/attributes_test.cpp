@@ -14,73 +14,9 @@
 #include "test_meshes.h"
 
 using namespace qem;
-
-namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-// A latitude-longitude sphere with a UV seam: the column at u = 1 repeats the positions of u = 0
-// with other texture coordinates (split vertices, as exporters write them); the poles are fans.
-Mesh uv_sphere(int rings, int segments) {
-  Mesh m;
-  VertexAttribute uv{"TEXCOORD_0", AttributeKind::TexCoord, 2, {}};
-  VertexAttribute normal{"NORMAL", AttributeKind::Normal, 3, {}};
-  for (int i = 0; i <= rings; ++i)
-    for (int j = 0; j <= segments; ++j) {
-      const double theta = kPi * i / rings, phi = 2 * kPi * (j % segments) / segments;
-      double p[3] = {std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)};
-      if (i == 0 || i == rings) p[0] = p[1] = 0;  // the poles: one position for the whole ring
-      // A little relief so that there is something to keep.
-      const double r = 1 + 0.05 * std::sin(5 * theta) * std::cos(3 * phi);
-      m.positions.insert(m.positions.end(), {r * p[0], r * p[1], r * p[2]});
-      uv.values.insert(uv.values.end(), {double(j) / segments, double(i) / rings});
-      normal.values.insert(normal.values.end(), {p[0], p[1], p[2]});
-    }
-  auto id = [&](int i, int j) { return std::uint32_t(i * (segments + 1) + j); };
-  for (int i = 0; i < rings; ++i)
-    for (int j = 0; j < segments; ++j) {
-      if (i > 0) m.indices.insert(m.indices.end(), {id(i, j), id(i + 1, j), id(i, j + 1)});
-      if (i + 1 < rings) m.indices.insert(m.indices.end(), {id(i, j + 1), id(i + 1, j), id(i + 1, j + 1)});
-    }
-  m.attributes = {uv, normal};
-  return m;
-}
-
-// Edges used by one face once the vertices are welded by position: holes and cracks. With
-// `square`, those on the unit square's outline (a flat grid's own border) are not counted.
-std::size_t open_edges_welded(const Mesh& m, bool square = false) {
-  std::map<std::array<double, 3>, std::uint32_t> id;
-  std::vector<std::uint32_t> welded(m.vertex_count());
-  for (std::size_t v = 0; v < m.vertex_count(); ++v)
-    welded[v] = id.try_emplace({m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]},
-                               std::uint32_t(id.size()))
-                    .first->second;
-  std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
-  for (std::size_t f = 0; f < m.face_count(); ++f)
-    for (int k = 0; k < 3; ++k) {
-      std::uint32_t a = welded[m.indices[3 * f + k]], b = welded[m.indices[3 * f + (k + 1) % 3]];
-      ++uses[{std::min(a, b), std::max(a, b)}];
-    }
-  std::vector<std::array<double, 3>> at(id.size());
-  for (const auto& [p, i] : id) at[i] = p;
-  auto on_outline = [&](std::uint32_t a, std::uint32_t b) {
-    for (int k = 0; k < 2; ++k)
-      for (double side : {0.0, 1.0})  // GH97 §6's border planes are a penalty: corners may drift a little
-        if (std::abs(at[a][k] - side) < 1e-9 && std::abs(at[b][k] - side) < 1e-9) return true;
-    return false;
-  };
-  std::size_t open = 0;
-  for (const auto& [edge, n] : uses) open += n == 1 && !(square && on_outline(edge.first, edge.second));
-  return open;
-}
-
-const VertexAttribute& attribute(const Mesh& m, AttributeKind kind) {
-  const VertexAttribute* a = m.find_attribute(kind);
-  EXPECT_NE(a, nullptr);
-  return *a;
-}
-
-}  // namespace
+using test::attribute;
+using test::open_edges_welded;
+using test::uv_sphere;
 
 TEST(Attributes, UvSeamStaysClosedAndOnItsLine) {
   const Mesh in = uv_sphere(40, 80);
@@ -300,4 +236,39 @@ TEST(Attributes, SeamPlanesKeepACurvedSeamsShape) {
   const double without = std::abs(disc_area(simplify(in, o).mesh) / before - 1);
   EXPECT_LT(with_planes, 0.02) << "the disc lost or gained area along its seam";
   EXPECT_LT(with_planes, without) << "seam planes made no difference (without them: " << without << ")";
+}
+
+TEST(Attributes, LinearUvsFollowTheMovedVertex) {
+  // UVs that are a linear function of the position (u = x, v = y on a wavy height field): Hoppe's
+  // optimum at a new position is that function (to second order off the faces' planes), also
+  // where the optimal placement leaves the collapsed edge (it does on a curved surface). Clamping
+  // them to the box of the two merged ends' UVs pulled such vertices' UVs off it; the box of the
+  // neighbours' UVs does not.
+  Mesh in =
+      test::height_field(24, [](double x, double y) { return 0.1 * std::sin(6 * x) * std::cos(5 * y); });
+  VertexAttribute uv{"TEXCOORD_0", AttributeKind::TexCoord, 2, {}};
+  for (std::size_t v = 0; v < in.vertex_count(); ++v)
+    uv.values.insert(uv.values.end(), {in.positions[3 * v], in.positions[3 * v + 1]});
+  in.attributes = {uv};
+  SimplifyOptions o;
+  o.target_ratio = 0.1;
+  o.refit_rounds = 0;    // the refit moves vertices and keeps their values
+  o.lock_border = true;  // the border's vertices would leave the chart, where the box holds them
+  const SimplifyResult r = simplify(in, o);
+  ASSERT_LE(r.mesh.face_count(), 116u);
+  const VertexAttribute& out = attribute(r.mesh, AttributeKind::TexCoord);
+  std::set<std::array<double, 3>> grid;  // the input's positions
+  for (std::size_t v = 0; v < in.vertex_count(); ++v)
+    grid.insert({in.positions[3 * v], in.positions[3 * v + 1], in.positions[3 * v + 2]});
+  std::size_t moved = 0;
+  double worst = 0;
+  for (std::size_t v = 0; v < r.mesh.vertex_count(); ++v) {
+    const double x = r.mesh.positions[3 * v], y = r.mesh.positions[3 * v + 1];
+    worst = std::max({worst, std::abs(out.values[2 * v] - x), std::abs(out.values[2 * v + 1] - y)});
+    moved += !grid.count({x, y, r.mesh.positions[3 * v + 2]});
+  }
+  EXPECT_GE(moved, 5u) << "the placements did not test what they should";
+  // Not exactly: each face's fit is linear within its plane, and a vertex placed off those planes
+  // is a second-order distance away (7e-6 here). The endpoints' box gave 0.04, a grid cell.
+  EXPECT_LT(worst, 1e-4);
 }

@@ -118,40 +118,14 @@ std::string image_bytes(const Glb& g, std::size_t i) {
   return im.value("uri", std::string());
 }
 
-void erase_default(json& o, const char* key, const json& value) {
-  if (o.is_object() && o.contains(key) && o[key] == value) o.erase(key);
-}
-
 /// The JSON without the buffer / buffer view / accessor layout, and without the values tinygltf
 /// writes or leaves out for their defaults (the same meaning either way).
 json without_layout(json j) {
   j.erase("buffers");
   j.erase("bufferViews");
-  for (json& a : j["accessors"])
-    a.erase("bufferView"), a.erase("byteOffset"), erase_default(a, "normalized", false);
+  for (json& a : j["accessors"]) a.erase("bufferView"), a.erase("byteOffset");
   for (json& im : j["images"]) im.erase("bufferView");
-  for (json& mesh : j["meshes"])
-    for (json& p : mesh["primitives"]) erase_default(p, "mode", 4);
-  for (json& m : j["materials"]) {
-    erase_default(m, "emissiveFactor", json::array({0.0, 0.0, 0.0}));
-    erase_default(m, "alphaMode", "OPAQUE");
-    erase_default(m, "alphaCutoff", 0.5);
-    erase_default(m, "doubleSided", false);
-    for (const char* t : {"normalTexture", "occlusionTexture", "emissiveTexture"})
-      if (m.contains(t))
-        erase_default(m[t], "texCoord", 0), erase_default(m[t], "scale", 1),
-            erase_default(m[t], "strength", 1);
-    if (m.contains("pbrMetallicRoughness")) {
-      json& pbr = m["pbrMetallicRoughness"];
-      erase_default(pbr, "baseColorFactor", json::array({1.0, 1.0, 1.0, 1.0}));
-      erase_default(pbr, "metallicFactor", 1.0);
-      erase_default(pbr, "roughnessFactor", 1.0);
-      for (const char* t : {"baseColorTexture", "metallicRoughnessTexture"})
-        if (pbr.contains(t)) erase_default(pbr[t], "texCoord", 0);
-      if (pbr.empty()) m.erase("pbrMetallicRoughness");
-    }
-  }
-  if (j.contains("materials") && j["materials"].empty()) j.erase("materials");
+  qem::test::erase_gltf_defaults(j);
   return j;
 }
 

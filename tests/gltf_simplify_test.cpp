@@ -22,24 +22,6 @@ namespace {
 
 using json = nlohmann::json;
 
-std::string base64(const std::string& in) {
-  static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  std::size_t i = 0;
-  for (; i + 2 < in.size(); i += 3) {
-    unsigned v = (unsigned char)in[i] << 16 | (unsigned char)in[i + 1] << 8 | (unsigned char)in[i + 2];
-    for (int s = 18; s >= 0; s -= 6) out += k[(v >> s) & 63];
-  }
-  if (i + 1 == in.size()) {
-    unsigned v = (unsigned char)in[i] << 16;
-    out += {k[(v >> 18) & 63], k[(v >> 12) & 63], '=', '='};
-  } else if (i + 2 == in.size()) {
-    unsigned v = (unsigned char)in[i] << 16 | (unsigned char)in[i + 1] << 8;
-    out += {k[(v >> 18) & 63], k[(v >> 12) & 63], k[(v >> 6) & 63], '='};
-  }
-  return out;
-}
-
 /// A glTF document assembled in code: meshes of float POSITION (+ NORMAL) and uint32 indices,
 /// each placed by a node with a uniform scale, one embedded buffer.
 struct Scene {
@@ -93,12 +75,7 @@ struct Scene {
     doc["nodes"].push_back({{"mesh", mesh}, {"scale", {scale, scale, scale}}});
     doc["scenes"][0]["nodes"].push_back(doc["nodes"].size() - 1);
   }
-  std::string text() const {
-    json d = doc;
-    d["buffers"][0]["byteLength"] = bin.size();
-    d["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64(bin);
-    return d.dump();
-  }
+  std::string text() const { return qem::test::gltf_text(doc, bin); }
 };
 
 /// Two spheres of 5120 faces: a unit one at scale 1 and one of local radius 0.1 drawn at scale 100
@@ -107,6 +84,19 @@ Scene two_spheres() {
   Scene s;
   s.node(s.mesh(qem::test::icosphere(4)), 1);
   s.node(s.mesh(qem::test::transformed(qem::test::icosphere(4), 0.1, 0, 0, 0)), 100);
+  return s;
+}
+
+/// 200 separate tetrahedra of 0.05 (800 faces, which no contraction may touch: each would lose its
+/// topology) in one mesh, and a unit sphere of 5120 faces in another.
+Scene dead_end_scene() {
+  Scene s;
+  qem::Mesh tetras;
+  for (int k = 0; k < 200; ++k)
+    tetras = qem::test::concatenated(
+        tetras, qem::test::transformed(qem::test::tetrahedron(), 0.05, k % 20, k / 20.0, 0));
+  s.node(s.mesh(tetras, false), 1);
+  s.node(s.mesh(qem::test::icosphere(4)), 1);
   return s;
 }
 
@@ -214,20 +204,58 @@ TEST(GltfSimplify, PrimitivesAtADeadEndLeaveTheReductionToTheOthers) {
   // 200 separate tetrahedra: no contraction keeps their topology, so their 800 faces stay; the
   // sphere must then go below the watched run's floor (a quarter of the scene's ratio) to come
   // as close to the target as it can.
-  Scene s;
-  qem::Mesh tetras;
-  for (int k = 0; k < 200; ++k)
-    tetras = qem::test::concatenated(
-        tetras, qem::test::transformed(qem::test::tetrahedron(), 0.05, k % 20, k / 20.0, 0));
-  s.node(s.mesh(tetras, false), 1);
-  s.node(s.mesh(qem::test::icosphere(4)), 1);
-  qem::GltfDocument doc = qem::GltfDocument::parse(s.text(), "dead_end.gltf");
+  qem::GltfDocument doc = qem::GltfDocument::parse(dead_end_scene().text(), "dead_end.gltf");
   qem::SimplifyOptions opt;
   opt.target_ratio = 0.1;  // 592 of 5920 faces
   const qem::GltfSimplifyReport r = qem::simplify_document(doc, opt);
   EXPECT_EQ(r.primitives[0].faces_out, 800u);
   EXPECT_LT(r.primitives[1].faces_out, 128u);  // 0.25 x 0.1 x 5120, the first floor
   EXPECT_EQ(r.primitives[1].stop_reason, qem::StopReason::NoValidPair);
+}
+
+TEST(GltfSimplify, PrimitivesOfOneMeshStayJoined) {
+  // A sphere split into two primitives of one mesh (two materials, each with its own copy of the
+  // vertices on the line where they meet, as exporters write them). Simplified apart, each would
+  // move or remove its side of the line: a crack. The shared vertices stay, so welded by position
+  // the output is as closed as the input, in both modes.
+  const qem::Mesh sphere = qem::test::icosphere(4);
+  Scene s;
+  s.doc["meshes"].push_back({{"primitives", json::array()}});
+  for (int half = 0; half < 2; ++half) {
+    qem::Mesh part;
+    std::vector<std::uint32_t> id(sphere.vertex_count(), UINT32_MAX);
+    for (std::size_t f = 0; f < sphere.face_count(); ++f) {
+      double z = 0;
+      for (int k = 0; k < 3; ++k) z += sphere.positions[3 * sphere.indices[3 * f + k] + 2];
+      if ((z > 0.3) != (half == 0)) continue;
+      for (int k = 0; k < 3; ++k) {
+        std::uint32_t& v = id[sphere.indices[3 * f + k]];
+        if (v == UINT32_MAX) {
+          v = std::uint32_t(part.vertex_count());
+          const double* p = &sphere.positions[3 * sphere.indices[3 * f + k]];
+          part.positions.insert(part.positions.end(), {p[0], p[1], p[2]});
+        }
+        part.indices.push_back(v);
+      }
+    }
+    const int m = s.mesh(part);
+    s.doc["meshes"][0]["primitives"].push_back(s.doc["meshes"][m]["primitives"][0]);
+  }
+  s.doc["meshes"].erase(2), s.doc["meshes"].erase(1);
+  s.node(0, 1);
+  ASSERT_EQ(qem::test::open_edges_welded(qem::GltfDocument::parse(s.text(), "halves.gltf").scene_mesh()), 0u);
+  for (bool per_mesh : {false, true}) {
+    SCOPED_TRACE(per_mesh ? "per mesh" : "shared budget");
+    qem::GltfDocument doc = qem::GltfDocument::parse(s.text(), "halves.gltf");
+    qem::SimplifyOptions opt;
+    opt.target_ratio = 0.1;
+    qem::GltfSimplifyOptions gltf_options;
+    gltf_options.per_primitive = per_mesh;
+    const qem::GltfSimplifyReport r = qem::simplify_document(doc, opt, gltf_options);
+    EXPECT_EQ(r.simplified, 2u);
+    EXPECT_LT(r.faces_out, r.faces_in / 5);
+    EXPECT_EQ(qem::test::open_edges_welded(doc.scene_mesh()), 0u) << "a crack opened between the primitives";
+  }
 }
 
 TEST(GltfSimplify, MorphTargetPrimitiveIsKeptUnchanged) {
@@ -305,6 +333,34 @@ TEST(GltfSimplifyCli, KeepsTheDocumentAndNotesKeptPrimitives) {
   // --per-mesh on a non-glTF output is refused.
   EXPECT_NE(run_qem("simplify '" + in + "' '" + dir + "/x.ply' --ratio 0.5 --per-mesh", &err), 0);
   EXPECT_NE(err.find("--per-mesh"), std::string::npos) << err;
+}
+
+TEST(GltfSimplifyCli, AsFarAsPossibleIsNoMissedTarget) {
+  // --faces 0 asks every primitive to go as far as the checks allow: stopping where no contraction
+  // is left is what was asked, not a target missed. With a target that a dead end keeps the scene
+  // from (200 tetrahedra that no contraction may touch, and a sphere), the summary says it missed.
+  Scene s = two_spheres();
+  const std::string dir = qem::test::temp_dir();
+  const std::string in = write(dir + "/far.gltf", s.text()), out = dir + "/far_out.glb";
+  std::string err;
+  ASSERT_EQ(run_qem("simplify '" + in + "' '" + out + "' --faces 0", &err), 0) << err;
+  EXPECT_EQ(err.find("stopped before"), std::string::npos) << err;
+  EXPECT_NE(err.find("2 primitives went as far as the checks allow"), std::string::npos) << err;
+  const std::string out_json = dir + "/far.json";
+  ASSERT_EQ(std::system((std::string(QEM_CLI_PATH) + " simplify '" + in + "' '" + out +
+                         "' --faces 0 --json -q > '" + out_json + "' 2> /dev/null")
+                            .c_str()),
+            0);
+  const json report = json::parse(qem::test::slurp(out_json));
+  EXPECT_EQ(report["stopped_early"], 0);
+  EXPECT_EQ(report["target_faces"], 0);
+  for (const json& each : report["each"]) EXPECT_EQ(each["stop"], "no valid contraction left");
+
+  const std::string in2 = write(dir + "/dead_end.gltf", dead_end_scene().text());
+  ASSERT_EQ(run_qem("simplify '" + in2 + "' '" + out + "' --ratio 0.1 --force", &err), 0) << err;
+  EXPECT_NE(err.find("1 primitive stopped before the scene's target"), std::string::npos) << err;
+  ASSERT_EQ(run_qem("simplify '" + in2 + "' '" + out + "' --faces 0 --force", &err), 0) << err;
+  EXPECT_EQ(err.find("stopped before"), std::string::npos) << err;
 }
 
 TEST(GltfSimplifyCli, CompressedGeometryIsRefusedWithNoOutput) {

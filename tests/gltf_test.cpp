@@ -22,24 +22,6 @@ namespace {
 
 using json = nlohmann::json;
 
-std::string base64(const std::string& in) {
-  static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  std::size_t i = 0;
-  for (; i + 2 < in.size(); i += 3) {
-    unsigned v = (unsigned char)in[i] << 16 | (unsigned char)in[i + 1] << 8 | (unsigned char)in[i + 2];
-    for (int s = 18; s >= 0; s -= 6) out += k[(v >> s) & 63];
-  }
-  if (i + 1 == in.size()) {
-    unsigned v = (unsigned char)in[i] << 16;
-    out += {k[(v >> 18) & 63], k[(v >> 12) & 63], '=', '='};
-  } else if (i + 2 == in.size()) {
-    unsigned v = (unsigned char)in[i] << 16 | (unsigned char)in[i + 1] << 8;
-    out += {k[(v >> 18) & 63], k[(v >> 12) & 63], k[(v >> 6) & 63], '='};
-  }
-  return out;
-}
-
 template <class T>
 void put(std::string& b, T v) {
   char c[sizeof(T)];
@@ -89,12 +71,7 @@ struct Tiny {
       "buffers": [{"byteLength": 0}]
     })");
   }
-  std::string text() const {
-    json d = doc;
-    d["buffers"][0]["byteLength"] = bin.size();
-    d["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64(bin);
-    return d.dump();
-  }
+  std::string text() const { return qem::test::gltf_text(doc, bin); }
 };
 
 /// A .glb split into its JSON and BIN chunks.
@@ -474,11 +451,6 @@ TEST(Gltf, SaveMeshWritesAMinimalGltfWithAttributesAndMaterials) {
 
 class GltfShared : public ::testing::TestWithParam<const char*> {};
 
-/// Removes `key` from `o` when it holds `value`.
-void erase_default(json& o, const char* key, const json& value) {
-  if (o.is_object() && o.contains(key) && o[key] == value) o.erase(key);
-}
-
 /// The document's JSON without what re-packing changes (buffer view offsets, the buffers) and
 /// without the differences tinygltf makes that mean the same: it leaves out properties equal to
 /// their default value (`byteOffset: 0`, `mode: 4`, `alphaMode: "OPAQUE"`, factors of 1, ...)
@@ -486,29 +458,9 @@ void erase_default(json& o, const char* key, const json& value) {
 json without_layout(json j) {
   j.erase("buffers");
   for (json& v : j["bufferViews"]) v.erase("byteOffset"), v.erase("target");
-  for (json& a : j["accessors"]) erase_default(a, "byteOffset", 0), erase_default(a, "normalized", false);
-  for (json& mesh : j["meshes"])
-    for (json& p : mesh["primitives"]) erase_default(p, "mode", 4);
-  for (json& m : j["materials"]) {
-    erase_default(m, "emissiveFactor", json::array({0.0, 0.0, 0.0}));
-    erase_default(m, "alphaMode", "OPAQUE");
-    erase_default(m, "alphaCutoff", 0.5);
-    erase_default(m, "doubleSided", false);
-    for (const char* t : {"normalTexture", "occlusionTexture", "emissiveTexture"})
-      if (m.contains(t))
-        erase_default(m[t], "texCoord", 0), erase_default(m[t], "scale", 1),
-            erase_default(m[t], "strength", 1);
-    if (m.contains("pbrMetallicRoughness")) {
-      json& pbr = m["pbrMetallicRoughness"];
-      erase_default(pbr, "baseColorFactor", json::array({1.0, 1.0, 1.0, 1.0}));
-      erase_default(pbr, "metallicFactor", 1.0);
-      erase_default(pbr, "roughnessFactor", 1.0);
-      for (const char* t : {"baseColorTexture", "metallicRoughnessTexture"})
-        if (pbr.contains(t)) erase_default(pbr[t], "texCoord", 0);
-      if (pbr.empty()) m.erase("pbrMetallicRoughness");
-    }
-  }
-  if (j.contains("materials") && j["materials"].empty()) j.erase("materials");
+  for (json& a : j["accessors"])
+    if (a.value("byteOffset", 0) == 0) a.erase("byteOffset");
+  qem::test::erase_gltf_defaults(j);
   return j;
 }
 

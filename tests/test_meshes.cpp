@@ -1,5 +1,6 @@
 #include "test_meshes.h"
 
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -9,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 namespace qem::test {
@@ -126,6 +128,211 @@ std::string slurp(const std::string& path) {
 int run_qem_quietly(const std::string& args) {
   const std::string cmd = std::string(QEM_CLI_PATH) + " " + args + " -q";
   return std::system(cmd.c_str());
+}
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+}  // namespace
+
+// A latitude-longitude sphere whose column u = 1 repeats the positions of u = 0 with other UVs,
+// and whose poles are one position with a wedge per segment.
+Mesh uv_sphere(int rings, int segments) {
+  Mesh m;
+  VertexAttribute uv{"TEXCOORD_0", AttributeKind::TexCoord, 2, {}};
+  VertexAttribute normal{"NORMAL", AttributeKind::Normal, 3, {}};
+  for (int i = 0; i <= rings; ++i)
+    for (int j = 0; j <= segments; ++j) {
+      const double theta = kPi * i / rings, phi = 2 * kPi * (j % segments) / segments;
+      double p[3] = {std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)};
+      if (i == 0 || i == rings) p[0] = p[1] = 0;
+      // sin(5 pi) is not exactly 0: the poles get radius 1 exactly, so each is one position.
+      const double r = i == 0 || i == rings ? 1 : 1 + 0.05 * std::sin(5 * theta) * std::cos(3 * phi);
+      m.positions.insert(m.positions.end(), {r * p[0], r * p[1], r * p[2]});
+      uv.values.insert(uv.values.end(), {double(j) / segments, double(i) / rings});
+      normal.values.insert(normal.values.end(), {p[0], p[1], p[2]});
+    }
+  auto id = [&](int i, int j) { return std::uint32_t(i * (segments + 1) + j); };
+  for (int i = 0; i < rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      if (i > 0) m.indices.insert(m.indices.end(), {id(i, j), id(i + 1, j), id(i, j + 1)});
+      if (i + 1 < rings) m.indices.insert(m.indices.end(), {id(i, j + 1), id(i + 1, j), id(i + 1, j + 1)});
+    }
+  m.attributes = {uv, normal};
+  return m;
+}
+
+// A cube of side 2 whose six sides are n x n grids, each its own UV chart (a cell of a 3 x 2
+// atlas) with its own vertices, so that every cube edge is a UV seam. `relief` bulges each side
+// (zero on the cube's edges, so the sides still meet); normals are the side's (flat shading) or
+// the position's direction.
+// With `block` > 0, each side is cut further into block x block-cell charts (many small UV
+// islands), and the sides of +x, +y, +z have material 0, the others material 1.
+Mesh uv_cube(int n, double relief, bool flat_normals, int block) {
+  Mesh m;
+  VertexAttribute uv{"TEXCOORD_0", AttributeKind::TexCoord, 2, {}};
+  VertexAttribute normal{"NORMAL", AttributeKind::Normal, 3, {}};
+  std::map<std::array<int, 5>, std::uint32_t> ids;  // (side, i, j, chart i, chart j)
+  for (int side = 0; side < 6; ++side) {
+    const int axis = side / 2;
+    const double sign = side % 2 ? -1 : 1;
+    const auto vertex = [&](int i, int j, int ci, int cj) {
+      auto [it, fresh] = ids.try_emplace({side, i, j, ci, cj}, std::uint32_t(m.vertex_count()));
+      if (!fresh) return it->second;
+      const double s = -1 + 2.0 * i / n, t = -1 + 2.0 * j / n;
+      double p[3];
+      p[axis] = sign * (1 + relief * (1 - s * s) * (1 - t * t) * std::cos(2 * s + t));
+      p[(axis + 1) % 3] = sign * s;  // the side's orientation follows its outward normal
+      p[(axis + 2) % 3] = t;
+      m.positions.insert(m.positions.end(), {p[0], p[1], p[2]});
+      // Each chart shifted in the atlas, so that neighbouring charts' UVs differ.
+      uv.values.insert(uv.values.end(), {(side % 3 + 0.05 + 0.9 * (s + 1) / 2) / 3 + 0.01 * ci,
+                                         (side / 3 + 0.05 + 0.9 * (t + 1) / 2) / 2 + 0.01 * cj});
+      double nn[3] = {0, 0, 0};
+      nn[axis] = sign;
+      const double len = std::hypot(p[0], p[1], p[2]);
+      if (flat_normals)
+        normal.values.insert(normal.values.end(), {nn[0], nn[1], nn[2]});
+      else
+        normal.values.insert(normal.values.end(), {p[0] / len, p[1] / len, p[2] / len});
+      return it->second;
+    };
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) {
+        const int ci = block > 0 ? i / block : 0, cj = block > 0 ? j / block : 0;
+        const std::uint32_t a = vertex(i, j, ci, cj), b = vertex(i + 1, j, ci, cj),
+                            c = vertex(i + 1, j + 1, ci, cj), d = vertex(i, j + 1, ci, cj);
+        m.indices.insert(m.indices.end(), {a, b, c, a, c, d});
+        if (block > 0) m.face_materials.insert(m.face_materials.end(), 2, std::uint32_t(side % 2));
+      }
+  }
+  m.attributes = {uv, normal};
+  return m;
+}
+
+// A wavy n x n grid over the unit square whose cell (i, j) lies in UV chart chart(i, j) (two
+// numbers): every chart has its own vertices and UVs (shifted in the atlas by its numbers, so
+// neighbouring charts' UVs differ), so chart boundaries are seams and the points where k charts
+// meet hold k wedges.
+Mesh chart_grid(int n, const std::function<std::pair<int, int>(int, int)>& chart) {
+  Mesh m;
+  VertexAttribute uv{"TEXCOORD_0", AttributeKind::TexCoord, 2, {}};
+  std::map<std::array<int, 4>, std::uint32_t> ids;  // (i, j, chart)
+  auto vertex = [&](int i, int j, std::pair<int, int> c) {
+    auto [it, fresh] = ids.try_emplace({i, j, c.first, c.second}, std::uint32_t(m.vertex_count()));
+    if (fresh) {
+      const double x = double(i) / n, y = double(j) / n;
+      m.positions.insert(m.positions.end(), {x, y, 0.08 * std::sin(5 * x) * std::cos(4 * y)});
+      uv.values.insert(uv.values.end(), {0.9 * x + 0.05 * c.first, 0.9 * y + 0.03 * c.second});
+    }
+    return it->second;
+  };
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const std::pair<int, int> c = chart(i, j);
+      const std::uint32_t a = vertex(i, j, c), b = vertex(i + 1, j, c), d = vertex(i + 1, j + 1, c),
+                          e = vertex(i, j + 1, c);
+      m.indices.insert(m.indices.end(), {a, b, d, a, d, e});
+    }
+  m.attributes = {uv};
+  return m;
+}
+
+// Cut into `block` x `block` cell charts.
+Mesh chart_grid(int n, int block) {
+  return chart_grid(n, [block](int i, int j) { return std::pair{i / block, j / block}; });
+}
+
+// Edges used by one face once the vertices are welded by position: holes and cracks. With
+// `square`, those on the unit square's outline (a flat grid's own border) are not counted.
+std::size_t open_edges_welded(const Mesh& m, bool square) {
+  std::map<std::array<double, 3>, std::uint32_t> id;
+  std::vector<std::uint32_t> welded(m.vertex_count());
+  for (std::size_t v = 0; v < m.vertex_count(); ++v)
+    welded[v] = id.try_emplace({m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]},
+                               std::uint32_t(id.size()))
+                    .first->second;
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
+  for (std::size_t f = 0; f < m.face_count(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      std::uint32_t a = welded[m.indices[3 * f + k]], b = welded[m.indices[3 * f + (k + 1) % 3]];
+      ++uses[{std::min(a, b), std::max(a, b)}];
+    }
+  std::vector<std::array<double, 3>> at(id.size());
+  for (const auto& [p, i] : id) at[i] = p;
+  auto on_outline = [&](std::uint32_t a, std::uint32_t b) {
+    for (int k = 0; k < 2; ++k)
+      for (double side : {0.0, 1.0})  // GH97 §6's border planes are a penalty: corners may drift a little
+        if (std::abs(at[a][k] - side) < 1e-9 && std::abs(at[b][k] - side) < 1e-9) return true;
+    return false;
+  };
+  std::size_t open = 0;
+  for (const auto& [edge, n] : uses) open += n == 1 && !(square && on_outline(edge.first, edge.second));
+  return open;
+}
+
+const VertexAttribute& attribute(const Mesh& m, AttributeKind kind) {
+  const VertexAttribute* a = m.find_attribute(kind);
+  EXPECT_NE(a, nullptr);
+  return *a;
+}
+
+std::string base64(const std::string& in) {
+  static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  std::size_t i = 0;
+  for (; i + 2 < in.size(); i += 3) {
+    unsigned v = (unsigned char)in[i] << 16 | (unsigned char)in[i + 1] << 8 | (unsigned char)in[i + 2];
+    for (int s = 18; s >= 0; s -= 6) out += k[(v >> s) & 63];
+  }
+  if (i + 1 == in.size()) {
+    unsigned v = (unsigned char)in[i] << 16;
+    out += {k[(v >> 18) & 63], k[(v >> 12) & 63], '=', '='};
+  } else if (i + 2 == in.size()) {
+    unsigned v = (unsigned char)in[i] << 16 | (unsigned char)in[i + 1] << 8;
+    out += {k[(v >> 18) & 63], k[(v >> 12) & 63], k[(v >> 6) & 63], '='};
+  }
+  return out;
+}
+
+std::string gltf_text(nlohmann::json doc, const std::string& bin) {
+  doc["buffers"][0]["byteLength"] = bin.size();
+  doc["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64(bin);
+  return doc.dump();
+}
+
+namespace {
+
+// Removes `key` from `o` when it holds `value`.
+void erase_default(nlohmann::json& o, const char* key, const nlohmann::json& value) {
+  if (o.is_object() && o.contains(key) && o[key] == value) o.erase(key);
+}
+
+}  // namespace
+
+void erase_gltf_defaults(nlohmann::json& j) {
+  for (nlohmann::json& a : j["accessors"]) erase_default(a, "normalized", false);
+  for (nlohmann::json& mesh : j["meshes"])
+    for (nlohmann::json& p : mesh["primitives"]) erase_default(p, "mode", 4);
+  for (nlohmann::json& m : j["materials"]) {
+    erase_default(m, "emissiveFactor", nlohmann::json::array({0.0, 0.0, 0.0}));
+    erase_default(m, "alphaMode", "OPAQUE");
+    erase_default(m, "alphaCutoff", 0.5);
+    erase_default(m, "doubleSided", false);
+    for (const char* t : {"normalTexture", "occlusionTexture", "emissiveTexture"})
+      if (m.contains(t))
+        erase_default(m[t], "texCoord", 0), erase_default(m[t], "scale", 1),
+            erase_default(m[t], "strength", 1);
+    if (m.contains("pbrMetallicRoughness")) {
+      nlohmann::json& pbr = m["pbrMetallicRoughness"];
+      erase_default(pbr, "baseColorFactor", nlohmann::json::array({1.0, 1.0, 1.0, 1.0}));
+      erase_default(pbr, "metallicFactor", 1.0);
+      erase_default(pbr, "roughnessFactor", 1.0);
+      for (const char* t : {"baseColorTexture", "metallicRoughnessTexture"})
+        if (pbr.contains(t)) erase_default(pbr[t], "texCoord", 0);
+      if (pbr.empty()) m.erase("pbrMetallicRoughness");
+    }
+  }
+  if (j.contains("materials") && j["materials"].empty()) j.erase("materials");
 }
 
 }  // namespace qem::test

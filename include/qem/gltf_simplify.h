@@ -64,7 +64,8 @@ struct GltfSimplifyReport {
   /// Triangles of the whole document before and after (kept primitives counted in both).
   std::size_t faces_in = 0, faces_out = 0;
   /// Shared budget: the faces the simplifiable primitives were to meet together (their input
-  /// total when only an error limit was given), and the world-unit error threshold chosen.
+  /// total when only an error limit was given, 0 as far as the checks allow), and the world-unit
+  /// error threshold chosen.
   std::size_t target_faces = 0;
   double world_threshold = 0;
   double max_world_error = 0;  ///< the largest world_error of any primitive

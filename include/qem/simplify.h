@@ -297,7 +297,8 @@ void check_options(const SimplifyOptions& options);
 SimplifyResult simplify(MeshView input, const SimplifyOptions& options, SimplifyObserver* observer = nullptr);
 
 /// The same, consuming the input: its index array is released (left empty) as soon as the
-/// simplifier holds its own copy of the faces, which lowers the peak memory on large meshes.
+/// simplifier holds its own copy of the faces, and its attributes' values (left empty, names and
+/// kinds kept) once it holds its own copy of them, which lowers the peak memory on large meshes.
 /// The positions are kept: unmoved vertices are copied from them at the end.
 SimplifyResult simplify(Mesh&& input, const SimplifyOptions& options, SimplifyObserver* observer = nullptr);
 

@@ -27,6 +27,7 @@ struct Worker {
   std::vector<std::uint32_t> faces, pairs;  // scratch: the survivor's faces and pairs
   std::vector<std::uint32_t> dead_faces;    // input faces killed by the last contraction, if observed
   std::vector<std::pair<std::uint32_t, std::uint32_t>> wedge_map;  // removed wedge -> survivor's
+  std::vector<std::uint32_t> emptied_wedges;  // wedges left without a face corner (Wedges::drop_unused)
   std::size_t faces_killed = 0, vertices_removed = 0, contractions = 0;
   std::size_t blocked_topology = 0, blocked_inversion = 0, blocked_error = 0, blocked_distance = 0;
   std::size_t blocked_component = 0;

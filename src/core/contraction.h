@@ -25,6 +25,9 @@ namespace qem::core {
 
 inline void kill_face(Context& c, std::uint32_t f, Worker& w) {
   c.mesh.face_alive[f] = 0;
+  if (c.wedges)
+    for (int k = 0; k < 3; ++k)
+      c.wedges->move_corner(c.mesh.corner_wedge[3 * std::size_t(f) + k], kNoVertex, w.emptied_wedges);
   ++w.faces_killed;
   if (c.observe_contractions) w.dead_faces.push_back(c.mesh.face_source[f]);
 }
@@ -76,6 +79,7 @@ inline void merge_faces(Context& c, std::uint32_t a, std::uint32_t b, bool may_d
           std::uint32_t& corner = m.corner_wedge[3 * std::size_t(f) + k];
           for (const auto& [removed, kept] : w.wedge_map)
             if (corner == removed) {
+              c.wedges->move_corner(removed, kept, w.emptied_wedges);
               corner = kept;
               break;
             }
@@ -163,7 +167,10 @@ void contract(Context& c, Lists& lists, std::uint32_t p, const Quadric& q, const
   merge_faces(c, a, b, m.aggregated[a] || !c.settings.preserve_topology, w);
   if (c.components) c.components->faces_died(a, w.faces_killed - killed_before);
   merge_pairs(c, lists, p, a, b, w);
-  if (c.wedges) c.wedges->merge(a, b, moves, target, w.wedge_map);
+  if (c.wedges) {
+    c.wedges->merge(a, b, moves, target, w.wedge_map, m, w.faces);
+    c.wedges->drop_unused(w.emptied_wedges);  // a seam whose faces on one side all died is gone
+  }
   lists.contracted(a, b, w.faces, w.pairs);
   // GH97 §4 step 5: update the costs of all valid pairs involving the new vertex.
   for (std::uint32_t r : w.pairs)

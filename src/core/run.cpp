@@ -62,6 +62,8 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   WorkingMesh mesh = prepare_input(input, &internal);  // check, drop degenerate and duplicate faces, frame
   std::optional<Wedges> wedges;  // with attributes, on the input's vertices (Hoppe 1999)
   if (!input.attributes.empty()) wedges.emplace(build_wedges(input, internal, mesh, options));
+  if (wedges && hooks.consumed_attributes)
+    for (VertexAttribute& a : *hooks.consumed_attributes) std::vector<double>().swap(a.values);
   std::vector<std::uint32_t>().swap(internal);
   if (!options.vertex_lock.empty()) lock_vertices(options.vertex_lock, input, wedges ? &*wedges : nullptr, mesh);
   if (wedges && options.lock_seams) lock_seam_vertices(*wedges, mesh);

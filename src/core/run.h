@@ -19,6 +19,9 @@ struct RunHooks {
   SimplifyObserver* observer = nullptr;
   /// The caller's index array, released once the core holds its own copy of the faces.
   std::vector<std::uint32_t>* consumed_indices = nullptr;
+  /// The caller's attributes, whose values are released once the wedges hold their own copy (their
+  /// names and kinds stay: the output's attributes are named after them).
+  std::vector<VertexAttribute>* consumed_attributes = nullptr;
   /// Called with the input just before its indices are released (what needs the input's faces).
   std::function<void(MeshView)> before_release;
   /// Fill SimplifyResult::output_vertex_of_input even when the options do not ask for it.

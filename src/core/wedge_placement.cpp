@@ -3,10 +3,11 @@
 namespace qem::core {
 
 bool place_with_wedges(const Context& c, std::uint32_t a, std::uint32_t b, const Quadric& q, Placed& placed) {
+  // Scratch space per thread (pair costs are computed on several threads): no allocation per pair.
+  thread_local std::vector<std::pair<std::uint32_t, std::uint32_t>> map;
+  thread_local std::vector<std::uint32_t> partners;
   const Wedges& wg = *c.wedges;
   const WorkingMesh& m = c.mesh;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> map;
-  std::vector<std::uint32_t> partners;
   bool found = false;
   const BorderTarget border = border_target(c, a, b);  // exact borders (border_placement.h)
   if (border == BorderTarget::Never) return false;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <unordered_map>
 
@@ -61,11 +62,31 @@ void add_face(Wedges& wg, const Vec3 p[3], const std::uint32_t w[3]) {
 
 }  // namespace
 
-Quadric Wedges::reduced(std::uint32_t w, std::uint32_t w2) const {
-  return w2 == kNoVertex ? reduced(w, nullptr, 0) : reduced(w, &w2, 1);
-}
-
 namespace {
+
+// Hoppe 1999's quadric of one wedge row q (or of several rows summed: row(i) gives the sum), each
+// interpolated component s_j at its optimum (G_j.p + D_j) / W: the head's A, b, c less
+// sum_j (G_j, D_j)(G_j, D_j)' / W, a plain quadric in p.
+template <class Row>
+Quadric reduce(const Row& row, std::uint32_t components) {
+  Quadric r;
+  r.a00 = row(0), r.a01 = row(1), r.a02 = row(2), r.a11 = row(3), r.a12 = row(4), r.a22 = row(5);
+  r.b0 = row(6), r.b1 = row(7), r.b2 = row(8), r.c = row(9);
+  r.weight = 0;  // it adds error, not surface
+  const double W = row(10);
+  if (!(W > 0)) return r;
+  double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0, xd = 0, yd = 0, zd = 0, dd = 0;
+  for (std::uint32_t j = 0; j < components; ++j) {
+    const std::uint32_t at = kHead + 4 * j;
+    const double gx = row(at), gy = row(at + 1), gz = row(at + 2), d = row(at + 3);
+    xx += gx * gx, xy += gx * gy, xz += gx * gz, yy += gy * gy, yz += gy * gz, zz += gz * gz;
+    xd += gx * d, yd += gy * d, zd += gz * d, dd += d * d;
+  }
+  const double inv = 1 / W;
+  r.a00 -= xx * inv, r.a01 -= xy * inv, r.a02 -= xz * inv, r.a11 -= yy * inv, r.a12 -= yz * inv;
+  r.a22 -= zz * inv, r.b0 -= xd * inv, r.b1 -= yd * inv, r.b2 -= zd * inv, r.c -= dd * inv;
+  return r;
+}
 
 // The quadric row of w with the rows of `merged` added, in `row` (or `big` when wider).
 const double* summed_row(const Wedges& wg, std::uint32_t w, const std::uint32_t* merged, std::size_t count,
@@ -83,25 +104,23 @@ const double* summed_row(const Wedges& wg, std::uint32_t w, const std::uint32_t*
 
 }  // namespace
 
+Quadric Wedges::reduced(std::uint32_t w, std::uint32_t w2) const {
+  return w2 == kNoVertex ? reduced(w, nullptr, 0) : reduced(w, &w2, 1);
+}
+
 Quadric Wedges::reduced(std::uint32_t w, const std::uint32_t* merged, std::size_t count) const {
+  const std::uint32_t components = (quadric_width - kHead) / 4;
+  const double* a = &quadric[std::size_t(w) * quadric_width];
+  // One or two rows (every interior collapse, most along a seam): read in place, not summed first.
+  if (count == 0) return reduce([a](std::uint32_t i) { return a[i]; }, components);
+  if (count == 1) {
+    const double* b = &quadric[std::size_t(merged[0]) * quadric_width];
+    return reduce([a, b](std::uint32_t i) { return a[i] + b[i]; }, components);
+  }
   double row[kHead + 4 * 32];
   std::vector<double> big;
   const double* q = summed_row(*this, w, merged, count, row, sizeof row / sizeof row[0], big);
-  Quadric r;
-  r.a00 = q[0], r.a01 = q[1], r.a02 = q[2], r.a11 = q[3], r.a12 = q[4], r.a22 = q[5];
-  r.b0 = q[6], r.b1 = q[7], r.b2 = q[8], r.c = q[9];
-  const double W = q[10];
-  if (!(W > 0)) return r;
-  for (std::uint32_t j = 0; kHead + 4 * j < quadric_width; ++j) {
-    const double* gd = q + kHead + 4 * j;
-    const double gx = gd[0], gy = gd[1], gz = gd[2], d = gd[3];
-    r.a00 -= gx * gx / W, r.a01 -= gx * gy / W, r.a02 -= gx * gz / W;
-    r.a11 -= gy * gy / W, r.a12 -= gy * gz / W, r.a22 -= gz * gz / W;
-    r.b0 -= gx * d / W, r.b1 -= gy * d / W, r.b2 -= gz * d / W;
-    r.c -= d * d / W;
-  }
-  r.weight = 0;
-  return r;
+  return reduce([q](std::uint32_t i) { return q[i]; }, components);
 }
 
 double Wedges::error_at(std::uint32_t w, const std::uint32_t* merged, std::size_t count, const Vec3& p) const {
@@ -139,7 +158,8 @@ void Wedges::update_values(std::uint32_t w, const Vec3& p) {
 }
 
 void Wedges::merge(std::uint32_t survivor, std::uint32_t removed, bool moved, const Vec3& p,
-                   const std::vector<std::pair<std::uint32_t, std::uint32_t>>& map) {
+                   const std::vector<std::pair<std::uint32_t, std::uint32_t>>& map, const WorkingMesh& m,
+                   const std::vector<std::uint32_t>& faces) {
   for (const auto& [r, s] : map) {
     double* into = &quadric[std::size_t(s) * quadric_width];
     const double* from = &quadric[std::size_t(r) * quadric_width];
@@ -148,33 +168,52 @@ void Wedges::merge(std::uint32_t survivor, std::uint32_t removed, bool moved, co
   }
   first[removed] = kNoVertex;
   if (!moved) return;
-  // Texture coordinates interpolate, never extrapolate: the optimum of Hoppe's quadric at the new
-  // position may lie beyond the values of both ends, which pulls a UV out of its chart (past the
-  // atlas's edge at a pole or a seam). A merged wedge keeps its UVs within the box of those it merged.
-  std::vector<std::uint32_t> boxed;  // survivor wedges, each with `width` lows and highs below
-  std::vector<double> low, high;
-  for (const auto& [r, s] : map) {
-    std::size_t at = std::find(boxed.begin(), boxed.end(), s) - boxed.begin();
-    if (at == boxed.size()) {
-      boxed.push_back(s);
-      low.insert(low.end(), &value[std::size_t(s) * width], &value[std::size_t(s) * width] + width);
-      high.insert(high.end(), &value[std::size_t(s) * width], &value[std::size_t(s) * width] + width);
-    }
-    for (std::uint32_t i = 0; i < width; ++i) {
-      low[at * width + i] = std::min(low[at * width + i], value[std::size_t(r) * width + i]);
-      high[at * width + i] = std::max(high[at * width + i], value[std::size_t(r) * width + i]);
-    }
-  }
   std::uint32_t w = first[survivor];
-  do update_values(w, p), w = next[w];
-  while (w != first[survivor]);
-  for (std::size_t at = 0; at < boxed.size(); ++at)
-    for (const Channel& ch : channels)
-      if (ch.kind == AttributeKind::TexCoord)
-        for (std::uint32_t c = 0; c < ch.components; ++c) {
-          double& v = value[std::size_t(boxed[at]) * width + ch.first + c];
-          v = std::clamp(v, low[at * width + ch.first + c], high[at * width + ch.first + c]);
+  do {
+    update_values(w, p);
+    // Texture coordinates interpolate, never extrapolate: the optimum of Hoppe's quadric at the
+    // new position may lie beyond the chart (past the atlas's edge at a pole or a seam). The new
+    // vertex lies among its neighbours, so its UVs stay within the box of their UVs on its faces.
+    // (Not the box of the two merged ends' UVs: a vertex placed off the edge, as the optimal
+    // placement does on a curved surface, has UVs off the edge's UV segment too.)
+    for (const Channel& ch : channels) {
+      if (ch.kind != AttributeKind::TexCoord || ch.weight == 0) continue;
+      for (std::uint32_t c = 0; c < ch.components; ++c) {
+        double low = std::numeric_limits<double>::infinity(), high = -low;
+        for (std::uint32_t f : faces) {
+          const std::uint32_t* t = m.face(f);
+          const std::uint32_t* cw = &m.corner_wedge[3 * std::size_t(f)];
+          if (!((t[0] == survivor && cw[0] == w) || (t[1] == survivor && cw[1] == w) ||
+                (t[2] == survivor && cw[2] == w)))
+            continue;
+          for (int k = 0; k < 3; ++k) {
+            if (t[k] == survivor) continue;
+            const double u = value[std::size_t(cw[k]) * width + ch.first + c];
+            low = std::min(low, u), high = std::max(high, u);
+          }
         }
+        if (low <= high) {
+          double& v = value[std::size_t(w) * width + ch.first + c];
+          v = std::clamp(v, low, high);
+        }
+      }
+    }
+    w = next[w];
+  } while (w != first[survivor]);
+}
+
+void Wedges::drop_unused(std::vector<std::uint32_t>& emptied) {
+  for (std::uint32_t w : emptied) {
+    if (corners[w] != 0 || merged_into[w] != kNoVertex || vertex[w] == kNoVertex) continue;
+    std::uint32_t& head = first[vertex[w]];
+    if (head == kNoVertex || next[w] == w) continue;  // a removed vertex, or its last wedge
+    std::uint32_t before = w;
+    while (next[before] != w) before = next[before];
+    next[before] = next[w];
+    next[w] = w;
+    if (head == w) head = before;
+  }
+  emptied.clear();
 }
 
 void Wedges::renumber(const std::vector<std::uint32_t>& vertex_to, std::size_t count) {
@@ -269,6 +308,8 @@ Wedges build_wedges(MeshView in, const std::vector<std::uint32_t>& internal, Wor
     for (std::uint32_t w = 0; w < wg.count(); ++w)
       if (options.vertex_protect[wg.source[w]]) wg.protect[wg.vertex[w]] = 1;
   }
+  wg.corners.assign(wg.count(), 0);
+  for (std::uint32_t w : m.corner_wedge) ++wg.corners[w];
   wg.quadric.assign(wg.count() * std::size_t(wg.quadric_width), 0);
   for (std::uint32_t f = 0; f < m.face_source.size(); ++f) {
     const std::uint32_t* t = m.face(f);

@@ -36,6 +36,9 @@ struct Wedges {
   std::vector<std::uint32_t> first;   ///< per working vertex, one of its wedges (kNoVertex: none)
   std::vector<std::uint32_t> source;  ///< input vertex of each wedge
   std::vector<std::uint32_t> merged_into;  ///< kNoVertex, or the wedge this one was merged into
+  /// Live face corners that use each wedge. A wedge whose count falls to 0 leaves its vertex's ring
+  /// (drop_unused): once the faces on one side of a seam are all gone, the seam is gone there too.
+  std::vector<std::uint32_t> corners;
   std::vector<double> value;          ///< `width` per wedge, as given (the quadrics hold the weights)
   std::vector<double> quadric;        ///< `quadric_width` per wedge (see wedges.cpp)
   std::vector<std::uint32_t> material;  ///< the face material of each wedge (0 without materials)
@@ -59,11 +62,23 @@ struct Wedges {
   /// Sets w's interpolated channels to their optimum at p (after the merge).
   void update_values(std::uint32_t w, const Vec3& p);
   /// `removed` went into `survivor`, now at p: each removed wedge's quadric joins its partner's
-  /// (map from map_wedges), and, if the survivor moved, its wedges take their optimal values at p.
-  /// A survivor that stays (a seam, a border, an endpoint placement) keeps its values, as it keeps
-  /// its position: a seam's UVs stay exactly on the chart's edge.
+  /// (map from map_wedges), and, if the survivor moved, its wedges take their optimal values at p,
+  /// UVs within the box of the UVs of its neighbours on `faces` (the survivor's live faces, corners
+  /// already mapped). A survivor that stays (a seam, a border, an endpoint placement) keeps its
+  /// values, as it keeps its position: a seam's UVs stay exactly on the chart's edge.
   void merge(std::uint32_t survivor, std::uint32_t removed, bool moved, const Vec3& p,
-             const std::vector<std::pair<std::uint32_t, std::uint32_t>>& map);
+             const std::vector<std::pair<std::uint32_t, std::uint32_t>>& map, const WorkingMesh& m,
+             const std::vector<std::uint32_t>& faces);
+  /// A face corner moved from wedge `from` to wedge `to` (`to` == kNoVertex: the face died).
+  /// A wedge left with no corner is added to `emptied`, for drop_unused.
+  void move_corner(std::uint32_t from, std::uint32_t to, std::vector<std::uint32_t>& emptied) {
+    if (--corners[from] == 0) emptied.push_back(from);
+    if (to != kNoVertex) ++corners[to];
+  }
+  /// Takes the wedges of `emptied` that still have no corner out of their vertex's ring (the last
+  /// wedge of a vertex stays, so a ring is never empty), and clears `emptied`. A vertex left with
+  /// one wedge is an ordinary vertex again: it may be removed and placed freely.
+  void drop_unused(std::vector<std::uint32_t>& emptied);
   /// Renumbering (renumber.h): working vertex v is now vertex_to[v].
   void renumber(const std::vector<std::uint32_t>& vertex_to, std::size_t count);
   /// The surviving wedge an input vertex's values went into (kNoVertex: none).
