@@ -40,19 +40,18 @@ void check_options(const SimplifyOptions& options) {
 
 namespace {
 
-// The bounding-box diagonal of the vertices the faces use (the core's frame: relative options).
-double referenced_diagonal(std::span<const double> positions, std::span<const std::uint32_t> indices) {
+// The frame of the box of the vertices the faces use (the core's frame: relative options are
+// fractions of its scale, the diagonal).
+Frame referenced_frame(std::span<const double> positions, std::span<const std::uint32_t> indices) {
   BoxOfPoints box;
   for (std::uint32_t v : indices) box.add(&positions[3 * std::size_t(v)]);
-  return frame_of_box(box.box()).scale;
+  return frame_of_box(box.box());
 }
 
 // The largest distance from `approx` to the input surface over 15 samples of each face
-// (core/distance_bound.h), in distance units: what the bound reached.
-double sampled_distance(std::span<const double> positions, std::span<const std::uint32_t> indices, const Mesh& approx) {
-  BoxOfPoints box;
-  for (std::uint32_t v : indices) box.add(&positions[3 * std::size_t(v)]);
-  const Frame frame = frame_of_box(box.box());
+// (core/distance_bound.h), in distance units: what the bound reached. `frame`: referenced_frame.
+double sampled_distance(std::span<const double> positions, std::span<const std::uint32_t> indices, const Frame& frame,
+                        const Mesh& approx) {
   const core::SurfaceDistance surface = refit_detail::surface_in_frame(positions, indices, frame);
   const auto at = [&](std::uint32_t v) {
     const double* p = &approx.positions[3 * std::size_t(v)];
@@ -142,8 +141,9 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
   const std::span<const std::uint32_t> input_faces =
       consumed_indices ? std::span<const std::uint32_t>(kept_indices) : input.indices;
   // The frame of the refit and of the distance report: the input's referenced vertices' box.
+  const Frame input_frame = bounded ? referenced_frame(input.positions, input_faces) : Frame{};
   double max_distance = options.max_distance;
-  if (bounded && options.max_distance_is_relative) max_distance *= referenced_diagonal(input.positions, input_faces);
+  if (bounded && options.max_distance_is_relative) max_distance *= input_frame.scale;
   if (refit && out.contractions > 0 && out.stop_reason != StopReason::Cancelled) {
     if (!consumed_indices) weights = refit_detail::vertex_areas(input);
     const refit_detail::FitPoints points(input.positions, weights);
@@ -166,7 +166,7 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
     out.refit_rounds = fit.rounds;
   }
   if (!options.map_input_vertices) std::vector<std::uint32_t>().swap(out.output_vertex_of_input);
-  if (bounded) out.output_to_input_distance = sampled_distance(input.positions, input_faces, out.mesh);
+  if (bounded) out.output_to_input_distance = sampled_distance(input.positions, input_faces, input_frame, out.mesh);
   return out;
 }
 

@@ -15,6 +15,7 @@
 #include "qem/io.h"
 #include "qem/measure.h"
 #include "qem/simplify.h"
+#include "mesh_checks.h"
 #include "test_meshes.h"
 
 namespace qem {
@@ -28,15 +29,8 @@ Point vertex(const Mesh& m, std::size_t v) {
 
 /// The vertices on an edge that one face has (or more than two).
 std::set<std::uint32_t> border_vertices(const Mesh& m) {
-  std::map<std::pair<std::uint32_t, std::uint32_t>, int> count;
-  for (std::size_t f = 0; f < m.indices.size(); f += 3)
-    for (int k = 0; k < 3; ++k) {
-      std::uint32_t a = m.indices[f + k], b = m.indices[f + (k + 1) % 3];
-      if (a > b) std::swap(a, b);
-      ++count[{a, b}];
-    }
   std::set<std::uint32_t> out;
-  for (const auto& [edge, n] : count)
+  for (const auto& [edge, n] : test::edge_face_counts(m))
     if (n != 2) out.insert(edge.first), out.insert(edge.second);
   return out;
 }
@@ -149,15 +143,8 @@ Mesh half_disc() {
 
 /// The edges that one face of `m` has.
 std::vector<std::pair<Point, Point>> border_edges(const Mesh& m) {
-  std::map<std::pair<std::uint32_t, std::uint32_t>, int> count;
-  for (std::size_t f = 0; f < m.indices.size(); f += 3)
-    for (int k = 0; k < 3; ++k) {
-      std::uint32_t a = m.indices[f + k], b = m.indices[f + (k + 1) % 3];
-      if (a > b) std::swap(a, b);
-      ++count[{a, b}];
-    }
   std::vector<std::pair<Point, Point>> out;
-  for (const auto& [edge, n] : count)
+  for (const auto& [edge, n] : test::edge_face_counts(m))
     if (n == 1) out.push_back({vertex(m, edge.first), vertex(m, edge.second)});
   return out;
 }

@@ -1,4 +1,4 @@
-// Exact borders (the default; SimplifyOptions::exact_border): an open border's vertices never
+// Exact borders (asked for: SimplifyOptions::exact_border, `--exact-borders`): an open border's vertices never
 // leave the input's border polylines. GH97 §6's border planes are a penalty that the optimal
 // placement trades against the faces' planes, so a border vertex drifts off its border and off
 // the plane of a flat patch; tiles simplified one by one then no longer meet. Here the planes

@@ -11,6 +11,7 @@
 #include <numeric>
 #include <thread>
 
+#include "analysis/disjoint_sets.h"
 #include "core/parallel_chunks.h"
 #include "partition/partition_targets.h"
 #include "qem/error.h"
@@ -29,24 +30,16 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 // Connected components of the input (faces joined through shared vertices), as simplify counts
 // them on its input: union-find over the vertices of the non-degenerate faces.
 std::size_t count_input_components(MeshView input) {
-  std::vector<std::uint32_t> parent(input.vertex_count());
-  std::iota(parent.begin(), parent.end(), 0u);
-  const auto find = [&](std::uint32_t v) {
-    while (parent[v] != v) v = parent[v] = parent[parent[v]];
-    return v;
-  };
+  analysis::DisjointSets parts(input.vertex_count());
   std::vector<std::uint8_t> used(input.vertex_count(), 0);
   for (std::size_t f = 0; f < input.face_count(); ++f) {
     const std::uint32_t* t = &input.indices[3 * f];
     if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
     for (int k = 0; k < 3; ++k) used[t[k]] = 1;
-    for (int k = 1; k < 3; ++k) {
-      const std::uint32_t a = find(t[0]), b = find(t[k]);
-      if (a != b) parent[std::max(a, b)] = std::min(a, b);
-    }
+    parts.unite(t[0], t[1]), parts.unite(t[0], t[2]);
   }
   std::size_t count = 0;
-  for (std::uint32_t v = 0; v < parent.size(); ++v) count += used[v] && find(v) == v;
+  for (std::uint32_t v = 0; v < input.vertex_count(); ++v) count += used[v] && parts.find(v) == v;
   return count;
 }
 
