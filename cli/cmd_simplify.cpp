@@ -108,11 +108,12 @@ int run_simplify_gltf(const SimplifyArgs& a, const SimplifyOptions& opt) {
         "{\"tool\":\"qem\",\"format\":\"gltf\",\"per_mesh\":%s,\"primitives\":%zu,\"simplified\":%zu,"
         "\"unchanged\":%zu,\"kept\":%zu,\"stopped_early\":%zu,\"in_faces\":%zu,\"target_faces\":%zu,"
         "\"out_faces\":%zu,"
-        "\"out_vertices\":%zu,\"max_error\":%s,\"world_threshold\":%s,\"load_s\":%s,\"simplify_s\":%s,"
+        "\"out_vertices\":%zu,\"max_error\":%s,\"output_to_input_distance\":%s,\"world_threshold\":%s,"
+        "\"load_s\":%s,\"simplify_s\":%s,"
         "\"simplify_cpu_s\":%s,\"write_s\":%s,\"total_s\":%s,\"peak_rss_mb\":%s,\"each\":[%s]}\n",
         a.per_mesh ? "true" : "false", r.primitives.size(), r.simplified, r.unchanged, r.kept, stopped_early,
         r.faces_in, r.target_faces, r.faces_out, out_vertices, json_number(r.max_world_error).c_str(),
-        json_number(r.world_threshold).c_str(), json_number(load_s).c_str(), json_number(simplify_s).c_str(),
+        json_number(r.max_world_distance).c_str(), json_number(r.world_threshold).c_str(), json_number(load_s).c_str(), json_number(simplify_s).c_str(),
         json_number(simplify_cpu_s).c_str(), json_number(write_s).c_str(),
         json_number(total.seconds()).c_str(), json_number(peak_rss_mb()).c_str(), each.c_str());
   }
@@ -122,6 +123,12 @@ int run_simplify_gltf(const SimplifyArgs& a, const SimplifyOptions& opt) {
                  "they were), max error %.4g in world units, %.3f s; the rest of the document is unchanged\n",
                  r.faces_in, r.faces_out, r.primitives.size(), r.simplified, r.unchanged, r.kept,
                  r.max_world_error, total.seconds());
+  if (!a.quiet && std::isfinite(opt.max_distance))
+    std::fprintf(stderr, "qem: distance from the output to the input %.4g in world units (sampled; bound %.4g%s)\n",
+                 r.max_world_distance, opt.max_distance,
+                 !opt.max_distance_is_relative ? " in world units"
+                 : a.per_mesh                  ? " of each primitive's diagonal"
+                                               : " of the scene's diagonal");
   if (!a.quiet && at_dead_end > 0)
     std::fprintf(stderr,
                  "qem: %zu primitive%s %s: no contraction left that keeps the topology, the borders and "
@@ -253,10 +260,17 @@ int run_simplify(const SimplifyArgs& a) {
   if (!a.quiet && r.dropped_degenerate_faces + r.dropped_duplicate_faces > 0)
     std::fprintf(stderr, "qem: left out %zu degenerate and %zu duplicate input faces\n",
                  r.dropped_degenerate_faces, r.dropped_duplicate_faces);
-  if (!a.quiet && std::isfinite(opt.max_distance))
-    std::fprintf(stderr, "qem: distance from the output to the input %.4g (sampled; bound %.4g%s), %zu contractions refused for it\n",
-                 r.output_to_input_distance, opt.max_distance, opt.max_distance_is_relative ? " of the diagonal" : "",
-                 r.rejected_distance);
+  if (!a.quiet && std::isfinite(opt.max_distance)) {
+    // The bound as the user gave it: a relative bound is compared with the distance over the diagonal.
+    char relative[64] = "";
+    if (opt.max_distance_is_relative)
+      std::snprintf(relative, sizeof relative, ", %.4g of the diagonal", r.output_to_input_distance_relative);
+    std::fprintf(stderr,
+                 "qem: distance from the output to the input %.4g%s (sampled; bound %.4g%s), %zu contractions "
+                 "refused for it\n",
+                 r.output_to_input_distance, relative, opt.max_distance,
+                 opt.max_distance_is_relative ? " of the diagonal" : "", r.rejected_distance);
+  }
   if (!a.quiet && opt.refit_rounds > 0)
     std::fprintf(stderr, "qem: refit in %zu round%s: RMS distance of the input's vertices %.4g -> %.4g\n",
                  r.refit_rounds, r.refit_rounds == 1 ? "" : "s", r.refit_rms_before, r.refit_rms_after);

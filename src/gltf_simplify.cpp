@@ -135,8 +135,22 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
       if (any) shared[j] = std::move(lock);
     }
   }
+  // The distance bound (--max-distance) in world units, relative: of the scene's diagonal (shared
+  // mode) or of each primitive's own (per primitive, as the error limit). Each primitive gets it in
+  // its own units, divided by its world_scale, the largest factor by which its nodes stretch a
+  // length: a distance within the local bound is within the world bound wherever the primitive is
+  // drawn. Every run of a primitive (watched and final) has the same bound, so that they refuse the
+  // same contractions.
+  const bool relative_per_primitive = gltf_options.per_primitive && options.max_distance_is_relative;
+  double world_max_distance = options.max_distance;
+  if (options.max_distance_is_relative && std::isfinite(world_max_distance) && !gltf_options.per_primitive)
+    world_max_distance *= bounding_box(doc.scene_mesh()).diagonal();
   const auto with_shared_locks = [&](SimplifyOptions o, std::size_t j) {
     if (!shared[j].empty()) o.vertex_lock = shared[j];
+    if (!relative_per_primitive) {
+      o.max_distance = local_error(world_max_distance, info[jobs[j]].world_scale);
+      o.max_distance_is_relative = false;
+    }
     return o;
   };
 
@@ -291,6 +305,7 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
     o.faces_out = r.mesh.face_count();
     o.max_error = r.max_error;
     o.world_error = r.max_error * o.world_scale;
+    o.world_distance = r.output_to_input_distance * o.world_scale;
     o.stop_reason = r.stop_reason;
     if (!curves.empty() && r.contractions < curves[j].errors.size())
       o.next_world_error = curves[j].errors[r.contractions];
@@ -307,6 +322,7 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
   for (const GltfPrimitiveOutcome& o : report.primitives) {
     report.faces_out += o.faces_out;
     report.max_world_error = std::max(report.max_world_error, o.world_error);
+    report.max_world_distance = std::max(report.max_world_distance, o.world_distance);
     if (o.status == GltfPrimitiveOutcome::Status::Simplified) ++report.simplified;
     if (o.status == GltfPrimitiveOutcome::Status::Unchanged) ++report.unchanged;
     if (o.status == GltfPrimitiveOutcome::Status::Kept) ++report.kept;

@@ -166,7 +166,10 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
     out.refit_rounds = fit.rounds;
   }
   if (!options.map_input_vertices) std::vector<std::uint32_t>().swap(out.output_vertex_of_input);
-  if (bounded) out.output_to_input_distance = sampled_distance(input.positions, input_faces, input_frame, out.mesh);
+  if (bounded) {
+    out.output_to_input_distance = sampled_distance(input.positions, input_faces, input_frame, out.mesh);
+    out.output_to_input_distance_relative = input_frame.scale > 0 ? out.output_to_input_distance / input_frame.scale : 0;
+  }
   return out;
 }
 

@@ -16,6 +16,7 @@
 
 #include "qem/error.h"
 #include "qem/gltf.h"
+#include "qem/measure.h"
 #include "test_meshes.h"
 
 namespace {
@@ -187,6 +188,32 @@ TEST(GltfSimplify, WorldErrorLimitIsSharedToo) {
     EXPECT_LE(o.world_error, 0.01);
     EXPECT_GT(o.world_error, 0.005);
   }
+}
+
+TEST(GltfSimplify, DistanceBoundIsInWorldUnits) {
+  // The second sphere has local radius 0.1 and is drawn 100 times larger: a world bound of 0.02 is
+  // 0.0002 in its units. Measured independently (qem::measure, in local units, times the scale),
+  // no primitive's output lies farther than the bound from its input in the world.
+  qem::GltfDocument doc = qem::GltfDocument::parse(two_spheres().text(), "two.gltf");
+  std::vector<qem::Mesh> before;
+  for (std::size_t i = 0; i < 2; ++i) before.push_back(doc.mesh(i));
+  qem::SimplifyOptions opt;
+  opt.max_distance = 0.02;
+  const qem::GltfSimplifyReport r = qem::simplify_document(doc, opt);
+  EXPECT_EQ(r.simplified, 2u);
+  EXPECT_GT(r.max_world_distance, 0);
+  EXPECT_LE(r.max_world_distance, 0.02);
+  qem::MeasureOptions mo;
+  mo.seed = 3;
+  for (std::size_t i = 0; i < 2; ++i) {
+    const qem::GltfPrimitiveOutcome& o = r.primitives[i];
+    const double world = qem::measure(before[i], doc.mesh(i), mo).h_approx_to_original * o.world_scale;
+    EXPECT_LE(world, 0.02) << "primitive " << i;
+    EXPECT_LE(o.world_distance, 0.02);
+    EXPECT_LT(o.faces_out, o.faces_in);  // the bound is a stop criterion, not a freeze
+  }
+  // The big sphere (world radius 10) keeps far more faces than the unit one under the same bound.
+  EXPECT_GT(r.primitives[1].faces_out, 2 * r.primitives[0].faces_out);
 }
 
 TEST(GltfSimplify, VertexTargetIsTheSameFractionOfTheFaces) {

@@ -110,6 +110,24 @@ TEST(OutOfCore, ForcedRunMeetsTargetWithoutCracksAndNearInCoreError) {
               static_cast<unsigned long long>(report.clustered_faces), e_ooc, e_ooc / e_in);
 }
 
+TEST(OutOfCore, DistanceBoundIsRefusedBeforeAnyWork) {
+  // Phase 2 sees only the clustered mesh, never the input's surface: the bound could not be kept.
+  const std::string dir = fresh_dir("bounded");
+  SimplifyOptions opt;
+  opt.target_faces = 5000;
+  opt.max_distance = 0.01;
+  OutOfCoreOptions ooc;
+  ooc.memory_limit = kTinyLimit;
+  ooc.temp_dir = dir;
+  try {
+    simplify_out_of_core(big_sphere(), opt, ooc);
+    ADD_FAILURE() << "a distance bound out of core was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--max-distance"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(entries(dir), 0u);
+}
+
 TEST(OutOfCore, PositionsBeyondTheBudgetAreMappedFromATemporaryFile) {
   const std::string dir = fresh_dir("mapped");
   SimplifyOptions opt;

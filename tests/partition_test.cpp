@@ -198,6 +198,10 @@ TEST(Partition, RefusesWhatThePartsCannotCarry) {
   limit.max_error = 0.01;
   EXPECT_FALSE(partition_refusal(test::icosphere(3), limit).empty());
   EXPECT_THROW(simplify_partitioned(test::icosphere(3), limit, in_parts(2)), Error);
+  SimplifyOptions bounded = ratio(0.1);
+  bounded.max_distance = 0.01;  // certified against the whole input, which the final pass lacks
+  EXPECT_FALSE(partition_refusal(test::icosphere(3), bounded).empty());
+  EXPECT_THROW(simplify_partitioned(test::icosphere(3), bounded, in_parts(2)), Error);
   EXPECT_TRUE(partition_refusal(test::icosphere(3), ratio(0.1)).empty());
 }
 

@@ -50,6 +50,9 @@ struct GltfPrimitiveOutcome {
   double world_scale = 1;  ///< GltfPrimitiveInfo::world_scale
   double max_error = 0;    ///< largest contraction error made, the primitive's own units
   double world_error = 0;  ///< the same times world_scale
+  /// With a distance bound (SimplifyOptions::max_distance): the output's sampled distance to the
+  /// primitive's input (SimplifyResult::output_to_input_distance) times world_scale; else 0.
+  double world_distance = 0;
   /// Shared budget: the world error of the first contraction the primitive did not make (from its
   /// watched run), +inf when that run had none left. It exceeds the threshold unless the
   /// primitive stopped on the step that reaches it (world_error is then the threshold).
@@ -69,14 +72,17 @@ struct GltfSimplifyReport {
   std::size_t target_faces = 0;
   double world_threshold = 0;
   double max_world_error = 0;  ///< the largest world_error of any primitive
+  double max_world_distance = 0;  ///< the largest world_distance of any primitive
 };
 
 /// Simplifies every simplifiable primitive of `doc` (GltfDocument::replace) with `options`. The
 /// stop criteria count the faces of the simplifiable primitives only (kept ones cannot change):
 /// target_faces / target_ratio of their total, target_vertices as the same fraction of their
-/// vertices; max_error is in world units, max_error_is_relative takes it of the scene's bounding
-/// box diagonal (GltfDocument::scene_mesh). With per_primitive, each primitive gets the options
-/// as they are, max_error still in world units (divided by its world_scale). options.threads is
+/// vertices; max_error and max_distance are in world units, max_error_is_relative and
+/// max_distance_is_relative take them of the scene's bounding box diagonal
+/// (GltfDocument::scene_mesh). With per_primitive, each primitive gets the options as they are,
+/// max_error and max_distance still in world units (divided by its world_scale), relative ones of
+/// the primitive's own diagonal. options.threads is
 /// used inside each run when primitives are not run in parallel. Throws qem::Error on invalid
 /// options (check_options) before anything is changed; the document is unchanged on error.
 GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& options,

@@ -214,6 +214,7 @@ struct SimplifyResult {
   /// With max_distance: the largest distance from the output to the input over the certified
   /// samples of every output face (after the refit), in distance units; at most max_distance.
   double output_to_input_distance = 0;
+  double output_to_input_distance_relative = 0;  ///< the same over the bounding-box diagonal
   /// ... and refused because a connected component would have dropped below its floor
   /// (SimplifyOptions::keep_components).
   std::size_t rejected_component = 0;

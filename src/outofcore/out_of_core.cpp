@@ -343,6 +343,11 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
   if (!input_options.vertex_lock.empty())
     throw Error(
         "per-vertex locks are not supported out of core (the clustering merges the input's vertices)");
+  // The bound is certified against the input's surface, which out of core is never in memory:
+  // phase 2 sees only the clustered mesh, so it could not promise the distance to the input.
+  if (std::isfinite(input_options.max_distance))
+    throw Error(path + ": a distance bound (--max-distance) needs the whole input in memory, and this run is out "
+                       "of core; raise --memory-limit so that it fits, or leave the bound out");
   OutOfCoreReport report;
   report.memory_limit = ooc.memory_limit ? ooc.memory_limit : default_memory_limit();
   const std::string temp_dir = ooc.temp_dir.empty() ? default_temp_dir() : ooc.temp_dir;

@@ -30,6 +30,9 @@ std::string partition_refusal(MeshView input, const SimplifyOptions& o) {
   if (!input.face_materials.empty()) return "the mesh has face materials, which the parts do not carry";
   if (std::isfinite(o.max_error))
     return "an error limit (--max-error) is measured against each part's quadrics, not the whole mesh's";
+  if (std::isfinite(o.max_distance))
+    return "a distance bound (--max-distance) is certified against the whole input, and the final pass "
+           "would see only the parts' output";
   if (o.threshold > 0) return "a pair threshold (--threshold) would pair vertices across the cuts";
   if (o.prune_size > 0) return "pruning (--prune) judges whole components, which the cuts divide";
   if (o.as_far_as_possible) return "a target of 0 (as far as the checks allow) has no share to give each part";
