@@ -153,6 +153,9 @@ class SimplifyResult(Mesh):
     input_components, output_components: connected components of the input and the output
       (vertex-connected); pruned_components: removed by `prune`; rejected_component: contractions
       refused because a component would have dropped below its floor (keep_components).
+    output_to_input_distance (model units) and output_to_input_distance_relative (over the
+      diagonal): with max_distance, the largest sampled distance from the output to the input
+      (0 without); rejected_distance: contractions refused for the bound.
     With return_mapping=True (else None):
       vertex_source: (n_out,) int32, the input vertex each output vertex started from;
       face_source: (m_out,) int32, the input face each output face is;
@@ -165,7 +168,8 @@ class SimplifyResult(Mesh):
         "max_error", "max_error_relative", "stop_reason", "stop_detail", "contractions", "input_faces",
         "input_vertices", "refit_rounds", "refit_rms_before", "refit_rms_after", "dropped_degenerate_faces",
         "dropped_duplicate_faces", "rejected_component", "input_components", "output_components",
-        "pruned_components", "vertex_source", "face_source", "output_vertex_of_input", "record",
+        "pruned_components", "output_to_input_distance", "output_to_input_distance_relative",
+        "rejected_distance", "vertex_source", "face_source", "output_vertex_of_input", "record",
     )
 
     def __repr__(self):
@@ -217,6 +221,7 @@ def _attribute_list(attributes):
 
 
 def _options(*, target_faces, target_ratio, target_vertices, max_error, max_error_relative, threshold,
+             max_distance=None, max_distance_relative=None,
              threshold_relative, weighting, placement, boundary_weight, lock_border, inversion, max_turn,
              allow_non_manifold, scheme, refit, threads, record, keep_components=True, prune=None,
              prune_relative=None, exact_border=False):
@@ -267,9 +272,19 @@ def _options(*, target_faces, target_ratio, target_vertices, max_error, max_erro
             if e < 0:
                 raise ValueError(f"{name}: must not be negative, got {e}")
             o.max_error, o.max_error_is_relative = e, relative
-    if (target_faces, target_ratio, target_vertices, max_error, max_error_relative) == (None,) * 5:
-        raise ValueError("no stop criterion: give target_faces, target_ratio, target_vertices, max_error "
-                         "or max_error_relative")
+    if max_distance is not None and max_distance_relative is not None:
+        raise ValueError("give max_distance or max_distance_relative, not both")
+    for name, value, relative in (("max_distance", max_distance, False),
+                                  ("max_distance_relative", max_distance_relative, True)):
+        if value is not None:
+            d = number(name, value)
+            if not 0 <= d < _math.inf:
+                raise ValueError(f"{name}: expected a finite distance >= 0, got {d}")
+            o.max_distance, o.max_distance_is_relative = d, relative
+    if (target_faces, target_ratio, target_vertices, max_error, max_error_relative, max_distance,
+            max_distance_relative) == (None,) * 7:
+        raise ValueError("no stop criterion: give target_faces, target_ratio, target_vertices, max_error, "
+                         "max_error_relative, max_distance or max_distance_relative")
     if threshold and threshold_relative:
         raise ValueError("give threshold or threshold_relative, not both")
     if threshold_relative:
@@ -320,7 +335,8 @@ def _options(*, target_faces, target_ratio, target_vertices, max_error, max_erro
 
 def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_ratio: Optional[float] = None,
              target_vertices: Optional[int] = None, max_error: Optional[float] = None,
-             max_error_relative: Optional[float] = None, threshold: float = 0.0,
+             max_error_relative: Optional[float] = None, max_distance: Optional[float] = None,
+             max_distance_relative: Optional[float] = None, threshold: float = 0.0,
              threshold_relative: Optional[float] = None, weighting: str = "area", placement: str = "optimal",
              boundary_weight: float = 1.0, lock_border: bool = False, inversion: str = "forbid",
              max_turn: float = 75.0, allow_non_manifold: bool = False, scheme: str = "passes",
@@ -339,6 +355,10 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
       max_error: never make a contraction whose error exceeds this distance (model units): the
         weighted RMS distance of the new vertex to the planes it stands for.
       max_error_relative: the same as a fraction of the bounding-box diagonal.
+      max_distance: no point of the output farther than this from the input surface (model units):
+        each contraction's new faces are certified against the input (--max-distance); alone it
+        means as few faces as the bound allows. max_distance_relative: the same over the diagonal.
+        result.output_to_input_distance says what was reached.
     The algorithm (the command line's defaults, so the same options give the same bytes as `qem simplify`;
     the one difference: this is always the in-core run, `--partition off`, while the command line cuts
     meshes of 1M faces or more into parts by default, docs/parallel.md):
@@ -391,7 +411,8 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
     if progress is not None and not callable(progress):
         raise ValueError(f"progress: expected a callable taking the fraction done, got {progress!r}")
     options = _options(target_faces=target_faces, target_ratio=target_ratio, target_vertices=target_vertices,
-                       max_error=max_error, max_error_relative=max_error_relative, threshold=threshold,
+                       max_error=max_error, max_error_relative=max_error_relative, max_distance=max_distance,
+                       max_distance_relative=max_distance_relative, threshold=threshold,
                        threshold_relative=threshold_relative, weighting=weighting, placement=placement,
                        boundary_weight=boundary_weight, lock_border=lock_border, inversion=inversion,
                        max_turn=max_turn, allow_non_manifold=allow_non_manifold, scheme=scheme, refit=refit,

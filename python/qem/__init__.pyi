@@ -69,6 +69,9 @@ class SimplifyResult(Mesh):
     input_components: int
     output_components: int
     pruned_components: int
+    output_to_input_distance: float
+    output_to_input_distance_relative: float
+    rejected_distance: int
     vertex_source: Optional[npt.NDArray[np.int32]]
     face_source: Optional[npt.NDArray[np.int32]]
     output_vertex_of_input: Optional[npt.NDArray[np.int32]]
@@ -128,6 +131,8 @@ def simplify(
     target_vertices: Optional[int] = ...,
     max_error: Optional[float] = ...,
     max_error_relative: Optional[float] = ...,
+    max_distance: Optional[float] = ...,
+    max_distance_relative: Optional[float] = ...,
     threshold: float = ...,
     threshold_relative: Optional[float] = ...,
     weighting: Literal["area", "uniform", "angle"] = ...,

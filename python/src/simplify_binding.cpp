@@ -256,6 +256,9 @@ void bind_simplify(py::module_& m) {
         out["input_components"] = r.input_components;
         out["output_components"] = r.output_components;
         out["pruned_components"] = r.pruned_components;
+        out["output_to_input_distance"] = r.output_to_input_distance;
+        out["output_to_input_distance_relative"] = r.output_to_input_distance_relative;
+        out["rejected_distance"] = r.rejected_distance;
         out["refit_rounds"] = r.refit_rounds;
         out["refit_rms_before"] = r.refit_rms_before;
         out["refit_rms_after"] = r.refit_rms_after;

@@ -25,6 +25,26 @@ def test_stop_criteria(small_torus):
     assert len(r.vertices) <= 100
 
 
+def test_distance_bound(small_torus):
+    # Alone, the bound is the stop criterion; what was reached is reported and checked here with
+    # qem.measure (independent samples): no output point farther than the bound from the input.
+    v, f = small_torus
+    r = qem.simplify(v, f, max_distance_relative=0.003)
+    assert 0 < r.output_to_input_distance_relative <= 0.003
+    assert r.rejected_distance > 0 and len(r.faces) < len(f)
+    m = qem.measure((v, f), r, samples=200_000)
+    assert m.h_approx_to_original <= 0.003 * m.bbox_diag
+    absolute = qem.simplify(v, f, max_distance=0.003 * m.bbox_diag)  # the same bound, in model units
+    assert 0 < absolute.output_to_input_distance <= 0.003 * m.bbox_diag
+    assert abs(len(absolute.faces) - len(r.faces)) <= 0.02 * len(r.faces)
+    unbounded = qem.simplify(v, f, target_ratio=0.5)
+    assert unbounded.output_to_input_distance == 0 and unbounded.rejected_distance == 0
+    with pytest.raises(ValueError):
+        qem.simplify(v, f, max_distance=0.1, max_distance_relative=0.1)
+    with pytest.raises(ValueError):
+        qem.simplify(v, f, max_distance=-1)
+
+
 def test_threads_give_the_same_bytes(large_torus):
     v, f = large_torus
     a = qem.simplify(v, f, target_ratio=0.1, threads=1)
