@@ -7,24 +7,32 @@
 
 namespace qem::core {
 
-bool SurfaceDistance::piece_within(const Vec3& a, const Vec3& b, const Vec3& c, double d, int depth) const {
+bool SurfaceDistance::piece_within(const Vec3& a, const Vec3& b, const Vec3& c, double d, int depth,
+                                  std::uint32_t parent) const {
   using measure_detail::squared_distance;
+  const auto near = [&](std::uint32_t id) {
+    const double* t = tree_.triangle(id);
+    const Vec3 ta{t[0], t[1], t[2]}, tb{t[3], t[4], t[5]}, tc{t[6], t[7], t[8]};
+    const auto one = [&](const Vec3& p) {
+      return squared_distance(p, measure_detail::closest_point_on_triangle(p, ta, tb, tc)) <= d * d;
+    };
+    return one(a) && one(b) && one(c);
+  };
+  // The parent piece's closest triangle often holds a smaller piece already (convexity, below):
+  // no search then. Else it warm-starts the search, which finds the same triangle as a cold one.
+  if (parent != UINT32_MAX && near(parent)) return true;
   const Vec3 m = (1.0 / 3) * (a + b + c);
   const double q[3] = {m.x, m.y, m.z};
-  const auto hit = tree_.closest(q, d * d);
+  const auto hit = tree_.closest(q, d * d, parent);
   if (!(hit.d2 <= d * d)) return false;  // the centroid itself is too far
   const double reach = std::sqrt(std::max({squared_distance(a, m), squared_distance(b, m), squared_distance(c, m)}));
   if (std::sqrt(hit.d2) + reach <= d) return true;  // 1-Lipschitz
-  const double* t = tree_.triangle(hit.triangle);
-  const Vec3 ta{t[0], t[1], t[2]}, tb{t[3], t[4], t[5]}, tc{t[6], t[7], t[8]};
-  const auto near_t = [&](const Vec3& p) {
-    return squared_distance(p, measure_detail::closest_point_on_triangle(p, ta, tb, tc)) <= d * d;
-  };
-  if (near_t(a) && near_t(b) && near_t(c)) return true;  // convexity of the distance to T
+  if (hit.triangle != parent && near(hit.triangle)) return true;  // convexity of the distance to T
   if (depth == kMaxDepth) return false;
   const Vec3 ab = 0.5 * (a + b), bc = 0.5 * (b + c), ca = 0.5 * (c + a);
-  return piece_within(a, ab, ca, d, depth + 1) && piece_within(ab, b, bc, d, depth + 1) &&
-         piece_within(ca, bc, c, d, depth + 1) && piece_within(ab, bc, ca, d, depth + 1);
+  const std::uint32_t t = hit.triangle;
+  return piece_within(a, ab, ca, d, depth + 1, t) && piece_within(ab, b, bc, d, depth + 1, t) &&
+         piece_within(ca, bc, c, d, depth + 1, t) && piece_within(ab, bc, ca, d, depth + 1, t);
 }
 
 double SurfaceDistance::triangle_sampled_max(const Vec3& a, const Vec3& b, const Vec3& c) const {

@@ -41,14 +41,16 @@ class SurfaceDistance {
   }
   /// Whether every point of triangle abc is certified within d of the surface (see above).
   bool triangle_within(const Vec3& a, const Vec3& b, const Vec3& c, double d) const {
-    return piece_within(a, b, c, d, 0);
+    return piece_within(a, b, c, d, 0, UINT32_MAX);
   }
   /// The largest distance to the surface over the corners, edge midpoints and centroid of abc
   /// and of its four halves-by-edge (a lower bound of the triangle's largest distance).
   double triangle_sampled_max(const Vec3& a, const Vec3& b, const Vec3& c) const;
 
  private:
-  bool piece_within(const Vec3& a, const Vec3& b, const Vec3& c, double d, int depth) const;
+  /// `parent`: the closest triangle to the centroid of the piece this one was split from
+  /// (UINT32_MAX at the top).
+  bool piece_within(const Vec3& a, const Vec3& b, const Vec3& c, double d, int depth, std::uint32_t parent) const;
 
   measure_detail::TriangleBvh tree_;
 };

@@ -196,6 +196,14 @@ TriangleBvh::Hit TriangleBvh::closest(const double p[3], std::uint32_t* hint) co
   return hit;
 }
 
+TriangleBvh::Hit TriangleBvh::closest(const double p[3], double max_d2, std::uint32_t hint) const {
+  if (hint >= ids_.size()) return search(p, max_d2, UINT32_MAX);
+  double point[3];
+  const std::uint32_t slot = slot_of_[hint];
+  const double d2 = slot_d2(p, slot, point);
+  return d2 <= max_d2 ? search(p, d2, slot) : search(p, max_d2, UINT32_MAX);
+}
+
 void TriangleBvh::within(const double p[3], double max_d2, std::vector<std::uint32_t>& out) const {
   if (nodes_.empty()) return;
   std::uint32_t stack[kStack];

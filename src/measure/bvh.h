@@ -33,6 +33,9 @@ class TriangleBvh {
   /// UINT32_MAX for none) bounds the search from the start, which prunes most of the tree when
   /// consecutive queries are near each other. `*hint` is set to the closest triangle found.
   Hit closest(const double p[3], std::uint32_t* hint) const;
+  /// The closest point within sqrt(max_d2) (as closest(p, max_d2): the same answer), the search
+  /// bounded from the start by triangle `hint`'s distance when it is within max_d2.
+  Hit closest(const double p[3], double max_d2, std::uint32_t hint) const;
 
   /// Appends to `out` the (input) index of every triangle within sqrt(max_d2) of `p`, in no order.
   void within(const double p[3], double max_d2, std::vector<std::uint32_t>& out) const;
