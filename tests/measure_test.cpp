@@ -94,6 +94,29 @@ TEST(Measure, BvhWarmStartGivesSameAnswer) {
   }
 }
 
+TEST(Measure, BvhBoundedWarmStartGivesTheBoundedAnswer) {
+  // closest(p, max_d2, hint), as the distance certificate calls it: the same triangle as the cold
+  // bounded search whatever the hint (near, far beyond the bound, or none), none beyond the bound.
+  const Mesh sphere = test::icosphere(4);
+  const measure_detail::Surface s = measure_detail::make_surface(sphere, "sphere");
+  const measure_detail::TriangleBvh bvh(s.corners);
+  measure_detail::Rng rng(5);
+  int found = 0, beyond = 0;
+  for (int i = 0; i < 3000; ++i) {
+    const double r = 0.8 + 0.4 * rng.uniform(), a = 6.3 * rng.uniform(), b = 3.1 * rng.uniform();
+    const double p[3] = {r * std::sin(b) * std::cos(a), r * std::sin(b) * std::sin(a), r * std::cos(b)};
+    const double max_d2 = 0.01 * rng.uniform();
+    const auto hint = static_cast<std::uint32_t>(rng.uniform() * double(s.triangle_count() + 1));  // may be none
+    const auto cold = bvh.closest(p, max_d2);
+    const auto warm = bvh.closest(p, max_d2, hint);
+    ASSERT_EQ(warm.d2, cold.d2) << i;
+    ASSERT_EQ(warm.triangle, cold.triangle) << i;
+    (cold.d2 <= max_d2 ? found : beyond) += 1;
+  }
+  EXPECT_GT(found, 300);  // both cases are exercised
+  EXPECT_GT(beyond, 300);
+}
+
 TEST(Measure, SamplesAreUniformByArea) {
   // Two triangles of areas 1/8 and 7/8 (split of the unit square at x = 1/4 on the bottom edge):
   // the mean x of area-uniform samples is the square's centroid, 1/2, only if faces are picked by area.
