@@ -19,7 +19,7 @@ namespace qem {
 
 /// What a long out-of-core run is doing, for a progress display.
 struct OutOfCoreProgress {
-  const char* phase = "";  ///< "bounds", "grid", "clustering", "reading clusters", "simplifying"
+  const char* phase = "";  ///< "bounds", "clustering", "simplifying"
   int phase_index = 0;     ///< 1-based, of phase_count
   int phase_count = 0;
   std::uint64_t bytes_read = 0;   ///< of the input, all passes so far
@@ -33,6 +33,14 @@ struct OutOfCoreOptions {
   std::uint64_t memory_limit = 0;
   /// Folder of the temporary files; empty = $TMPDIR, else /tmp.
   std::string temp_dir;
+  /// Phase 2 starts from at most about this many times the target's faces (the clustering's grid
+  /// is sized for it, and coarsened when it gives more than twice as many): phase 2's time grows
+  /// with its input, and beyond some tens of times the target its result hardly improves
+  /// (docs/benchmarks.md, "Out of core"). 0: only the memory budget bounds it.
+  double phase2_faces_per_target = 32;
+  /// Parts of phase 2 (qem/partition.h): 0 = automatic_parts of the clustered faces (when the
+  /// options allow a partitioned run), 1 = one in-core run.
+  unsigned parts = 0;
   /// Called about once a second (and at each phase change); returning false cancels the run
   /// (qem::Error "cancelled"), after which no temporary file is left.
   std::function<bool(const OutOfCoreProgress&)> progress;
@@ -41,17 +49,20 @@ struct OutOfCoreOptions {
 /// One phase of a run and how long it took.
 struct OutOfCorePhase {
   std::string name;
-  double seconds = 0;
+  double seconds = 0;      ///< wall
+  double cpu_seconds = 0;  ///< of the process, all threads (on a loaded machine wall says little)
 };
 
 struct OutOfCoreReport {
   std::uint64_t input_faces = 0, input_vertices = 0;
   std::uint64_t memory_limit = 0;        ///< the budget used (after the default)
   std::uint64_t grid_resolution = 0;     ///< cells along the bounding box's longest side
+  unsigned grid_coarsenings = 0;         ///< times the sampled grid was too fine and was halved
   std::uint64_t clustered_vertices = 0;  ///< occupied cells
   std::uint64_t clustered_faces = 0;     ///< faces handed to phase 2 (after dropping duplicates)
   std::uint64_t temp_bytes_written = 0;
   std::uint64_t peak_memory_bytes = 0;  ///< peak resident set of the process (VmHWM)
+  unsigned parts = 1;                   ///< parts of phase 2
   std::vector<OutOfCorePhase> phases;
 };
 
