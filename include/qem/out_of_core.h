@@ -2,9 +2,11 @@
 // Lindstrom 2000's out-of-core vertex clustering: the input is read as a stream (binary PLY or
 // binary STL, in chunks), every triangle's plane quadric is added to the grid cells of its corners
 // (memory proportional to the occupied cells, not to the input), and the triangles that span three
-// cells are written to a temporary file as cell triples. Phase 2 is the in-core simplification
-// (qem::simplify) of that clustered mesh down to the target. The grid is chosen as fine as the
-// memory budget allows, so that phase 2, which decides quality, starts from as many faces as fit.
+// cells are written to a temporary file as cell triples; the triangles are clustered in blocks on
+// every thread, added in file order. Phase 2 is the in-core simplification (qem::simplify, or
+// part by part with qem/partition.h when large) of that clustered mesh down to the target. The
+// grid is as fine as the memory budget allows, up to a multiple of the target (phase 2's time), so
+// that phase 2, which decides quality, starts from a mesh tens of times larger than the target.
 #pragma once
 
 #include <cstddef>
@@ -81,7 +83,8 @@ bool fits_in_memory(const std::string& path, std::uint64_t memory_limit);
 
 /// Simplifies the mesh file `path` in the two phases, whatever its size, under the options'
 /// budget. `options` are those of qem::simplify and apply to phase 2 (its quadrics are recomputed
-/// from the clustered faces); target_ratio counts the input's faces; vertex_lock is refused. Throws
+/// from the clustered faces); target_ratio counts the input's faces; vertex_lock is refused; the
+/// result does not depend on options.threads. Throws
 /// qem::Error on a malformed input, an unwritable or full temporary folder, or a cancel; temporary files are
 /// removed in every case (and on SIGINT/SIGTERM).
 SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptions& options,

@@ -1,5 +1,6 @@
-// Garland & Shaffer 2002's two phases: Lindstrom 2000 out-of-core clustering (this file's
-// cluster_stream), then GH97 in core (qem::simplify) on the clustered mesh.
+// Garland & Shaffer 2002's two phases: Lindstrom 2000 out-of-core clustering
+// (outofcore/parallel_clustering.h, the grid sized here from a sample), then GH97 in core
+// (qem::simplify, or part by part) on the clustered mesh.
 #include "qem/out_of_core.h"
 
 #include <fcntl.h>
