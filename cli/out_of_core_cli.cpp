@@ -50,7 +50,8 @@ int run_out_of_core(const std::string& input, const std::string& output, const S
       used = 0;
     }
     if (used != args.partition.size() || parts == 0 || parts > 4096)
-      throw Error("--partition must be auto, off or a number of parts from 1 to 4096, not '" + args.partition + "'");
+      throw Error("--partition must be auto, off or a number of parts from 1 to 4096, not '" +
+                  args.partition + "'");
     ooc.parts = unsigned(parts);
   }
   if (ooc.temp_dir.empty() && !std::getenv("TMPDIR")) {
@@ -81,31 +82,35 @@ int run_out_of_core(const std::string& input, const std::string& output, const S
     std::string phases = "[";
     for (const OutOfCorePhase& p : report.phases)
       phases += std::string(phases.size() > 1 ? "," : "") + "{\"name\":" + json_string(p.name) +
-                ",\"seconds\":" + json_number(p.seconds) + ",\"cpu_seconds\":" + json_number(p.cpu_seconds) + "}";
+                ",\"seconds\":" + json_number(p.seconds) + ",\"cpu_seconds\":" + json_number(p.cpu_seconds) +
+                "}";
     phases += "]";
     std::printf(
         "{\"tool\":\"qem\",\"out_of_core\":true,\"in_faces\":%llu,\"target_faces\":%zu,\"out_faces\":%zu,"
-        "\"out_vertices\":%zu,\"clustered_faces\":%llu,\"grid_resolution\":%llu,\"grid_coarsenings\":%u,\"memory_limit_bytes\":%llu,"
-        "\"peak_memory_bytes\":%llu,\"temp_bytes_written\":%llu,\"parts\":%u,\"total_s\":%s,\"cpu_s\":%s,\"peak_rss_mb\":%s,"
+        "\"out_vertices\":%zu,\"clustered_faces\":%llu,\"grid_resolution\":%llu,\"grid_coarsenings\":%u,"
+        "\"memory_limit_bytes\":%llu,"
+        "\"peak_memory_bytes\":%llu,\"temp_bytes_written\":%llu,\"parts\":%u,\"total_s\":%s,\"cpu_s\":%s,"
+        "\"peak_rss_mb\":%s,"
         "\"max_error\":%s,\"max_error_rel\":%s,\"stop\":\"%s\",\"phases\":%s}\n",
         static_cast<unsigned long long>(report.input_faces), out.target_faces, r.mesh.face_count(),
         r.mesh.vertex_count(), static_cast<unsigned long long>(report.clustered_faces),
         static_cast<unsigned long long>(report.grid_resolution), report.grid_coarsenings,
         static_cast<unsigned long long>(report.memory_limit),
         static_cast<unsigned long long>(report.peak_memory_bytes),
-        static_cast<unsigned long long>(report.temp_bytes_written), report.parts, json_number(total.seconds()).c_str(),
-        json_number(process_cpu_seconds()).c_str(),
+        static_cast<unsigned long long>(report.temp_bytes_written), report.parts,
+        json_number(total.seconds()).c_str(), json_number(process_cpu_seconds()).c_str(),
         json_number(peak_rss_mb()).c_str(), json_number(r.max_error).c_str(),
         json_number(r.max_error_relative).c_str(), to_string(r.stop_reason), phases.c_str());
   }
   if (!out.quiet)
-    std::fprintf(stderr,
-                 "qem: %llu -> %zu faces out of core (clustered to %llu faces on a grid of %llu, %u parts), %.3f s, "
-                 "peak memory %.0f MB, %.0f MB of temporary files\n",
-                 static_cast<unsigned long long>(report.input_faces), r.mesh.face_count(),
-                 static_cast<unsigned long long>(report.clustered_faces),
-                 static_cast<unsigned long long>(report.grid_resolution), report.parts, total.seconds(),
-                 double(report.peak_memory_bytes) / 1e6, double(report.temp_bytes_written) / 1e6);
+    std::fprintf(
+        stderr,
+        "qem: %llu -> %zu faces out of core (clustered to %llu faces on a grid of %llu, %u parts), %.3f s, "
+        "peak memory %.0f MB, %.0f MB of temporary files\n",
+        static_cast<unsigned long long>(report.input_faces), r.mesh.face_count(),
+        static_cast<unsigned long long>(report.clustered_faces),
+        static_cast<unsigned long long>(report.grid_resolution), report.parts, total.seconds(),
+        double(report.peak_memory_bytes) / 1e6, double(report.temp_bytes_written) / 1e6);
   return 0;
 }
 

@@ -388,8 +388,9 @@ void MeshStream::read_triangles(const std::function<void(const std::uint32_t*, s
       for (int c = 0; c < 3; ++c)
         if (v[c] >= nv)  // an int32 below 0 reads as a large uint32
           m.fail_at(e, i,
-                    "vertex index " + std::to_string(e.props[0].type == Type::I32 ? std::int64_t(std::int32_t(v[c]))
-                                                                                  : std::int64_t(v[c])) +
+                    "vertex index " +
+                        std::to_string(e.props[0].type == Type::I32 ? std::int64_t(std::int32_t(v[c]))
+                                                                    : std::int64_t(v[c])) +
                         " out of range (" + std::to_string(nv) + " vertices)");
       m.cur += 13;
       tri.insert(tri.end(), {v[0], v[1], v[2]});

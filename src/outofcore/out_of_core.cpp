@@ -36,11 +36,11 @@ namespace {
 
 using outofcore::CellKey;
 using outofcore::CellSet;
+using outofcore::CellTable;
 using outofcore::Grid;
+using outofcore::MeshStream;
 using outofcore::ParallelClustering;
 using outofcore::PositionSource;
-using outofcore::CellTable;
-using outofcore::MeshStream;
 using outofcore::TempFile;
 
 /// Peak memory of the in-core path per input face (load, working mesh, heap, refit), the figure
@@ -67,7 +67,8 @@ std::uint64_t peak_rss_bytes() {
 double process_cpu_seconds() {
   rusage u{};
   ::getrusage(RUSAGE_SELF, &u);
-  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
 std::string default_temp_dir() {
@@ -384,12 +385,14 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
       std::max(0.0, std::min(phase1_room / kClusterBytesPerCell, budget / kPhase2BytesPerCell)));
   // Phase 2's time: the clustered mesh need not be larger than a multiple of the target (about
   // two faces a cell on a closed surface).
-  const double target = options.target_faces ? double(options.target_faces) : 2.0 * double(options.target_vertices);
+  const double target =
+      options.target_faces ? double(options.target_faces) : 2.0 * double(options.target_vertices);
   const std::uint64_t goal_by_time = target > 0 && ooc.phase2_faces_per_target > 0
                                          ? std::uint64_t(ooc.phase2_faces_per_target * target / 2)
                                          : std::numeric_limits<std::uint64_t>::max();
   // Never fewer cells than the target's vertices, or phase 2 would have nothing to choose from.
-  const std::uint64_t floor_cells = std::max<std::uint64_t>({options.target_faces, options.target_vertices * 2, 1024});
+  const std::uint64_t floor_cells =
+      std::max<std::uint64_t>({options.target_faces, options.target_vertices * 2, 1024});
   max_cells = std::max(max_cells, floor_cells);
   // The grid aims at the goal; the clustering coarsens it when the cells pass twice the goal (the
   // time bound is soft) or the budget's (a hard bound).
@@ -398,8 +401,8 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
   // 0.87-1.2x of the cells on the spheres and tori of docs/benchmarks.md).
   const std::uint64_t hard_cells =
       goal_by_time < max_cells / 2 ? std::max(2 * goal_by_time, floor_cells) : max_cells;
-  const std::uint64_t goal_cells =
-      std::max(goal_by_time < max_cells / 2 ? goal_by_time : std::uint64_t(0.75 * double(max_cells)), floor_cells);
+  const std::uint64_t goal_cells = std::max(
+      goal_by_time < max_cells / 2 ? goal_by_time : std::uint64_t(0.75 * double(max_cells)), floor_cells);
 
   // --- pass 1: bounds (and, for a PLY, the positions) ---------------------------------------------
   progress.phase("bounds", 1);
@@ -450,10 +453,12 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
   fine.size = starting_cell_size(sample, lo, extent, goal_cells);
   std::vector<float>().swap(sample);
   TempFile faces(temp_dir, "faces");
-  const unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  const unsigned threads =
+      options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
   ParallelClustering clustering(fine, hard_cells, threads, faces);
   // Mapped positions: their pages are given back whenever they pass a quarter of the budget.
-  const std::uint64_t mapped_allowance = std::max<std::uint64_t>(std::uint64_t(budget / 4), std::uint64_t(32) << 20);
+  const std::uint64_t mapped_allowance =
+      std::max<std::uint64_t>(std::uint64_t(budget / 4), std::uint64_t(32) << 20);
   clustering.after_block = [&, blocks = 0]() mutable {
     if (store && store->mapped() && ++blocks % 16 == 0 && resident_file_bytes() > mapped_allowance)
       store->drop_pages();

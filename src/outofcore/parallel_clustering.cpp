@@ -119,7 +119,8 @@ struct ParallelClustering::Block {
         cell.sum[0] += corner[k]->x, cell.sum[1] += corner[k]->y, cell.sum[2] += corner[k]->z;
         cell.corners += 1;
       }
-      if (id[0] != id[1] && id[1] != id[2] && id[0] != id[2]) triples.insert(triples.end(), {id[0], id[1], id[2]});
+      if (id[0] != id[1] && id[1] != id[2] && id[0] != id[2])
+        triples.insert(triples.end(), {id[0], id[1], id[2]});
     }
   }
 };
@@ -157,12 +158,15 @@ struct ParallelClustering::Workers {
   }
 };
 
-ParallelClustering::ParallelClustering(const Grid& fine, std::uint64_t max_cells, unsigned threads, TempFile& faces)
-    : fine_(fine), max_cells_(std::max<std::uint64_t>(max_cells, 1)), faces_(faces), cells_(std::size_t(max_cells_)) {
+ParallelClustering::ParallelClustering(const Grid& fine, std::uint64_t max_cells, unsigned threads,
+                                       TempFile& faces)
+    : fine_(fine),
+      max_cells_(std::max<std::uint64_t>(max_cells, 1)),
+      faces_(faces),
+      cells_(std::size_t(max_cells_)) {
   if (threads > 1) {
     workers_ = std::make_unique<Workers>();
-    for (unsigned t = 0; t < threads; ++t)
-      workers_->threads.emplace_back([this] { workers_->run(fine_); });
+    for (unsigned t = 0; t < threads; ++t) workers_->threads.emplace_back([this] { workers_->run(fine_); });
   }
 }
 
@@ -187,7 +191,8 @@ void ParallelClustering::start_block() {
   filling_->positions = nullptr;
 }
 
-void ParallelClustering::add_indexed(const std::uint32_t* corners, std::size_t n, const PositionSource& positions) {
+void ParallelClustering::add_indexed(const std::uint32_t* corners, std::size_t n,
+                                     const PositionSource& positions) {
   while (n > 0) {
     if (!filling_) start_block();
     filling_->positions = &positions;
@@ -285,7 +290,8 @@ std::vector<std::uint32_t> read_clustered_faces(ParallelClustering& clustering, 
         id[k] = cells.find(coarser_cell(buf[3 * t + k], levels));
         if (id[k] == CellTable::kNoCell) throw Error(faces.path() + ": a face names a cell never met");
       }
-      if (id[0] != id[1] && id[1] != id[2] && id[0] != id[2]) indices.insert(indices.end(), {id[0], id[1], id[2]});
+      if (id[0] != id[1] && id[1] != id[2] && id[0] != id[2])
+        indices.insert(indices.end(), {id[0], id[1], id[2]});
     }
     left -= n;
   }
