@@ -174,9 +174,12 @@ int run_simplify(const SimplifyArgs& a) {
   if (gltf_document) opt.refit_rounds = attribute_refit_rounds(a.algorithm, opt);
   if (gltf_document) return run_simplify_gltf(a, opt);
   // An input too large for memory goes the out-of-core way (qem/out_of_core.h); others as before.
-  if (a.record.empty() && wants_out_of_core(a.input, a.out_of_core))
-    return run_out_of_core(a.input, a.output, opt, a.out_of_core,
+  if (a.record.empty() && wants_out_of_core(a.input, a.out_of_core)) {
+    OutOfCoreArgs ooc = a.out_of_core;
+    ooc.partition = a.partition.partition;
+    return run_out_of_core(a.input, a.output, opt, ooc,
                            {a.ascii, a.json, a.quiet, a.double_values, a.faces.value_or(0)});
+  }
 
   const bool show_progress = !a.quiet && !a.json && ::isatty(STDERR_FILENO);
 

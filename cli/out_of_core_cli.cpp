@@ -20,6 +20,12 @@ void add_out_of_core_options(CLI::App* sub, OutOfCoreArgs& args) {
   sub->add_option("--temp-dir", args.temp_dir,
                   "Folder for the out-of-core run's temporary files (default: $TMPDIR, else the output's "
                   "folder); they are removed at the end, on failure and on Ctrl-C");
+  sub->add_option("--phase2-size", args.phase2_size,
+                  "Out of core: the clustered mesh handed to the in-memory pass has at most about this many "
+                  "times the target's faces (fewer when the memory limit says so); larger is slower and "
+                  "closer to an in-memory run; 0 = as many as the memory limit allows")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
 }
 
 bool wants_out_of_core(const std::string& input, const OutOfCoreArgs& args) {
@@ -32,6 +38,22 @@ int run_out_of_core(const std::string& input, const std::string& output, const S
   OutOfCoreOptions ooc;
   if (!args.memory_limit.empty()) ooc.memory_limit = parse_memory_size(args.memory_limit);
   ooc.temp_dir = args.temp_dir;
+  ooc.phase2_faces_per_target = args.phase2_size;
+  if (args.partition == "off")
+    ooc.parts = 1;
+  else if (args.partition != "auto") {
+    std::size_t used = 0;
+    unsigned long parts = 0;
+    try {
+      parts = std::stoul(args.partition, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != args.partition.size() || parts == 0 || parts > 4096)
+      throw Error("--partition must be auto, off or a number of parts from 1 to 4096, not '" +
+                  args.partition + "'");
+    ooc.parts = unsigned(parts);
+  }
   if (ooc.temp_dir.empty() && !std::getenv("TMPDIR")) {
     const auto slash = output.find_last_of('/');
     ooc.temp_dir = slash == std::string::npos ? "." : output.substr(0, slash + 1);
@@ -60,30 +82,35 @@ int run_out_of_core(const std::string& input, const std::string& output, const S
     std::string phases = "[";
     for (const OutOfCorePhase& p : report.phases)
       phases += std::string(phases.size() > 1 ? "," : "") + "{\"name\":" + json_string(p.name) +
-                ",\"seconds\":" + json_number(p.seconds) + "}";
+                ",\"seconds\":" + json_number(p.seconds) + ",\"cpu_seconds\":" + json_number(p.cpu_seconds) +
+                "}";
     phases += "]";
     std::printf(
         "{\"tool\":\"qem\",\"out_of_core\":true,\"in_faces\":%llu,\"target_faces\":%zu,\"out_faces\":%zu,"
-        "\"out_vertices\":%zu,\"clustered_faces\":%llu,\"grid_resolution\":%llu,\"memory_limit_bytes\":%llu,"
-        "\"peak_memory_bytes\":%llu,\"temp_bytes_written\":%llu,\"total_s\":%s,\"peak_rss_mb\":%s,"
+        "\"out_vertices\":%zu,\"clustered_faces\":%llu,\"grid_resolution\":%llu,\"grid_coarsenings\":%u,"
+        "\"memory_limit_bytes\":%llu,"
+        "\"peak_memory_bytes\":%llu,\"temp_bytes_written\":%llu,\"parts\":%u,\"total_s\":%s,\"cpu_s\":%s,"
+        "\"peak_rss_mb\":%s,"
         "\"max_error\":%s,\"max_error_rel\":%s,\"stop\":\"%s\",\"phases\":%s}\n",
         static_cast<unsigned long long>(report.input_faces), out.target_faces, r.mesh.face_count(),
         r.mesh.vertex_count(), static_cast<unsigned long long>(report.clustered_faces),
-        static_cast<unsigned long long>(report.grid_resolution),
+        static_cast<unsigned long long>(report.grid_resolution), report.grid_coarsenings,
         static_cast<unsigned long long>(report.memory_limit),
         static_cast<unsigned long long>(report.peak_memory_bytes),
-        static_cast<unsigned long long>(report.temp_bytes_written), json_number(total.seconds()).c_str(),
+        static_cast<unsigned long long>(report.temp_bytes_written), report.parts,
+        json_number(total.seconds()).c_str(), json_number(process_cpu_seconds()).c_str(),
         json_number(peak_rss_mb()).c_str(), json_number(r.max_error).c_str(),
         json_number(r.max_error_relative).c_str(), to_string(r.stop_reason), phases.c_str());
   }
   if (!out.quiet)
-    std::fprintf(stderr,
-                 "qem: %llu -> %zu faces out of core (clustered to %llu faces on a grid of %llu), %.3f s, "
-                 "peak memory %.0f MB, %.0f MB of temporary files\n",
-                 static_cast<unsigned long long>(report.input_faces), r.mesh.face_count(),
-                 static_cast<unsigned long long>(report.clustered_faces),
-                 static_cast<unsigned long long>(report.grid_resolution), total.seconds(),
-                 double(report.peak_memory_bytes) / 1e6, double(report.temp_bytes_written) / 1e6);
+    std::fprintf(
+        stderr,
+        "qem: %llu -> %zu faces out of core (clustered to %llu faces on a grid of %llu, %u parts), %.3f s, "
+        "peak memory %.0f MB, %.0f MB of temporary files\n",
+        static_cast<unsigned long long>(report.input_faces), r.mesh.face_count(),
+        static_cast<unsigned long long>(report.clustered_faces),
+        static_cast<unsigned long long>(report.grid_resolution), report.parts, total.seconds(),
+        double(report.peak_memory_bytes) / 1e6, double(report.temp_bytes_written) / 1e6);
   return 0;
 }
 

@@ -12,6 +12,8 @@ namespace qem::cli {
 struct OutOfCoreArgs {
   std::string memory_limit;  ///< --memory-limit, e.g. "2G"; empty = automatic
   std::string temp_dir;      ///< --temp-dir; empty = $TMPDIR, else the output's folder
+  double phase2_size = 32;   ///< --phase2-size: phase 2 starts from at most ~this many times the target
+  std::string partition = "auto";  ///< --partition, for phase 2: auto, off or a number of parts
 };
 
 void add_out_of_core_options(CLI::App* sub, OutOfCoreArgs& args);

@@ -93,7 +93,7 @@ TEST(OutOfCore, ForcedRunMeetsTargetWithoutCracksAndNearInCoreError) {
   EXPECT_LT(report.clustered_faces, input.face_count() / 2);
   EXPECT_GT(report.clustered_faces, 4 * opt.target_faces);
   EXPECT_GT(report.temp_bytes_written, 0u);
-  EXPECT_EQ(report.phases.size(), 4u);
+  EXPECT_EQ(report.phases.size(), 3u);  // bounds, clustering, simplifying
   EXPECT_LE(r.mesh.face_count(), opt.target_faces);
   EXPECT_GE(r.mesh.face_count(), opt.target_faces - 2);
   Mesh welded = r.mesh;
@@ -128,20 +128,90 @@ TEST(OutOfCore, DistanceBoundIsRefusedBeforeAnyWork) {
   EXPECT_EQ(entries(dir), 0u);
 }
 
-TEST(OutOfCore, PositionsBeyondTheBudgetAreMappedFromATemporaryFile) {
+TEST(OutOfCore, FloatPositionsAreMappedFromTheInputOthersFromATemporaryFile) {
   const std::string dir = fresh_dir("mapped");
   SimplifyOptions opt;
   opt.target_faces = 3000;
   OutOfCoreOptions ooc;
   ooc.memory_limit = std::uint64_t(4) << 20;  // the 163,842 positions (1.9 MB) exceed a third of it
   ooc.temp_dir = dir;
-  OutOfCoreReport report;
-  SimplifyResult r = simplify_out_of_core(big_sphere(), opt, ooc, &report);
-  EXPECT_GE(report.temp_bytes_written, 163842u * 12 + 12 * report.clustered_faces);
+  // The generator's PLY holds float x, y, z: mapped from the file itself, only the clustered
+  // faces (three 8-byte cell keys each) reach the temporary folder.
+  OutOfCoreReport mapped;
+  SimplifyResult r = simplify_out_of_core(big_sphere(), opt, ooc, &mapped);
+  EXPECT_GT(mapped.temp_bytes_written, 0u);
+  EXPECT_EQ(mapped.temp_bytes_written % 24, 0u);
+  EXPECT_LT(mapped.temp_bytes_written, 163842u * 12);
   EXPECT_LE(r.mesh.face_count(), 3000u);
   Mesh welded = r.mesh;
   weld_exact(welded);
   EXPECT_EQ(test::boundary_edges(welded), 0u);
+  // Double coordinates cannot be mapped as float: copied to a temporary file, then mapped.
+  const std::string doubles = dir + "/sphere_double.ply";
+  SaveOptions save;
+  save.double_precision = true;
+  save_mesh(doubles, load_mesh(big_sphere()), save);
+  OutOfCoreReport copied;
+  r = simplify_out_of_core(doubles, opt, ooc, &copied);
+  EXPECT_GE(copied.temp_bytes_written, 163842u * 12 + mapped.temp_bytes_written);
+  EXPECT_LE(r.mesh.face_count(), 3000u);
+  welded = r.mesh;
+  weld_exact(welded);
+  EXPECT_EQ(test::boundary_edges(welded), 0u);
+  fs::remove(doubles);
+  EXPECT_EQ(entries(dir), 0u);
+}
+
+// The clustering's blocks are added in file order whatever the threads (parallel_clustering.h):
+// the output's bytes do not depend on --threads, and the partitioned phase 2 depends on the parts
+// only.
+TEST(OutOfCore, SameResultOnAnyNumberOfThreads) {
+  const std::string dir = fresh_dir("threads");
+  SimplifyOptions opt;
+  opt.target_faces = 4000;
+  OutOfCoreOptions ooc;
+  ooc.memory_limit = kTinyLimit;
+  ooc.temp_dir = dir;
+  ooc.parts = 2;
+  std::vector<Mesh> results;
+  for (unsigned threads : {1u, 2u, 3u}) {
+    opt.threads = threads;
+    OutOfCoreReport report;
+    results.push_back(simplify_out_of_core(big_sphere(), opt, ooc, &report).mesh);
+    EXPECT_EQ(report.parts, 2u);
+  }
+  for (std::size_t i = 1; i < results.size(); ++i) {
+    EXPECT_EQ(results[i].positions, results[0].positions) << i;
+    EXPECT_EQ(results[i].indices, results[0].indices) << i;
+  }
+  Mesh welded = results[0];
+  weld_exact(welded);
+  EXPECT_EQ(test::validity_problem(welded), "");
+  EXPECT_EQ(test::boundary_edges(welded), 0u);  // the parts' borders met: no crack
+  EXPECT_EQ(entries(dir), 0u);
+}
+
+// Phase 2's input is bounded by a multiple of the target as well as by memory: with plenty of
+// memory, the clustered mesh has at most about phase2_faces_per_target times the target's faces
+// (the grid is coarsened past twice that), and without the bound it is as large as memory allows.
+TEST(OutOfCore, Phase2InputIsAMultipleOfTheTarget) {
+  const std::string dir = fresh_dir("phase2_cap");
+  SimplifyOptions opt;
+  opt.target_faces = 1000;
+  OutOfCoreOptions ooc;
+  ooc.memory_limit = std::uint64_t(1) << 30;
+  ooc.temp_dir = dir;
+  ooc.parts = 1;
+  ooc.phase2_faces_per_target = 8;
+  OutOfCoreReport capped, free;
+  simplify_out_of_core(big_sphere(), opt, ooc, &capped);
+  // Cells: at most twice the aim of 8 x 1000 / 2; faces about twice the cells on a closed surface.
+  EXPECT_LE(capped.clustered_vertices, 8000u);
+  EXPECT_GE(capped.clustered_vertices, 1000u);
+  EXPECT_LE(capped.clustered_faces, 2 * 8000u);
+  ooc.phase2_faces_per_target = 0;
+  simplify_out_of_core(big_sphere(), opt, ooc, &free);
+  EXPECT_GT(free.clustered_faces, 8 * capped.clustered_faces);
   EXPECT_EQ(entries(dir), 0u);
 }
 

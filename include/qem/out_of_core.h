@@ -2,9 +2,11 @@
 // Lindstrom 2000's out-of-core vertex clustering: the input is read as a stream (binary PLY or
 // binary STL, in chunks), every triangle's plane quadric is added to the grid cells of its corners
 // (memory proportional to the occupied cells, not to the input), and the triangles that span three
-// cells are written to a temporary file as cell triples. Phase 2 is the in-core simplification
-// (qem::simplify) of that clustered mesh down to the target. The grid is chosen as fine as the
-// memory budget allows, so that phase 2, which decides quality, starts from as many faces as fit.
+// cells are written to a temporary file as cell triples; the triangles are clustered in blocks on
+// every thread, added in file order. Phase 2 is the in-core simplification (qem::simplify, or
+// part by part with qem/partition.h when large) of that clustered mesh down to the target. The
+// grid is as fine as the memory budget allows, up to a multiple of the target (phase 2's time), so
+// that phase 2, which decides quality, starts from a mesh tens of times larger than the target.
 #pragma once
 
 #include <cstddef>
@@ -19,7 +21,7 @@ namespace qem {
 
 /// What a long out-of-core run is doing, for a progress display.
 struct OutOfCoreProgress {
-  const char* phase = "";  ///< "bounds", "grid", "clustering", "reading clusters", "simplifying"
+  const char* phase = "";  ///< "bounds", "clustering", "simplifying"
   int phase_index = 0;     ///< 1-based, of phase_count
   int phase_count = 0;
   std::uint64_t bytes_read = 0;   ///< of the input, all passes so far
@@ -33,6 +35,14 @@ struct OutOfCoreOptions {
   std::uint64_t memory_limit = 0;
   /// Folder of the temporary files; empty = $TMPDIR, else /tmp.
   std::string temp_dir;
+  /// Phase 2 starts from at most about this many times the target's faces (the clustering's grid
+  /// is sized for it, and coarsened when it gives more than twice as many): phase 2's time grows
+  /// with its input, and beyond some tens of times the target its result hardly improves
+  /// (docs/benchmarks.md, "Out of core"). 0: only the memory budget bounds it.
+  double phase2_faces_per_target = 32;
+  /// Parts of phase 2 (qem/partition.h): 0 = automatic_parts of the clustered faces (when the
+  /// options allow a partitioned run), 1 = one in-core run.
+  unsigned parts = 0;
   /// Called about once a second (and at each phase change); returning false cancels the run
   /// (qem::Error "cancelled"), after which no temporary file is left.
   std::function<bool(const OutOfCoreProgress&)> progress;
@@ -41,17 +51,20 @@ struct OutOfCoreOptions {
 /// One phase of a run and how long it took.
 struct OutOfCorePhase {
   std::string name;
-  double seconds = 0;
+  double seconds = 0;      ///< wall
+  double cpu_seconds = 0;  ///< of the process, all threads (on a loaded machine wall says little)
 };
 
 struct OutOfCoreReport {
   std::uint64_t input_faces = 0, input_vertices = 0;
   std::uint64_t memory_limit = 0;        ///< the budget used (after the default)
   std::uint64_t grid_resolution = 0;     ///< cells along the bounding box's longest side
+  unsigned grid_coarsenings = 0;         ///< times the sampled grid was too fine and was halved
   std::uint64_t clustered_vertices = 0;  ///< occupied cells
   std::uint64_t clustered_faces = 0;     ///< faces handed to phase 2 (after dropping duplicates)
   std::uint64_t temp_bytes_written = 0;
   std::uint64_t peak_memory_bytes = 0;  ///< peak resident set of the process (VmHWM)
+  unsigned parts = 1;                   ///< parts of phase 2
   std::vector<OutOfCorePhase> phases;
 };
 
@@ -70,7 +83,8 @@ bool fits_in_memory(const std::string& path, std::uint64_t memory_limit);
 
 /// Simplifies the mesh file `path` in the two phases, whatever its size, under the options'
 /// budget. `options` are those of qem::simplify and apply to phase 2 (its quadrics are recomputed
-/// from the clustered faces); target_ratio counts the input's faces; vertex_lock is refused. Throws
+/// from the clustered faces); target_ratio counts the input's faces; vertex_lock is refused; the
+/// result does not depend on options.threads. Throws
 /// qem::Error on a malformed input, an unwritable or full temporary folder, or a cancel; temporary files are
 /// removed in every case (and on SIGINT/SIGTERM).
 SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptions& options,

@@ -22,6 +22,30 @@ inline void unpack_cell(CellKey key, std::uint64_t out[3]) {
   out[0] = key >> 42, out[1] = (key >> 21) & 0x1fffff, out[2] = key & 0x1fffff;
 }
 
+/// The cell `levels` times coarser that holds `key`: each coordinate halved per level (a cell of
+/// twice the side is the union of eight, so a key computed on the fine grid and coarsened equals
+/// the key computed on the coarse grid with the same origin).
+inline CellKey coarser_cell(CellKey key, int levels) {
+  if (levels == 0) return key;
+  std::uint64_t c[3];
+  unpack_cell(key, c);
+  return pack_cell(c[0] >> levels, c[1] >> levels, c[2] >> levels);
+}
+
+/// What a cell accumulates (Lindstrom 2000 §3): the quadric of its faces and the sum of their
+/// corners in it, whose mean is where the cell's vertex is sought.
+struct CellSums {
+  core::Quadric quadric;
+  double sum[3] = {0, 0, 0};
+  double corners = 0;
+  CellSums& operator+=(const CellSums& o) {
+    quadric += o.quadric;
+    sum[0] += o.sum[0], sum[1] += o.sum[1], sum[2] += o.sum[2];
+    corners += o.corners;
+    return *this;
+  }
+};
+
 inline std::size_t slot_of(CellKey key, std::size_t mask) {
   return std::size_t((key * 0x9E3779B97F4A7C15ull) >> 20) & mask;
 }
@@ -70,11 +94,7 @@ class CellSet {
 /// its faces' quadrics and of its corners' positions.
 class CellTable {
  public:
-  struct Cell {
-    core::Quadric quadric;
-    double sum[3] = {0, 0, 0};
-    double corners = 0;
-  };
+  using Cell = CellSums;
 
   explicit CellTable(std::size_t expected_cells) : keys_(table_capacity(expected_cells)), ids_(keys_.size()) {
     cells_.reserve(expected_cells);
@@ -100,6 +120,23 @@ class CellTable {
         return ids_[s];
       }
     }
+  }
+  static constexpr std::uint32_t kNoCell = 0xffffffffu;
+  /// The id of the cell `key`, kNoCell when it is not in the table.
+  std::uint32_t find(CellKey key) const {
+    const std::size_t mask = keys_.size() - 1;
+    for (std::size_t s = slot_of(key, mask);; s = (s + 1) & mask) {
+      if (keys_[s] == key) return ids_[s];
+      if (keys_[s] == 0) return kNoCell;
+    }
+  }
+  /// Merges every cell into its parent on the grid of twice the side, renumbering the cells in the
+  /// order of their first child: the result depends only on the table's order, never on timing.
+  void coarsen() {
+    CellTable parents(cells_.size() / 2 + 1);
+    for (std::uint32_t i = 0; i < cells_.size(); ++i)
+      parents.cell(parents.find_or_add(coarser_cell(cell_keys_[i], 1))) += cells_[i];
+    *this = std::move(parents);
   }
   void release() {
     std::vector<CellKey>().swap(keys_);

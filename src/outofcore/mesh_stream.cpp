@@ -309,6 +309,25 @@ std::uint64_t MeshStream::file_size() const { return impl_->size; }
 std::uint64_t MeshStream::bytes_read() const { return impl_->read_total; }
 const std::string& MeshStream::path() const { return impl_->path; }
 
+bool MeshStream::float_vertex_layout(std::uint64_t& offset, std::size_t& row, std::size_t at[3]) const {
+  const Impl& m = *impl_;
+  if (!m.ply || m.swap) return false;
+  offset = m.body;
+  for (int i = 0; i < m.vertex_element; ++i) {
+    const Element& e = m.elements[std::size_t(i)];
+    if (!e.fixed_size()) return false;
+    offset += e.count * e.row_size();
+  }
+  const Element& v = m.elements[std::size_t(m.vertex_element)];
+  row = std::size_t(v.row_size());
+  for (int a = 0; a < 3; ++a) {
+    if (v.props[std::size_t(m.axis[a])].type != Type::F32) return false;
+    at[a] = 0;
+    for (int k = 0; k < m.axis[a]; ++k) at[a] += type_size(v.props[std::size_t(k)].type);
+  }
+  return offset + v.count * row <= m.size;
+}
+
 bool MeshStream::streamable_extension(const std::string& path) {
   if (path.size() < 4) return false;
   std::string ext = path.substr(path.size() - 4);
@@ -330,11 +349,14 @@ void MeshStream::read_vertices(const std::function<void(const double*, std::size
   const std::size_t row = std::size_t(e.row_size());
   std::vector<double> xyz;
   xyz.reserve(3 * kChunkItems);
+  const bool floats = !m.swap && type[0] == Type::F32 && type[1] == Type::F32 && type[2] == Type::F32;
   for (std::uint64_t i = 0; i < e.count; ++i) {
     m.need(e, i, row);
     const unsigned char* p = &m.buf[m.cur];
     for (int a = 0; a < 3; ++a) {
-      const double v = load(p + at[a], type[a], m.swap);
+      float f;
+      if (floats) std::memcpy(&f, p + at[a], 4);  // the common layout, without load()'s switch
+      const double v = floats ? double(f) : load(p + at[a], type[a], m.swap);
       if (!std::isfinite(v)) m.fail_at(e, i, "coordinate is not finite");
       xyz.push_back(v);
     }
@@ -355,7 +377,29 @@ void MeshStream::read_triangles(const std::function<void(const std::uint32_t*, s
   const std::uint64_t nv = vertex_count();
   std::vector<std::uint32_t> tri, poly;
   tri.reserve(3 * kChunkItems + 3 * 256);
+  // The common layout (one list of uchar count and 32-bit indices, little endian): a triangle's
+  // row is read with one copy; any other row (a polygon, other properties) takes the general way.
+  const bool simple = e.props.size() == 1 && e.props[0].count_type == Type::U8 &&
+                      (e.props[0].type == Type::I32 || e.props[0].type == Type::U32) && !m.swap;
   for (std::uint64_t i = 0; i < e.count; ++i) {
+    if (simple && m.ensure(13) && m.buf[m.cur] == 3) {
+      std::uint32_t v[3];
+      std::memcpy(v, &m.buf[m.cur + 1], 12);
+      for (int c = 0; c < 3; ++c)
+        if (v[c] >= nv)  // an int32 below 0 reads as a large uint32
+          m.fail_at(e, i,
+                    "vertex index " +
+                        std::to_string(e.props[0].type == Type::I32 ? std::int64_t(std::int32_t(v[c]))
+                                                                    : std::int64_t(v[c])) +
+                        " out of range (" + std::to_string(nv) + " vertices)");
+      m.cur += 13;
+      tri.insert(tri.end(), {v[0], v[1], v[2]});
+      if (tri.size() >= 3 * kChunkItems) {
+        chunk(tri.data(), tri.size() / 3);
+        tri.clear();
+      }
+      continue;
+    }
     for (std::size_t k = 0; k < e.props.size(); ++k) {
       const Property& p = e.props[k];
       if (int(k) != m.face_list) {

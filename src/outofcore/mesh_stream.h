@@ -40,6 +40,11 @@ class MeshStream {
   /// STL: every triangle, a chunk at a time: `xyz` holds 9 * n coordinates.
   void read_soup(const std::function<void(const double* xyz, std::size_t n)>& chunk);
 
+  /// PLY whose x, y, z are little-endian floats (as qem and most tools write them): where the
+  /// vertex rows start in the file, their size and the byte offset of x, y and z in a row, so that
+  /// the positions can be mapped from the file itself instead of copied. False otherwise.
+  bool float_vertex_layout(std::uint64_t& offset, std::size_t& row, std::size_t at[3]) const;
+
   /// True when `path` names a format read by MeshStream (by extension: .ply, .stl).
   static bool streamable_extension(const std::string& path);
 

@@ -1,9 +1,11 @@
-// Garland & Shaffer 2002's two phases: Lindstrom 2000 out-of-core clustering (this file's
-// cluster_stream), then GH97 in core (qem::simplify) on the clustered mesh.
+// Garland & Shaffer 2002's two phases: Lindstrom 2000 out-of-core clustering
+// (outofcore/parallel_clustering.h, the grid sized here from a sample), then GH97 in core
+// (qem::simplify, or part by part) on the clustered mesh.
 #include "qem/out_of_core.h"
 
 #include <fcntl.h>
 #include <sys/mman.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -18,13 +20,16 @@
 #include <limits>
 #include <memory>
 #include <sstream>
+#include <thread>
 
 #include "cluster/cluster_quadric.h"
 #include "core/quadric.h"
 #include "outofcore/cell_table.h"
 #include "outofcore/mesh_stream.h"
+#include "outofcore/parallel_clustering.h"
 #include "outofcore/temp_file.h"
 #include "qem/error.h"
+#include "qem/partition.h"
 
 namespace qem {
 namespace {
@@ -32,7 +37,10 @@ namespace {
 using outofcore::CellKey;
 using outofcore::CellSet;
 using outofcore::CellTable;
+using outofcore::Grid;
 using outofcore::MeshStream;
+using outofcore::ParallelClustering;
+using outofcore::PositionSource;
 using outofcore::TempFile;
 
 /// Peak memory of the in-core path per input face (load, working mesh, heap, refit), the figure
@@ -54,6 +62,13 @@ std::uint64_t peak_rss_bytes() {
   while (std::getline(in, line))
     if (line.rfind("VmHWM:", 0) == 0) return std::strtoull(line.c_str() + 6, nullptr, 10) * 1024;
   return 0;
+}
+
+double process_cpu_seconds() {
+  rusage u{};
+  ::getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
 std::string default_temp_dir() {
@@ -119,20 +134,33 @@ class Phase2Observer : public SimplifyObserver {
   Progress& progress_;
 };
 
-/// The input's positions as float (12 bytes a vertex), in memory when they fit the budget, else
-/// in a temporary file mapped read-only, whose pages the kernel can drop and read again.
+/// The input's positions, for the clustering pass's random access. Mapped from the input itself
+/// when its vertex rows hold float x, y, z (nothing copied); otherwise kept as float (12 bytes a
+/// vertex) in memory when they take at most a third of the budget, else in a temporary file mapped
+/// read-only. Mapped pages belong to the kernel's page cache: drop_pages() takes them out of the
+/// process (they stay cached and come back on the next touch), so that the resident set keeps to
+/// the budget however large the input.
 class PositionStore {
  public:
+  /// The `count` rows of `row` bytes at `offset` in `path`, x, y, z as float at `at`.
+  PositionStore(const std::string& path, std::uint64_t offset, std::size_t row, const std::size_t at[3],
+                std::uint64_t count)
+      : count_(count) {
+    source_.row = row;
+    std::copy(at, at + 3, source_.at);
+    map(path, offset, count * row);
+  }
+  /// Positions appended as read, in memory or in a temporary file in `temp_dir`.
   PositionStore(std::uint64_t vertices, bool in_memory, const std::string& temp_dir) : count_(vertices) {
     if (in_memory) {
       memory_.reserve(3 * vertices);
     } else {
       file_ = std::make_unique<TempFile>(temp_dir, "positions");
     }
+    copied_ = true;
   }
-  ~PositionStore() {
-    if (map_) ::munmap(map_, map_bytes_);
-  }
+  ~PositionStore() { unmap(); }
+  bool copied() const { return copied_; }
   void append(const double* xyz, std::size_t n) {
     for (std::size_t i = 0; i < 3 * n; ++i) {
       const float f = static_cast<float>(xyz[i]);
@@ -142,96 +170,72 @@ class PositionStore {
         memory_.push_back(f);
     }
   }
-  /// After the last append: the positions, 3 floats a vertex.
-  const float* finish() {
-    if (!file_) return memory_.data();
-    file_->flush();
-    map_bytes_ = std::size_t(count_) * 12;
-    if (map_bytes_ == 0) return nullptr;
-    int fd = ::open(file_->path().c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) throw Error(file_->path() + ": cannot reopen: " + std::strerror(errno));
-    map_ = ::mmap(nullptr, map_bytes_, PROT_READ, MAP_SHARED, fd, 0);
-    ::close(fd);
-    if (map_ == MAP_FAILED) {
-      map_ = nullptr;
-      throw Error(file_->path() + ": cannot map: " + std::strerror(errno));
+  /// After the last append: where the positions are.
+  const PositionSource& finish() {
+    if (file_) {
+      file_->flush();
+      map(file_->path(), 0, count_ * 12);
+    } else if (copied_) {
+      source_.base = reinterpret_cast<const unsigned char*>(memory_.data());
     }
-    return static_cast<const float*>(map_);
+    return source_;
+  }
+  bool mapped() const { return map_ != nullptr; }
+  void drop_pages() {
+    if (map_) ::madvise(map_, map_bytes_, MADV_DONTNEED);
   }
   void release() {
-    if (map_) ::munmap(map_, map_bytes_);
-    map_ = nullptr;
+    unmap();
     std::vector<float>().swap(memory_);
     file_.reset();
   }
 
  private:
+  void map(const std::string& path, std::uint64_t offset, std::uint64_t bytes) {
+    if (bytes == 0) return;
+    const std::uint64_t page = std::uint64_t(::sysconf(_SC_PAGESIZE));
+    const std::uint64_t start = offset / page * page;
+    map_bytes_ = std::size_t(offset - start + bytes);
+    int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) throw Error(path + ": cannot reopen: " + std::strerror(errno));
+    map_ = ::mmap(nullptr, map_bytes_, PROT_READ, MAP_SHARED, fd, off_t(start));
+    ::close(fd);
+    if (map_ == MAP_FAILED) {
+      map_ = nullptr;
+      throw Error(path + ": cannot map: " + std::strerror(errno));
+    }
+    source_.base = static_cast<const unsigned char*>(map_) + (offset - start);
+  }
+  void unmap() {
+    if (map_) ::munmap(map_, map_bytes_);
+    map_ = nullptr;
+  }
+
   std::uint64_t count_;
+  bool copied_ = false;
+  PositionSource source_;
   std::vector<float> memory_;
   std::unique_ptr<TempFile> file_;
   void* map_ = nullptr;
   std::size_t map_bytes_ = 0;
 };
 
-/// The grid: cubic cells of side `size` from the box's low corner.
-struct Grid {
-  double lo[3] = {0, 0, 0};
-  double size = 1;
-  CellKey key(double x, double y, double z) const {
-    const double c[3] = {x, y, z};
-    std::uint64_t k[3];
-    for (int a = 0; a < 3; ++a) {
-      double t = std::floor((c[a] - lo[a]) / size);
-      k[a] = std::uint64_t(std::clamp(t, 0.0, double((1u << 21) - 1)));
-    }
-    return outofcore::pack_cell(k[0], k[1], k[2]);
-  }
-};
+/// Resident pages of the process that are mapped from files (its code, the mapped positions), from
+/// /proc/self/statm: those drop_pages() gives back.
+std::uint64_t resident_file_bytes() {
+  std::ifstream in("/proc/self/statm");
+  std::uint64_t size = 0, resident = 0, shared = 0;
+  in >> size >> resident >> shared;
+  return shared * std::uint64_t(::sysconf(_SC_PAGESIZE));
+}
 
-/// Picks the finest grid whose occupied cells stay within `max_cells` (Lindstrom 2000 sizes the
-/// grid by hand; here it follows the budget). Four families of grids, their cell sizes a quarter
-/// octave apart, each coarsened by halves while its cells exceed the budget (cells of twice the
-/// side are unions of eight, so the count stays exact): one pass over the positions, and the
-/// chosen grid is within 2^(1/4) of the finest that fits.
-class GridChooser {
- public:
-  GridChooser(const double lo[3], double start_size, std::uint64_t max_cells) : max_cells_(max_cells) {
-    std::copy(lo, lo + 3, grid_.lo);
-    for (int f = 0; f < 4; ++f)
-      families_.push_back({CellSet(max_cells), start_size * std::pow(2.0, f / 4.0)});
-  }
-  void add(double x, double y, double z) {
-    for (Family& fam : families_) {
-      grid_.size = fam.size;
-      fam.set.insert(grid_.key(x, y, z));
-      while (fam.set.size() > max_cells_) fam.set.coarsen(), fam.size *= 2;
-    }
-  }
-  Grid best() const {
-    Grid g = grid_;
-    g.size = std::numeric_limits<double>::infinity();
-    for (const Family& fam : families_) g.size = std::min(g.size, fam.size);
-    return g;
-  }
-
- private:
-  struct Family {
-    CellSet set;
-    double size;
-  };
-  std::uint64_t max_cells_;
-  Grid grid_;
-  std::vector<Family> families_;
-};
-
-/// Where GridChooser starts: every coarsening rebuilds a table of the budget's size, so starting
-/// at the finest grid costs a dozen rebuilds a family. A sample of the points counts the occupied
-/// cells at coarse grids, where each cell holds many samples and the count is close to the
-/// input's; a surface's count grows with the square of the resolution, which extrapolates it to
-/// the budget. Starting 2x finer than that leaves room for a surface that is rougher than the
-/// sample shows; a grid too fine only costs rebuilds.
+/// The cell size the clustering starts from. A sample of the points counts the occupied cells at
+/// coarse grids, where each cell holds many samples and the count is close to the input's; a
+/// surface's count grows with the square of the resolution, which extrapolates it to `goal_cells`.
+/// A surface rougher than the sample shows gives more cells: the clustering then coarsens its grid
+/// (ParallelClustering), so an estimate too fine costs a coarsening, never memory.
 double starting_cell_size(const std::vector<float>& sample, const double lo[3], double extent,
-                          std::uint64_t max_cells) {
+                          std::uint64_t goal_cells) {
   const std::size_t n = sample.size() / 3;
   double resolution = 1, cells = 1;
   for (double r = 2; r <= kFinestResolution; r *= 2) {
@@ -242,8 +246,8 @@ double starting_cell_size(const std::vector<float>& sample, const double lo[3], 
     if (double(set.size()) > double(n) / 16) break;  // too few samples a cell to count them all
     resolution = r, cells = double(set.size());
   }
-  const double estimate = resolution * std::sqrt(double(max_cells) / cells);
-  return extent / std::min(kFinestResolution, 2 * estimate);
+  const double estimate = resolution * std::sqrt(double(goal_cells) / cells);
+  return extent / std::min(kFinestResolution, estimate);
 }
 
 /// Clustering maps the closed input surface onto a surface that is closed in the mod-2 sense:
@@ -254,25 +258,26 @@ double starting_cell_size(const std::vector<float>& sample, const double lo[3], 
 /// keeps every edge's count even: no boundary edge the input did not have.
 void drop_paired_faces(std::vector<std::uint32_t>& indices) {
   const std::size_t nf = indices.size() / 3;
-  auto sorted_key = [&](std::size_t f) {
-    std::array<std::uint32_t, 3> t{indices[3 * f], indices[3 * f + 1], indices[3 * f + 2]};
-    std::sort(t.begin(), t.end());
-    return t;
-  };
-  std::vector<std::uint32_t> order(nf);
-  for (std::size_t f = 0; f < nf; ++f) order[f] = std::uint32_t(f);
-  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-    const auto ka = sorted_key(a), kb = sorted_key(b);
-    return ka != kb ? ka < kb : a < b;
-  });
+  // Each face as its sorted corners and its place in the file: sorting these groups the copies of
+  // a face, the first in file order leading each group.
+  std::vector<std::array<std::uint32_t, 4>> order(nf);
+  for (std::size_t f = 0; f < nf; ++f) {
+    std::array<std::uint32_t, 4>& t = order[f];
+    t = {indices[3 * f], indices[3 * f + 1], indices[3 * f + 2], std::uint32_t(f)};
+    std::sort(t.begin(), t.begin() + 3);
+  }
+  std::sort(order.begin(), order.end());
   std::vector<bool> keep(nf, false);
+  auto same_face = [&](std::size_t i, std::size_t j) {
+    return order[i][0] == order[j][0] && order[i][1] == order[j][1] && order[i][2] == order[j][2];
+  };
   for (std::size_t i = 0; i < nf;) {
     std::size_t j = i + 1;
-    const auto k = sorted_key(order[i]);
-    while (j < nf && sorted_key(order[j]) == k) ++j;
-    if ((j - i) % 2 == 1) keep[order[i]] = true;  // the first in file order
+    while (j < nf && same_face(i, j)) ++j;
+    if ((j - i) % 2 == 1) keep[order[i][3]] = true;  // the first in file order
     i = j;
   }
+  std::vector<std::array<std::uint32_t, 4>>().swap(order);
   std::size_t out = 0;
   for (std::size_t f = 0; f < nf; ++f)
     if (keep[f]) {
@@ -363,25 +368,46 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
     options.target_faces = options.target_faces ? std::min(options.target_faces, by_ratio) : by_ratio;
     options.target_ratio = 0;
   }
-  Progress progress(ooc, 4);
-  // The passes over the file: PLY once (vertices, then faces), STL three times (bounds, grid, clusters).
-  progress.set_total(soup ? 3 * in.file_size() : in.file_size());
-  auto lap = [&, t = 0.0](const char* name) mutable {
-    const double now = progress.seconds();
-    report.phases.push_back({name, now - t});
-    t = now;
+  Progress progress(ooc, 3);
+  // The passes over the file: PLY once (vertices, then faces), STL twice (bounds, clusters).
+  progress.set_total(soup ? 2 * in.file_size() : in.file_size());
+  auto lap = [&, t = 0.0, cpu = process_cpu_seconds()](const char* name) mutable {
+    const double now = progress.seconds(), cpu_now = process_cpu_seconds();
+    report.phases.push_back({name, now - t, cpu_now - cpu});
+    t = now, cpu = cpu_now;
   };
 
   // The budget: 90 % of the limit (the rest for the program itself and the read buffers).
   const double budget = 0.9 * double(report.memory_limit);
   const std::uint64_t nv = in.vertex_count();
-  const bool positions_in_memory = !soup && 12.0 * double(nv) <= budget / 3;
+  std::uint64_t layout_offset = 0;
+  std::size_t layout_row = 0, layout_at[3] = {0, 0, 0};
+  const bool map_input = !soup && in.float_vertex_layout(layout_offset, layout_row, layout_at);
+  const bool positions_in_memory = !soup && !map_input && 12.0 * double(nv) <= budget / 3;
 
   const double phase1_room = budget - (positions_in_memory ? 12.0 * double(nv) : 0.0);
   std::uint64_t max_cells = std::uint64_t(
       std::max(0.0, std::min(phase1_room / kClusterBytesPerCell, budget / kPhase2BytesPerCell)));
+  // Phase 2's time: the clustered mesh need not be larger than a multiple of the target (about
+  // two faces a cell on a closed surface).
+  const double target =
+      options.target_faces ? double(options.target_faces) : 2.0 * double(options.target_vertices);
+  const std::uint64_t goal_by_time = target > 0 && ooc.phase2_faces_per_target > 0
+                                         ? std::uint64_t(ooc.phase2_faces_per_target * target / 2)
+                                         : std::numeric_limits<std::uint64_t>::max();
   // Never fewer cells than the target's vertices, or phase 2 would have nothing to choose from.
-  max_cells = std::max<std::uint64_t>({max_cells, options.target_faces, options.target_vertices * 2, 1024});
+  const std::uint64_t floor_cells =
+      std::max<std::uint64_t>({options.target_faces, options.target_vertices * 2, 1024});
+  max_cells = std::max(max_cells, floor_cells);
+  // The grid aims at the goal; the clustering coarsens it when the cells pass twice the goal (the
+  // time bound is soft) or the budget's (a hard bound).
+  // When the budget binds, the grid aims at 75 % of it: an estimate a little short then still fits,
+  // where a coarsening would leave a quarter of the cells (the sample's estimate came within
+  // 0.87-1.2x of the cells on the spheres and tori of docs/benchmarks.md).
+  const std::uint64_t hard_cells =
+      goal_by_time < max_cells / 2 ? std::max(2 * goal_by_time, floor_cells) : max_cells;
+  const std::uint64_t goal_cells = std::max(
+      goal_by_time < max_cells / 2 ? goal_by_time : std::uint64_t(0.75 * double(max_cells)), floor_cells);
 
   // --- pass 1: bounds (and, for a PLY, the positions) ---------------------------------------------
   progress.phase("bounds", 1);
@@ -394,142 +420,132 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
   const std::uint64_t sample_step =
       std::max<std::uint64_t>(1, points / std::min<std::uint64_t>(1000000, max_cells));
   std::vector<float> sample;
-  std::uint64_t seen = 0;
+  std::uint64_t until_sample = 0;
   auto grow = [&](const double* xyz, std::size_t n) {
-    for (std::size_t i = 0; i < n; ++i, ++seen) {
+    for (std::size_t i = 0; i < n; ++i) {
       for (int a = 0; a < 3; ++a) {
         // As float, the precision the positions are kept in (and every cell is computed from).
         const double v = static_cast<float>(xyz[3 * i + a]);
         lo[a] = std::min(lo[a], v), hi[a] = std::max(hi[a], v);
       }
-      if (seen % sample_step == 0)
+      if (until_sample-- == 0) {
         sample.insert(sample.end(), {float(xyz[3 * i]), float(xyz[3 * i + 1]), float(xyz[3 * i + 2])});
+        until_sample = sample_step - 1;
+      }
     }
     progress.read(in.bytes_read());
   };
   std::unique_ptr<PositionStore> store;
-  const float* positions = nullptr;
   if (soup) {
     in.read_soup([&](const double* xyz, std::size_t n) { grow(xyz, 3 * n); });
   } else {
-    store = std::make_unique<PositionStore>(nv, positions_in_memory, temp_dir);
+    store = map_input ? std::make_unique<PositionStore>(path, layout_offset, layout_row, layout_at, nv)
+                      : std::make_unique<PositionStore>(nv, positions_in_memory, temp_dir);
     in.read_vertices([&](const double* xyz, std::size_t n) {
-      store->append(xyz, n);
+      if (store->copied()) store->append(xyz, n);
       grow(xyz, n);
     });
-    positions = store->finish();
   }
+  const PositionSource positions = store ? store->finish() : PositionSource{};
   if (report.input_faces == 0 || !(lo[0] <= hi[0])) throw Error(path + ": no faces to simplify");
   const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-30});
   lap("bounds");
 
-  // --- the grid: as fine as the budget allows -----------------------------------------------------
-  progress.phase("grid", 2);
-  GridChooser chooser(lo, starting_cell_size(sample, lo, extent, max_cells), max_cells);
+  // --- phase 1: Lindstrom 2000 clustering, the grid sized by a sample ------------------------------
+  progress.phase("clustering", 2);
+  Grid fine;
+  std::copy(lo, lo + 3, fine.lo);
+  fine.size = starting_cell_size(sample, lo, extent, goal_cells);
   std::vector<float>().swap(sample);
-  if (soup) {
-    // The positions are not kept: the grid's pass reads the file again.
-    in.read_soup([&](const double* xyz, std::size_t n) {
-      for (std::size_t i = 0; i < 3 * n; ++i)
-        chooser.add(float(xyz[3 * i]), float(xyz[3 * i + 1]), float(xyz[3 * i + 2]));
-      progress.read(in.bytes_read());
-    });
-  } else {
-    for (std::uint64_t v = 0; v < nv; ++v)
-      chooser.add(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]);
-  }
-  const Grid grid = chooser.best();
-  report.grid_resolution = std::uint64_t(std::ceil(extent / grid.size));
-  lap("grid");
-
-  // --- phase 1: Lindstrom 2000 clustering ----------------------------------------------------------
-  // Every triangle's plane quadric, weighted by its area (HG99, as the in-core default), is added
-  // to the cell of each of its corners; the triangles whose corners fall in three different cells
-  // survive as cell triples, written to a temporary file.
-  progress.phase("clustering", 3);
-  CellTable cells(max_cells);
   TempFile faces(temp_dir, "faces");
-  std::uint64_t clustered = 0;
-  auto add_triangle = [&](const double p[9]) {
-    std::uint32_t id[3];
-    for (int k = 0; k < 3; ++k) id[k] = cells.find_or_add(grid.key(p[3 * k], p[3 * k + 1], p[3 * k + 2]));
-    // Local coordinates (from the box corner) keep the quadric's constant term small.
-    const Vec3 a{p[0] - lo[0], p[1] - lo[1], p[2] - lo[2]};
-    const Vec3 b{p[3] - lo[0], p[4] - lo[1], p[5] - lo[2]};
-    const Vec3 c{p[6] - lo[0], p[7] - lo[1], p[8] - lo[2]};
-    const Vec3 nrm = cross(b - a, c - a);
-    const double len = length(nrm);
-    if (len > 0) {
-      const Vec3 u = nrm / len;
-      const core::Quadric q = core::Quadric::plane(u, -dot(u, a), len / 2);
-      for (int k = 0; k < 3; ++k) cells.cell(id[k]).quadric += q;
-    }
-    const Vec3* corner[3] = {&a, &b, &c};
-    for (int k = 0; k < 3; ++k) {
-      auto& cell = cells.cell(id[k]);
-      cell.sum[0] += corner[k]->x, cell.sum[1] += corner[k]->y, cell.sum[2] += corner[k]->z;
-      cell.corners += 1;
-    }
-    if (id[0] != id[1] && id[1] != id[2] && id[0] != id[2]) {
-      faces.write(id, sizeof id);
-      ++clustered;
-    }
+  const unsigned threads =
+      options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  ParallelClustering clustering(fine, hard_cells, threads, faces);
+  // Mapped positions: their pages are given back whenever they pass a quarter of the budget.
+  const std::uint64_t mapped_allowance =
+      std::max<std::uint64_t>(std::uint64_t(budget / 4), std::uint64_t(32) << 20);
+  clustering.after_block = [&, blocks = 0]() mutable {
+    if (store && store->mapped() && ++blocks % 16 == 0 && resident_file_bytes() > mapped_allowance)
+      store->drop_pages();
+    progress.read(in.bytes_read());
   };
   if (soup) {
     in.read_soup([&](const double* xyz, std::size_t n) {
-      double p[9];
-      for (std::size_t t = 0; t < n; ++t) {
-        for (int k = 0; k < 9; ++k) p[k] = static_cast<float>(xyz[9 * t + k]);
-        add_triangle(p);
-      }
+      clustering.add_soup(xyz, n);
       progress.read(in.bytes_read());
     });
   } else {
     in.read_triangles([&](const std::uint32_t* tri, std::size_t n) {
-      double p[9];
-      for (std::size_t t = 0; t < n; ++t) {
-        for (int k = 0; k < 3; ++k)
-          for (int a = 0; a < 3; ++a) p[3 * k + a] = positions[3 * std::size_t(tri[3 * t + k]) + a];
-        add_triangle(p);
-      }
+      clustering.add_indexed(tri, n, positions);
       progress.read(in.bytes_read());
     });
   }
+  clustering.finish();
+  report.grid_coarsenings = unsigned(clustering.levels());
   if (store) store->release();
+  CellTable& cells = clustering.cells();
   report.clustered_vertices = cells.size();
+  const double cell_size = fine.size * std::ldexp(1.0, clustering.levels());
+  report.grid_resolution = std::uint64_t(std::ceil(extent / cell_size));
 
   // Each cell's representative: the minimum of its quadric around the corners' mean, kept inside
   // the cell (Lindstrom & Silva 2001 §4: a point outside would fold neighbouring cells' faces).
+  // Each cell on its own, so the threads share them in ranges without changing a bit.
   Mesh clustered_mesh;
-  clustered_mesh.positions.resize(3 * cells.size());
-  for (std::uint32_t i = 0; i < cells.size(); ++i) {
-    const auto& cell = cells.cell(i);
-    const double mean[3] = {cell.sum[0] / cell.corners, cell.sum[1] / cell.corners,
-                            cell.sum[2] / cell.corners};
-    double x[3];
-    cluster_detail::minimize_around(cell.quadric, mean, x);
-    std::uint64_t k[3];
-    outofcore::unpack_cell(cells.key(i), k);
-    for (int a = 0; a < 3; ++a) {
-      const double c0 = double(k[a]) * grid.size, c1 = c0 + grid.size;
-      clustered_mesh.positions[3 * i + a] = lo[a] + std::clamp(x[a], c0, c1);
+  clustered_mesh.positions.resize(3 * std::size_t(cells.size()));
+  auto place_cells = [&](std::uint32_t begin, std::uint32_t end) {
+    for (std::uint32_t i = begin; i < end; ++i) {
+      const auto& cell = cells.cell(i);
+      const double mean[3] = {cell.sum[0] / cell.corners, cell.sum[1] / cell.corners,
+                              cell.sum[2] / cell.corners};
+      double x[3];
+      cluster_detail::minimize_around(cell.quadric, mean, x);
+      std::uint64_t k[3];
+      outofcore::unpack_cell(cells.key(i), k);
+      for (int a = 0; a < 3; ++a) {
+        const double c0 = double(k[a]) * cell_size, c1 = c0 + cell_size;
+        clustered_mesh.positions[3 * i + a] = lo[a] + std::clamp(x[a], c0, c1);
+      }
     }
+  };
+  {
+    std::vector<std::thread> helpers;
+    const std::uint32_t n = cells.size(), per = n / threads + 1;
+    for (unsigned t = 1; t < threads && t * per < n; ++t)
+      helpers.emplace_back(place_cells, t * per, std::min<std::uint32_t>(n, (t + 1) * per));
+    place_cells(0, std::min(n, per));
+    for (std::thread& h : helpers) h.join();
   }
+  clustered_mesh.indices = outofcore::read_clustered_faces(clustering, faces);
   cells.release();
-  lap("clustering");
-
-  // --- phase 2: GH97 in core on the clustered mesh ------------------------------------------------
-  progress.phase("simplifying", 4);
-  progress.start_phase2();
-  faces.rewind_for_reading();
-  clustered_mesh.indices.resize(3 * clustered);
-  if (faces.read(clustered_mesh.indices.data(), 12 * clustered) != 12 * clustered)
-    throw Error(faces.path() + ": the temporary file is shorter than written");
   drop_paired_faces(clustered_mesh.indices);
   report.clustered_faces = clustered_mesh.face_count();
   report.temp_bytes_written = outofcore::temp_bytes_written() - temp_bytes_before;
-  Phase2Observer observer(progress);
-  SimplifyResult r = simplify(std::move(clustered_mesh), options, &observer);
+  lap("clustering");
+
+  // --- phase 2: GH97 in core on the clustered mesh, part by part when it is large -------------------
+  progress.phase("simplifying", 3);
+  progress.start_phase2();
+  const unsigned parts = ooc.parts ? ooc.parts
+                         : partition_refusal(clustered_mesh, options).empty()
+                             ? automatic_parts(clustered_mesh.face_count())
+                             : 1;
+  SimplifyResult r;
+  if (parts > 1) {
+    PartitionOptions po;
+    po.parts = parts;
+    po.progress = [&](unsigned done, unsigned all) {
+      progress.fraction(0.9 * double(done) / double(all));
+      return true;
+    };
+    PartitionReport pr;
+    r = simplify_partitioned(clustered_mesh, options, po, &pr);
+    report.parts = pr.parts;
+  } else {
+    Phase2Observer observer(progress);
+    r = simplify(std::move(clustered_mesh), options, &observer);
+    report.parts = 1;
+  }
   lap("simplifying");
   report.peak_memory_bytes = peak_rss_bytes();
   if (report_out) *report_out = std::move(report);

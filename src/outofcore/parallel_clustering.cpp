@@ -1,0 +1,301 @@
+#include "outofcore/parallel_clustering.h"
+
+#include <algorithm>
+#include <cmath>
+#include <condition_variable>
+#include <deque>
+#include <exception>
+#include <mutex>
+#include <thread>
+
+#include "geometry/vec3.h"
+#include "qem/error.h"
+
+namespace qem::outofcore {
+
+namespace {
+
+/// One block's cells, numbered in the order its triangles meet them: open addressing over flat
+/// arrays, emptied between blocks by clearing only the slots used.
+class BlockCells {
+ public:
+  std::vector<CellKey> keys;
+  std::vector<CellSums> sums;
+
+  std::uint32_t find_or_add(CellKey key) {
+    if (2 * (keys.size() + 1) > slots_.size()) grow();
+    const std::size_t mask = slots_.size() - 1;
+    for (std::size_t s = slot_of(key, mask);; s = (s + 1) & mask) {
+      if (slots_[s].key == key) return slots_[s].id;
+      if (slots_[s].key == 0) {
+        slots_[s] = {key, std::uint32_t(keys.size())};
+        keys.push_back(key);
+        sums.emplace_back();
+        return slots_[s].id;
+      }
+    }
+  }
+  void clear() {
+    const std::size_t mask = slots_.size() - 1;
+    for (CellKey k : keys)
+      for (std::size_t s = slot_of(k, mask);; s = (s + 1) & mask)
+        if (slots_[s].key == k) {
+          slots_[s].key = 0;
+          break;
+        }
+    // Open addressing: a cleared slot may sit inside another key's probe run, but every key of the
+    // block is cleared, so the table ends empty.
+    keys.clear();
+    sums.clear();
+  }
+
+ private:
+  struct Slot {
+    CellKey key = 0;
+    std::uint32_t id = 0;
+  };
+  void grow() {
+    std::vector<Slot> slots(std::max<std::size_t>(4096, 2 * slots_.size()));
+    const std::size_t mask = slots.size() - 1;
+    for (const Slot& old : slots_)
+      if (old.key) {
+        std::size_t t = slot_of(old.key, mask);
+        while (slots[t].key) t = (t + 1) & mask;
+        slots[t] = old;
+      }
+    slots_.swap(slots);
+  }
+  std::vector<Slot> slots_;
+};
+
+}  // namespace
+
+struct ParallelClustering::Block {
+  std::uint64_t index = 0;
+  std::vector<std::uint32_t> corners;  // indexed input
+  std::vector<float> xyz;              // soup input
+  BlockCells cells;
+  std::vector<std::uint32_t> triples;  // block-local cell ids
+  const PositionSource* positions = nullptr;
+  bool done = false;
+
+  std::size_t triangles() const { return corners.empty() ? xyz.size() / 9 : corners.size() / 3; }
+
+  /// Lindstrom 2000 §3 for this block's triangles: each triangle's plane quadric, weighted by its
+  /// area (HG99, as the in-core default), is added to the cell of each corner, with the corner;
+  /// the triangles whose corners fall in three cells are kept as triples.
+  void cluster(const Grid& grid) {
+    cells.clear();
+    triples.clear();
+    const std::size_t n = triangles();
+    double p[9];
+    for (std::size_t t = 0; t < n; ++t) {
+      if (!corners.empty()) {
+        for (int k = 0; k < 3; ++k) positions->get(corners[3 * t + k], p + 3 * k);
+      } else {
+        for (int k = 0; k < 9; ++k) p[k] = xyz[9 * t + k];
+      }
+      std::uint32_t id[3];
+      CellKey key[3];
+      for (int k = 0; k < 3; ++k) {
+        key[k] = grid.key(p[3 * k], p[3 * k + 1], p[3 * k + 2]);
+        // Neighbouring corners mostly share a cell: no lookup for a repeat.
+        id[k] = k > 0 && key[k] == key[k - 1] ? id[k - 1]
+                : k > 1 && key[k] == key[0]   ? id[0]
+                                              : cells.find_or_add(key[k]);
+      }
+      // Local coordinates (from the box corner) keep the quadric's constant term small.
+      const Vec3 a{p[0] - grid.lo[0], p[1] - grid.lo[1], p[2] - grid.lo[2]};
+      const Vec3 b{p[3] - grid.lo[0], p[4] - grid.lo[1], p[5] - grid.lo[2]};
+      const Vec3 c{p[6] - grid.lo[0], p[7] - grid.lo[1], p[8] - grid.lo[2]};
+      const Vec3 nrm = cross(b - a, c - a);
+      const double len = length(nrm);
+      const Vec3* corner[3] = {&a, &b, &c};
+      const core::Quadric q =
+          len > 0 ? core::Quadric::plane(nrm / len, -dot(nrm / len, a), len / 2) : core::Quadric{};
+      for (int k = 0; k < 3; ++k) {
+        CellSums& cell = cells.sums[id[k]];
+        if (len > 0) cell.quadric += q;
+        cell.sum[0] += corner[k]->x, cell.sum[1] += corner[k]->y, cell.sum[2] += corner[k]->z;
+        cell.corners += 1;
+      }
+      if (id[0] != id[1] && id[1] != id[2] && id[0] != id[2])
+        triples.insert(triples.end(), {id[0], id[1], id[2]});
+    }
+  }
+};
+
+struct ParallelClustering::Workers {
+  std::mutex mutex;
+  std::condition_variable work, finished;
+  std::deque<Block*> queue;
+  std::vector<std::unique_ptr<Block>> in_flight;  // in block order
+  std::vector<std::thread> threads;
+  std::exception_ptr failure;
+  bool stop = false;
+
+  void run(const Grid& grid) {
+    std::unique_lock lock(mutex);
+    for (;;) {
+      work.wait(lock, [&] { return stop || !queue.empty(); });
+      if (stop) return;
+      Block* b = queue.front();
+      queue.pop_front();
+      lock.unlock();
+      try {
+        b->cluster(grid);
+      } catch (...) {
+        lock.lock();
+        if (!failure) failure = std::current_exception();
+        b->done = true;
+        finished.notify_all();
+        continue;
+      }
+      lock.lock();
+      b->done = true;
+      finished.notify_all();
+    }
+  }
+};
+
+ParallelClustering::ParallelClustering(const Grid& fine, std::uint64_t max_cells, unsigned threads,
+                                       TempFile& faces)
+    : fine_(fine),
+      max_cells_(std::max<std::uint64_t>(max_cells, 1)),
+      faces_(faces),
+      cells_(std::size_t(max_cells_)) {
+  if (threads > 1) {
+    workers_ = std::make_unique<Workers>();
+    for (unsigned t = 0; t < threads; ++t) workers_->threads.emplace_back([this] { workers_->run(fine_); });
+  }
+}
+
+ParallelClustering::~ParallelClustering() {
+  if (!workers_) return;
+  {
+    std::lock_guard lock(workers_->mutex);
+    workers_->stop = true;
+  }
+  workers_->work.notify_all();
+  for (std::thread& t : workers_->threads) t.join();
+}
+
+void ParallelClustering::start_block() {
+  if (!spare_.empty()) {
+    filling_ = std::move(spare_.back());
+    spare_.pop_back();
+  } else {
+    filling_ = std::make_unique<Block>();
+  }
+  filling_->corners.clear(), filling_->xyz.clear();
+  filling_->positions = nullptr;
+}
+
+void ParallelClustering::add_indexed(const std::uint32_t* corners, std::size_t n,
+                                     const PositionSource& positions) {
+  while (n > 0) {
+    if (!filling_) start_block();
+    filling_->positions = &positions;
+    const std::size_t take = std::min(n, kBlockTriangles - filling_->triangles());
+    filling_->corners.insert(filling_->corners.end(), corners, corners + 3 * take);
+    corners += 3 * take, n -= take;
+    if (filling_->triangles() == kBlockTriangles) submit();
+  }
+}
+
+void ParallelClustering::add_soup(const double* xyz, std::size_t n) {
+  while (n > 0) {
+    if (!filling_) start_block();
+    const std::size_t take = std::min(n, kBlockTriangles - filling_->triangles());
+    for (std::size_t i = 0; i < 9 * take; ++i) filling_->xyz.push_back(static_cast<float>(xyz[i]));
+    xyz += 9 * take, n -= take;
+    if (filling_->triangles() == kBlockTriangles) submit();
+  }
+}
+
+void ParallelClustering::submit() {
+  std::unique_ptr<Block> b = std::move(filling_);
+  b->index = submitted_++;
+  b->done = false;
+  if (!workers_) {
+    b->cluster(fine_);
+    add_block(*b);
+    spare_.push_back(std::move(b));
+    return;
+  }
+  {
+    std::lock_guard lock(workers_->mutex);
+    workers_->queue.push_back(b.get());
+    workers_->in_flight.push_back(std::move(b));
+  }
+  workers_->work.notify_one();
+  // Bounded memory: at most a few blocks waiting or being clustered per thread.
+  for (;;) {
+    merge_ready(false);
+    if (workers_->in_flight.size() < 2 * workers_->threads.size() + 2) break;
+    std::unique_lock lock(workers_->mutex);
+    workers_->finished.wait(lock, [&] { return workers_->in_flight.front()->done; });
+  }
+}
+
+void ParallelClustering::merge_ready(bool wait_all) {
+  for (;;) {
+    std::unique_ptr<Block> b;
+    {
+      std::unique_lock lock(workers_->mutex);
+      if (workers_->in_flight.empty()) return;
+      if (wait_all) workers_->finished.wait(lock, [&] { return workers_->in_flight.front()->done; });
+      if (!workers_->in_flight.front()->done) return;
+      if (workers_->failure) std::rethrow_exception(workers_->failure);
+      b = std::move(workers_->in_flight.front());
+      workers_->in_flight.erase(workers_->in_flight.begin());
+    }
+    add_block(*b);
+    spare_.push_back(std::move(b));
+  }
+}
+
+void ParallelClustering::add_block(Block& block) {
+  for (std::size_t i = 0; i < block.cells.keys.size(); ++i)
+    cells_.cell(cells_.find_or_add(coarser_cell(block.cells.keys[i], levels_))) += block.cells.sums[i];
+  for (std::size_t t = 0; t < block.triples.size(); ++t) faces_.put(block.cells.keys[block.triples[t]]);
+  triples_ += block.triples.size() / 3;
+  while (cells_.size() > max_cells_) {
+    cells_.coarsen();
+    ++levels_;
+  }
+  ++merged_;
+  if (after_block) after_block();
+}
+
+void ParallelClustering::finish() {
+  if (filling_ && filling_->triangles() > 0) submit();
+  if (workers_) merge_ready(true);
+}
+
+std::vector<std::uint32_t> read_clustered_faces(ParallelClustering& clustering, TempFile& faces) {
+  faces.rewind_for_reading();
+  const CellTable& cells = clustering.cells();
+  const int levels = clustering.levels();
+  std::vector<std::uint32_t> indices;
+  std::vector<CellKey> buf(3 << 16);
+  std::uint64_t left = clustering.triples();
+  while (left > 0) {
+    const std::size_t n = std::size_t(std::min<std::uint64_t>(left, buf.size() / 3));
+    if (faces.read(buf.data(), 24 * n) != 24 * n)
+      throw Error(faces.path() + ": the temporary file is shorter than written");
+    for (std::size_t t = 0; t < n; ++t) {
+      std::uint32_t id[3];
+      for (int k = 0; k < 3; ++k) {
+        id[k] = cells.find(coarser_cell(buf[3 * t + k], levels));
+        if (id[k] == CellTable::kNoCell) throw Error(faces.path() + ": a face names a cell never met");
+      }
+      if (id[0] != id[1] && id[1] != id[2] && id[0] != id[2])
+        indices.insert(indices.end(), {id[0], id[1], id[2]});
+    }
+    left -= n;
+  }
+  return indices;
+}
+
+}  // namespace qem::outofcore
