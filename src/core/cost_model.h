@@ -2,6 +2,7 @@
 // placed by the chosen policy, cost Q(position), honouring --lock-border and --inversion penalize.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <utility>
@@ -41,13 +42,25 @@ inline bool place_pair(const Context& c, std::uint32_t p, Quadric& q, Placed& pl
   const std::uint32_t a = c.pairs.pairs[p].v[0], b = c.pairs.pairs[p].v[1];
   const WorkingMesh& m = c.mesh;
   q = c.quadric[a] + c.quadric[b];
-  if (c.wedges) return place_with_wedges(c, a, b, q, placed);
-  switch (border_target(c, a, b)) {
+  const BorderTarget border = border_target(c, a, b);
+  if (c.wedges) {
+    if (!place_with_wedges(c, a, b, q, placed)) return false;
+    if (border == BorderTarget::AtEither) placed.error = std::max(placed.error, hole_error(m, a, b, q.weight));
+    return true;
+  }
+  switch (border) {
     case BorderTarget::Free: break;
     case BorderTarget::Never: return false;
-    case BorderTarget::AtA: placed = {m.pos[a], q.evaluate(m.pos[a])}; return true;
-    case BorderTarget::AtB: placed = {m.pos[b], q.evaluate(m.pos[b])}; return true;
-    case BorderTarget::AtEither: place_along_border(c, a, b, q, placed); return true;
+    case BorderTarget::AtA:  // b may be a soft corner that leaves (corner_error)
+      placed = {m.pos[a], std::max(q.evaluate(m.pos[a]), corner_error(c, a, b, m.pos[a], q.weight))};
+      return true;
+    case BorderTarget::AtB:
+      placed = {m.pos[b], std::max(q.evaluate(m.pos[b]), corner_error(c, a, b, m.pos[b], q.weight))};
+      return true;
+    case BorderTarget::AtEither:
+      place_along_border(c, a, b, q, placed);
+      placed.error = std::max(placed.error, hole_error(m, a, b, q.weight));  // a hole down to three vertices
+      return true;
   }
   const bool held_a = m.held(a, c.settings.lock_border), held_b = m.held(b, c.settings.lock_border);
   if (held_a || held_b) {
