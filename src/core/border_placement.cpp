@@ -159,28 +159,49 @@ double squared_distance_to_segment(const Vec3& p, const Vec3& s, const Vec3& e) 
 
 }  // namespace
 
+namespace {
+
+// A soft corner's size at the current state: its distance from the line between the nearest
+// corners (soft or hard, or held vertices) on either side along the current border, walking at
+// most kCornerWalk border edges each way. Scan noise is a corner between corners close by (a
+// small size); a square's corner sits between the square's other corners (a size of the square).
+// As the corners around one go, its size grows: it is the corner at the scale of the error.
+constexpr int kCornerWalk = 64;
+
+double corner_size(const Context& c, std::uint32_t v) {
+  const WorkingMesh& m = c.mesh;
+  const auto stops = [&](std::uint32_t x) { return m.corner[x] != 0 || m.held(x, c.settings.lock_border); };
+  std::uint32_t end[2] = {kNoVertex, kNoVertex};
+  double farthest = 0;  // a loop without another corner: the farthest vertex on it
+  std::uint32_t first = kNoVertex;
+  for (int side = 0; side < 2; ++side) {
+    std::uint32_t prev = v, cur = other_border_neighbour(m, v, side == 0 ? kNoVertex : first);
+    if (side == 0) first = cur;
+    for (int steps = 0; cur != kNoVertex && cur != v; ++steps) {
+      farthest = std::max(farthest, std::sqrt(dot(m.pos[cur] - m.pos[v], m.pos[cur] - m.pos[v])));
+      if (stops(cur) || steps == kCornerWalk) break;
+      const std::uint32_t next = other_border_neighbour(m, cur, prev);
+      prev = cur, cur = next;
+    }
+    if (cur == v) return farthest;
+    end[side] = cur;
+  }
+  if (end[0] == kNoVertex || end[1] == kNoVertex) return farthest;
+  return std::sqrt(squared_distance_to_segment(m.pos[v], m.pos[end[0]], m.pos[end[1]]));
+}
+
+}  // namespace
+
 double corner_error(const Context& c, std::uint32_t a, std::uint32_t b, const Vec3& x, double weight) {
   const WorkingMesh& m = c.mesh;
   if (m.corner.empty()) return 0;
   const auto same = [](const Vec3& p, const Vec3& q) { return p.x == q.x && p.y == q.y && p.z == q.z; };
-  double d2 = 0;
-  bool found = false, looked = false;
-  std::uint32_t na = kNoVertex, nb = kNoVertex;
+  double size = 0;
   for (int end = 0; end < 2; ++end) {
     const std::uint32_t e = end == 0 ? a : b;
-    if (m.corner[e] != kSoftCorner || same(x, m.pos[e])) continue;
-    if (!looked) {  // the border after the contraction: na - x - nb
-      na = other_border_neighbour(m, a, b), nb = other_border_neighbour(m, b, a);
-      looked = true;
-    }
-    double here = std::numeric_limits<double>::infinity();
-    if (na != kNoVertex) here = std::min(here, squared_distance_to_segment(m.pos[e], m.pos[na], x));
-    if (nb != kNoVertex) here = std::min(here, squared_distance_to_segment(m.pos[e], x, m.pos[nb]));
-    if (!std::isfinite(here)) here = dot(m.pos[e] - x, m.pos[e] - x);
-    d2 = std::max(d2, here);
-    found = true;
+    if (m.corner[e] == kSoftCorner && !same(x, m.pos[e])) size = std::max(size, corner_size(c, e));
   }
-  return found ? (weight > 0 ? weight : 1) * d2 : 0;
+  return (weight > 0 ? weight : 1) * size * size;
 }
 
 std::uint32_t hole_closed_by(const WorkingMesh& m, std::uint32_t a, std::uint32_t b) {
