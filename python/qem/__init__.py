@@ -348,9 +348,11 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
       placement: "optimal", "segment", "midpoint", "endpoints".
       boundary_weight: weight of the planes that hold open borders in place (0 = none).
       lock_border: border vertices never move.
-      exact_border: border vertices stay on the input's border lines (at input vertices or sliding
-        along input border edges; corners fixed), as --exact-borders; False (the default) = GH97's
-        penalty planes alone (boundary_weight).
+      exact_border: True (the default): border vertices stay on the input's border lines (at input
+        vertices or sliding along input border edges); border ends and junctions fixed, corners
+        (turns above 45 degrees) kept until the error reaches their size, holes down to three
+        vertices closed once the error reaches their size (README, Boundaries). False = GH97's
+        penalty planes alone (boundary_weight), as --penalty-borders.
       inversion: "forbid", "penalize" or "off": contractions that turn a face by more than max_turn degrees.
       allow_non_manifold: skip the link condition (edge collapses may make non-manifold edges).
       scheme: "passes" (fast) or "greedy" (GH97's heap: strictly cheapest first).

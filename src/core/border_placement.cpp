@@ -9,6 +9,16 @@
 
 namespace qem::core {
 
+namespace {
+double squared_distance_to_segment(const Vec3& p, const Vec3& s, const Vec3& e) {
+  const Vec3 d = e - s, w = p - s;
+  const double len2 = dot(d, d);
+  const double t = len2 > 0 ? std::clamp(dot(w, d) / len2, 0.0, 1.0) : 0.0;
+  const Vec3 r = w - d * t;
+  return dot(r, r);
+}
+}  // namespace
+
 void mark_border_corners(WorkingMesh& m, const std::vector<Edge>& edges) {
   const std::size_t n = m.vertex_count();
   m.corner.assign(n, 0);
@@ -52,6 +62,33 @@ void mark_border_corners(WorkingMesh& m, const std::vector<Edge>& edges) {
   for (std::uint32_t v = 0; v < n; ++v)
     for (int k = 0; k < 2 && slot[v] != kNoSlot; ++k)
       if (other[2 * std::size_t(v) + k] != kNoVertex) ch.neighbour[2 * std::size_t(slot[v]) + k] = slot[other[2 * std::size_t(v) + k]];
+  // Each soft corner's size: its distance from the line between the nearest corners (or held
+  // vertices) on either side along the input border, at most kCornerWalk edges away; on a loop
+  // with no other corner, its distance to the farthest slot. Scan noise is a corner between
+  // corners close by (a small size); a square's corner sits between the square's other corners.
+  ch.corner_size.assign(ch.pos.size(), 0);
+  for (std::uint32_t v = 0; v < n; ++v) {
+    if (slot[v] == kNoSlot || m.corner[v] != kSoftCorner) continue;
+    const std::uint32_t s0 = slot[v];
+    std::uint32_t end[2] = {kNoSlot, kNoSlot};
+    double farthest = 0;
+    bool around = false;
+    for (int side = 0; side < 2 && !around; ++side) {
+      std::uint32_t prev = s0, cur = ch.neighbour[2 * std::size_t(s0) + side];
+      for (std::size_t steps = 0; cur != kNoSlot && cur != s0; ++steps) {
+        farthest = std::max(farthest, std::sqrt(dot(ch.pos[cur] - ch.pos[s0], ch.pos[cur] - ch.pos[s0])));
+        end[side] = cur;
+        if (ch.corner[cur] || steps == kCornerWalk) break;
+        const std::uint32_t* nb = &ch.neighbour[2 * std::size_t(cur)];
+        const std::uint32_t next = nb[0] == prev ? nb[1] : nb[0];
+        prev = cur, cur = next;
+      }
+      around = cur == s0;
+    }
+    ch.corner_size[s0] = around || end[0] == kNoSlot || end[1] == kNoSlot
+                             ? farthest
+                             : std::sqrt(squared_distance_to_segment(ch.pos[s0], ch.pos[end[0]], ch.pos[end[1]]));
+  }
   // Each simple closed loop's size (its slots all on two border edges, none a hard corner).
   const std::size_t slots = ch.pos.size();
   ch.loop_radius.assign(slots, std::numeric_limits<double>::infinity());
@@ -149,57 +186,18 @@ std::uint32_t other_border_neighbour(const WorkingMesh& m, std::uint32_t v, std:
   return kNoVertex;
 }
 
-double squared_distance_to_segment(const Vec3& p, const Vec3& s, const Vec3& e) {
-  const Vec3 d = e - s, w = p - s;
-  const double len2 = dot(d, d);
-  const double t = len2 > 0 ? std::clamp(dot(w, d) / len2, 0.0, 1.0) : 0.0;
-  const Vec3 r = w - d * t;
-  return dot(r, r);
-}
-
 }  // namespace
 
-namespace {
-
-// A soft corner's size at the current state: its distance from the line between the nearest
-// corners (soft or hard, or held vertices) on either side along the current border, walking at
-// most kCornerWalk border edges each way. Scan noise is a corner between corners close by (a
-// small size); a square's corner sits between the square's other corners (a size of the square).
-// As the corners around one go, its size grows: it is the corner at the scale of the error.
-constexpr int kCornerWalk = 64;
-
-double corner_size(const Context& c, std::uint32_t v) {
-  const WorkingMesh& m = c.mesh;
-  const auto stops = [&](std::uint32_t x) { return m.corner[x] != 0 || m.held(x, c.settings.lock_border); };
-  std::uint32_t end[2] = {kNoVertex, kNoVertex};
-  double farthest = 0;  // a loop without another corner: the farthest vertex on it
-  std::uint32_t first = kNoVertex;
-  for (int side = 0; side < 2; ++side) {
-    std::uint32_t prev = v, cur = other_border_neighbour(m, v, side == 0 ? kNoVertex : first);
-    if (side == 0) first = cur;
-    for (int steps = 0; cur != kNoVertex && cur != v; ++steps) {
-      farthest = std::max(farthest, std::sqrt(dot(m.pos[cur] - m.pos[v], m.pos[cur] - m.pos[v])));
-      if (stops(cur) || steps == kCornerWalk) break;
-      const std::uint32_t next = other_border_neighbour(m, cur, prev);
-      prev = cur, cur = next;
-    }
-    if (cur == v) return farthest;
-    end[side] = cur;
-  }
-  if (end[0] == kNoVertex || end[1] == kNoVertex) return farthest;
-  return std::sqrt(squared_distance_to_segment(m.pos[v], m.pos[end[0]], m.pos[end[1]]));
-}
-
-}  // namespace
-
-double corner_error(const Context& c, std::uint32_t a, std::uint32_t b, const Vec3& x, double weight) {
-  const WorkingMesh& m = c.mesh;
+double corner_error(const Context& c_, std::uint32_t a, std::uint32_t b, const Vec3& x, double weight) {
+  const WorkingMesh& m = c_.mesh;
   if (m.corner.empty()) return 0;
   const auto same = [](const Vec3& p, const Vec3& q) { return p.x == q.x && p.y == q.y && p.z == q.z; };
   double size = 0;
   for (int end = 0; end < 2; ++end) {
     const std::uint32_t e = end == 0 ? a : b;
-    if (m.corner[e] == kSoftCorner && !same(x, m.pos[e])) size = std::max(size, corner_size(c, e));
+    // A soft corner never moved, so it is at its own slot.
+    if (m.corner[e] == kSoftCorner && !same(x, m.pos[e]) && m.border_spot[e].from != kNoSlot)
+      size = std::max(size, m.chains.corner_size[m.border_spot[e].from]);
   }
   return (weight > 0 ? weight : 1) * size * size;
 }

@@ -41,6 +41,10 @@ namespace qem::core {
 /// (docs/benchmarks.md, "Borders").
 inline constexpr double kCornerDegrees = 45;
 
+/// A soft corner's size is measured between the nearest corners at most this many input border
+/// edges away on either side (mark_border_corners).
+inline constexpr std::size_t kCornerWalk = 64;
+
 /// A border vertex slides at most this many input border edges per contraction (the stretch
 /// between the two ends is walked edge by edge); a longer stretch is placed at either end.
 inline constexpr std::size_t kMaxBorderWalk = 4096;
@@ -98,8 +102,9 @@ inline BorderTarget border_target(const Context& c, std::uint32_t a, std::uint32
 }
 
 /// Corners at the scale of the error: the contraction of border edge (a, b) to x removes a soft
-/// corner at a or b unless x is that corner's place. Its error is then at least the corner's
-/// distance d from the border that replaces it (the new border through x), as a quadric error
+/// corner at a or b unless x is that corner's place. Its error is then at least the corner's size
+/// d (BorderChains::corner_size: its distance from the line between the nearest input corners on
+/// either side, a property of the input, so no pair's cost goes stale), as a quadric error
 /// over `weight` (weight * d^2: sqrt(Q / weight) is the error in distance units, cost_model.h),
 /// so the run removes a corner only once its error has grown to the corner's size: scan noise
 /// (jagged holes) goes early, a square's corners stay unless the target asks for more than their

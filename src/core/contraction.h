@@ -225,6 +225,16 @@ bool try_contract(Context& c, Lists& lists, std::uint32_t p, Worker& w) {
     ps.block(p);
     return false;
   }
+  // Exact borders: a border pair's cost depends on more than its two ends. Its placement is the
+  // cheapest point that flips no face, so a neighbour's contraction can push it to a dearer one
+  // (one that removes a corner, corner_error), and a hole comes down to three vertices by a
+  // contraction elsewhere on its loop (hole_error). Neither re-costs this pair, so when its cost
+  // now exceeds the ranked one it is ranked again instead of being made out of order.
+  if (c.settings.exact_border && (c.mesh.boundary[a] || c.mesh.boundary[b]) &&
+      round_key(placed.error) > double(ps.cost[p])) {
+    lists.pair_changed(p);
+    return false;
+  }
   if (c.settings.inversion == InversionPolicy::Forbid && flips(c.mesh, a, b, placed.position, c.settings.cos_max_turn)) {
     ++w.blocked_inversion;
     ps.block(p);
