@@ -35,7 +35,7 @@ inline double normalized_error(double q_error, double weight) {
 bool place_with_wedges(const Context& c, std::uint32_t a, std::uint32_t b, const Quadric& q, Placed& placed);
 
 /// The quadric and placement of pair p. False if the pair can never move (both ends on a locked
-/// border, two corners or two stretches of border under exact borders, or, with attributes, a
+/// border, two hard corners or two stretches of border under exact borders, or, with attributes, a
 /// collapse that would move or close a seam); with one end on a locked border, that end is the
 /// placement; under exact borders, border_target decides (border_placement.h).
 inline bool place_pair(const Context& c, std::uint32_t p, Quadric& q, Placed& placed) {
