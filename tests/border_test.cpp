@@ -6,6 +6,7 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <set>
 #include <string>
@@ -288,6 +289,26 @@ TEST(Borders, ScanWithJaggedHolesReachesACoarseTarget) {
   }
   for (std::uint32_t v : border_vertices(r.mesh))
     EXPECT_LE(distance_to_edges(vertex(r.mesh, v), in_border), 1e-12 * std::sqrt(diag2)) << "vertex " << v;
+}
+
+// The command line: exact borders by default and with --exact-borders; --penalty-borders, or
+// --boundary-weight given alone, asks for GH97's penalty; the two border flags together are refused.
+TEST(Borders, CommandLineChoosesExactOrPenalty) {
+  const std::string dir = test::temp_dir() + "/border_cli";
+  std::filesystem::create_directories(dir);
+  const std::string in = dir + "/in.obj";
+  save_mesh(in, test::height_field(20, bumps));
+  const auto out = [&](const std::string& name, const std::string& flags) {
+    EXPECT_EQ(test::run_qem_quietly("simplify " + in + " " + dir + "/" + name + ".obj --faces 40 " + flags), 0) << flags;
+    return test::slurp(dir + "/" + name + ".obj");
+  };
+  const std::string exact = out("default", ""), penalty = out("penalty", "--penalty-borders");
+  EXPECT_FALSE(exact.empty());
+  EXPECT_NE(exact, penalty);
+  EXPECT_EQ(out("exact", "--exact-borders"), exact);
+  EXPECT_EQ(out("weight", "--boundary-weight 1"), penalty);
+  EXPECT_EQ(out("both", "--exact-borders --boundary-weight 1"), exact);
+  EXPECT_NE(test::run_qem_quietly("simplify " + in + " " + dir + "/x.obj --faces 40 --exact-borders --penalty-borders"), 0);
 }
 
 /// A closed unit cube whose sides are n x n grids, and a small sphere (radius 0.05) floating

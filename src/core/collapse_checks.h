@@ -73,6 +73,13 @@ inline bool link_condition_ok(const WorkingMesh& m, std::uint32_t a, std::uint32
       if (marks[x] == s_nbr && x != closes) return false;
       if (marks[x] == s_opp) ++opp_corners;
     }
+    // Closing a hole: b's face (b, closes, x) becomes (a, closes, x); a must not have that face
+    // already (a hole whose three faces meet at one apex would fold onto itself).
+    if (closes != kNoVertex && m.face_has(f, closes)) {
+      const std::uint32_t x = t[0] != b && t[0] != closes ? t[0] : t[1] != b && t[1] != closes ? t[1] : t[2];
+      for (std::uint32_t g : m.vertex_faces[a])
+        if (m.face_alive[g] && m.face_has(g, closes) && m.face_has(g, x)) return false;
+    }
     // A face (b, x, y) with x, y both opposite corners: if a also has a face (a, x, y), the
     // collapse would stack two faces on the same vertices (the tetrahedron case).
     if (opp_corners == 2) {
