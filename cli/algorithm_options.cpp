@@ -34,15 +34,19 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
   sub->add_option("--threads", a.threads, "Threads for the passes: re-costing pairs, and making contractions region by region (0 = all; same result)")
       ->capture_default_str();
   sub->add_option("--boundary-weight", a.boundary_weight,
-                  "Weight of GH97 6's boundary constraint planes, times the squared edge length (0 = off): "
-                  "a penalty that holds open borders near their place (with --exact-borders they only rank "
-                  "the contractions)")
+                  "Weight of GH97 6's boundary constraint planes, times the squared edge length (0 = off). "
+                  "Given alone it asks for GH97's penalty borders (as --penalty-borders, with this weight); "
+                  "with --exact-borders the planes only rank the contractions")
+      ->each([&a](const std::string&) { a.boundary_weight_given = true; })
       ->capture_default_str();
   sub->add_flag("--exact-borders", a.exact_borders,
-                "Border vertices stay on the input's border polylines (they may slide along them) and border "
-                "corners (turns above 45 degrees) are kept exactly, bit for bit; for tiles and CAD patches "
-                "that must still meet. Not the default: small jagged holes (scans) then stop a coarse run "
-                "early at a higher error (docs/benchmarks.md, Borders)");
+                "The default: border vertices stay on the input's border polylines (they may slide along "
+                "them); border ends and junctions are kept exactly, and corners (turns above 45 degrees) "
+                "too until the run's error reaches their distance from the border that would replace "
+                "them, so tiles and CAD patches still meet (docs/benchmarks.md, Borders)");
+  sub->add_flag("--penalty-borders", a.penalty_borders,
+                "GH97 6's penalty instead of exact borders: the boundary planes (--boundary-weight) pull "
+                "the placement and border vertices may leave the border by a little");
   sub->add_flag("--lock-border", a.lock_border, "Boundary vertices never move (nor are removed)");
   sub->add_option("--attribute-weight", a.attribute_weights,
                   "Weight of an attribute's error against distance, as KIND=W (normal, uv, color, scalar; "
@@ -139,7 +143,9 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
   opt.boundary_weight = a.boundary_weight;
   opt.max_normal_turn_degrees = a.max_turn;
   opt.lock_border = a.lock_border;
-  opt.exact_border = a.exact_borders;
+  if (a.exact_borders && a.penalty_borders) throw Error("give --exact-borders or --penalty-borders, not both");
+  // --boundary-weight alone is a request for GH97's penalty (the weight of a penalty).
+  opt.exact_border = a.exact_borders || !(a.penalty_borders || a.boundary_weight_given);
   opt.preserve_topology = !a.allow_non_manifold;
   opt.keep_components = !a.allow_vanishing;
   if (a.prune > 0 && a.prune_rel > 0) throw Error("give --prune or --prune-rel, not both");

@@ -23,7 +23,9 @@ struct AlgorithmArgs {
   double boundary_weight = SimplifyOptions{}.boundary_weight;
   double max_turn = SimplifyOptions{}.max_normal_turn_degrees;
   bool lock_border = false, allow_non_manifold = false;
-  bool exact_borders = false;  // --exact-borders: border vertices stay on the input's border lines
+  bool exact_borders = false;    // --exact-borders: accepted, the default
+  bool boundary_weight_given = false;  // --boundary-weight asks for the penalty unless --exact-borders
+  bool penalty_borders = false;  // --penalty-borders: GH97 §6's penalty, border vertices may leave the border
   bool allow_vanishing = false;         // --allow-vanishing: components may contract to nothing
   double prune = 0, prune_rel = 0;      // --prune D, --prune-rel F
   bool weld = false, no_weld = false;

@@ -6,6 +6,7 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <set>
 #include <string>
@@ -40,10 +41,9 @@ double bumps(double x, double y) {
   return 4 * x * (1 - x) * y * (1 - y) * (0.05 + 0.03 * std::sin(9 * x) * std::cos(7 * y));
 }
 
-// Exact borders (not the default: SimplifyOptions::exact_border) with the given refit.
+// The default options (exact borders: SimplifyOptions::exact_border) with the given refit.
 SimplifyOptions defaults_with_refit(unsigned rounds, double points_per_vertex) {
-  SimplifyOptions o;
-  o.exact_border = true;
+  SimplifyOptions o;  // exact borders are the default
   o.refit_rounds = rounds;
   o.refit_points_per_vertex = points_per_vertex;
   return o;
@@ -204,6 +204,111 @@ TEST(Borders, SlidBorderVertexLiesOnAnInputBorderEdge) {
     EXPECT_LE(distance_to_edges(p, in_border), 2e-12) << "vertex " << v;
   }
   EXPECT_GT(slid, 0u);
+}
+
+/// The bumpy square (20 x 20 cells) with two square holes: a small one (cell 4, 4) and a large one
+/// (cells 10-14 in both directions).
+Mesh square_with_holes() {
+  const int n = 20;
+  const Mesh grid = test::height_field(n, bumps);
+  Mesh in;
+  in.positions = grid.positions;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      if ((i == 4 && j == 4) || (i >= 10 && i < 15 && j >= 10 && j < 15)) continue;
+      const std::size_t f = 2 * std::size_t(j * n + i);
+      in.indices.insert(in.indices.end(), grid.indices.begin() + 3 * f, grid.indices.begin() + 3 * (f + 2));
+    }
+  return in;
+}
+
+/// How many border loops m has (each vertex on two border edges, as in square_with_holes' output).
+std::size_t border_loops(const Mesh& m) {
+  std::map<std::uint32_t, std::vector<std::uint32_t>> next;
+  for (const auto& [edge, n] : test::edge_face_counts(m))
+    if (n == 1) next[edge.first].push_back(edge.second), next[edge.second].push_back(edge.first);
+  std::set<std::uint32_t> seen;
+  std::size_t loops = 0;
+  for (const auto& [start, unused] : next) {
+    if (seen.count(start)) continue;
+    ++loops;
+    std::vector<std::uint32_t> stack{start};
+    while (!stack.empty()) {
+      const std::uint32_t v = stack.back();
+      stack.pop_back();
+      if (!seen.insert(v).second) continue;
+      for (std::uint32_t w : next[v]) stack.push_back(w);
+    }
+  }
+  return loops;
+}
+
+// Small holes close at the scale of the error (border_placement.h, hole_closed_by): with the error
+// bounded by 0.1, the hole of half-diagonal 0.035 closes, the one of 0.18 stays with its four
+// corners bit for bit (their size, 0.18, is above the bound too), and so do the square's.
+TEST(Borders, SmallHoleClosesBelowTheErrorLargeOneStaysExact) {
+  const Mesh in = square_with_holes();
+  ASSERT_EQ(border_loops(in), 3u);
+  SimplifyOptions o;
+  o.target_faces = 0;  // as far as the checks allow
+  o.max_error = 0.1;
+  const SimplifyResult r = simplify(in, o);
+  EXPECT_EQ(border_loops(r.mesh), 2u);
+  std::set<Point> out;
+  for (std::size_t v = 0; v < r.mesh.vertex_count(); ++v) out.insert(vertex(r.mesh, v));
+  for (double x : {0.0, 1.0})
+    for (double y : {0.0, 1.0}) EXPECT_EQ(out.count(Point{x, y, 0.0}), 1u) << x << ", " << y;
+  for (int i : {10, 15})
+    for (int j : {10, 15}) EXPECT_EQ(out.count(vertex(in, std::size_t(j * 21 + i))), 1u) << i << ", " << j;
+  const std::vector<std::pair<Point, Point>> in_border = border_edges(in);
+  for (std::uint32_t v : border_vertices(r.mesh))
+    EXPECT_LE(distance_to_edges(vertex(r.mesh, v), in_border), 2e-12) << "vertex " << v;
+  // Below the hole's size the hole stays: an error bound of 0.02 keeps all three loops.
+  o.max_error = 0.02;
+  EXPECT_EQ(border_loops(simplify(in, o).mesh), 3u);
+}
+
+// The Stanford bunny (5 jagged scan holes) to 100 faces with the default exact borders: before the
+// corners went at the scale of the error it stopped at 126 faces (issue 21). Every output border
+// vertex lies on an input border edge.
+TEST(Borders, ScanWithJaggedHolesReachesACoarseTarget) {
+  const std::string path = test::shared_data("gh_bunny_zipper.ply");
+  if (path.empty()) GTEST_SKIP() << "../shared/data not found";
+  const Mesh in = load_mesh(path);
+  SimplifyOptions o;
+  o.target_faces = 100;
+  const SimplifyResult r = simplify(in, o);
+  EXPECT_LE(r.mesh.face_count(), 100u);
+  EXPECT_GE(r.mesh.face_count(), 98u);
+  const std::vector<std::pair<Point, Point>> in_border = border_edges(in);
+  double diag2 = 0;
+  for (int k = 0; k < 3; ++k) {
+    double lo = HUGE_VAL, hi = -HUGE_VAL;
+    for (std::size_t v = 0; v < in.vertex_count(); ++v) lo = std::min(lo, in.positions[3 * v + k]), hi = std::max(hi, in.positions[3 * v + k]);
+    diag2 += (hi - lo) * (hi - lo);
+  }
+  for (std::uint32_t v : border_vertices(r.mesh))
+    EXPECT_LE(distance_to_edges(vertex(r.mesh, v), in_border), 1e-12 * std::sqrt(diag2)) << "vertex " << v;
+}
+
+// The command line: exact borders by default and with --exact-borders; --penalty-borders, or
+// --boundary-weight given alone, asks for GH97's penalty; the two border flags together are refused.
+TEST(Borders, CommandLineChoosesExactOrPenalty) {
+  const std::string dir = test::temp_dir() + "/border_cli";
+  std::filesystem::create_directories(dir);
+  const std::string in = dir + "/in.obj";
+  save_mesh(in, test::height_field(20, bumps));
+  const auto out = [&](const std::string& name, const std::string& flags) {
+    EXPECT_EQ(test::run_qem_quietly("simplify " + in + " " + dir + "/" + name + ".obj --faces 40 " + flags), 0) << flags;
+    return test::slurp(dir + "/" + name + ".obj");
+  };
+  const std::string exact = out("default", ""), penalty = out("penalty", "--penalty-borders");
+  EXPECT_FALSE(exact.empty());
+  EXPECT_NE(exact, penalty);
+  EXPECT_EQ(out("exact", "--exact-borders"), exact);
+  EXPECT_EQ(out("weight", "--boundary-weight 1"), penalty);
+  EXPECT_EQ(out("both", "--exact-borders --boundary-weight 1"), exact);
+  EXPECT_NE(test::run_qem_quietly("simplify " + in + " " + dir + "/x.obj --faces 40 --exact-borders --penalty-borders"), 0);
 }
 
 /// A closed unit cube whose sides are n x n grids, and a small sphere (radius 0.05) floating

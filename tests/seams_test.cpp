@@ -260,6 +260,10 @@ TEST(Seams, AChartWhoseFacesAllDiedIsNoSeam) {
   ASSERT_EQ(islands.vertex_count(), plain.vertex_count() + 4 * 4) << "four islands of four wedges";
   SimplifyOptions o;
   o.as_far_as_possible = true;
+  // GH97's penalty borders: with exact borders (the default) the grid's rim corners go only at
+  // their size, and a collapse with wedges is placed at its survivor, so the two runs stop at
+  // different counts for a reason that is not the seams (12 faces against 1).
+  o.exact_border = false;
   for (Scheme scheme : {Scheme::Passes, Scheme::Greedy}) {
     SCOPED_TRACE(to_string(scheme));
     o.scheme = scheme;

@@ -151,7 +151,7 @@ TEST_P(Simplify, BoundaryPlanesKeepTheBorderOnTheSquare) {
     return drift;
   };
   SimplifyOptions o = faces(150);
-  o.exact_border = false;  // GH97's penalty (the default; exact borders are tested in border_test.cpp)
+  o.exact_border = false;  // GH97's penalty (exact borders, the default, are tested in border_test.cpp)
   SimplifyResult kept = simplify(in, o);  // default boundary weight
   o.boundary_weight = 0;
   SimplifyResult eroded = simplify(in, o);

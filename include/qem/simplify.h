@@ -130,16 +130,15 @@ struct SimplifyOptions {
   /// rank the contractions only; without, they are GH97's penalty and also pull the placement.
   double boundary_weight = 1;
   bool lock_border = false;  ///< boundary vertices never move
-  /// Open borders stay exact: a border vertex never leaves the input's border polylines (it stays,
-  /// or slides along its own polyline to the lowest-error point between the two ends of a border
-  /// edge); border corners (a turn above 45 degrees, border ends and junctions, non-manifold
-  /// edges) are never removed nor moved and keep bit-identical coordinates, and the refit does not
-  /// move border vertices. false: GH97 §6's penalty alone (boundary_weight), the vertices may
-  /// leave the border. Off by default for now: on scans with small jagged holes (the Stanford
-  /// bunny at 100 faces) the fixed corners and outlines stop the run early at many times the
-  /// penalty's error (docs/benchmarks.md, "Borders"); until holes that are small against the error
-  /// may shrink, exactness is asked for (`qem simplify --exact-borders`).
-  bool exact_border = false;
+  /// Open borders stay exact (the default): a border vertex never leaves the input's border
+  /// polylines (it stays, or slides along its own polyline to the lowest-error point between the
+  /// two ends of a border edge), and the refit does not move border vertices. Hard corners
+  /// (border ends and junctions, non-manifold edges, locked vertices) are never removed nor moved;
+  /// soft corners (a turn above 45 degrees) stay, bit for bit, until the run's error reaches their
+  /// distance from the border that would replace them (a scan's jagged hole loses its noise, a
+  /// square keeps its corners). false: GH97 §6's penalty alone (boundary_weight), the vertices
+  /// may leave the border (`qem simplify --penalty-borders`).
+  bool exact_border = true;
   /// Keep every connected component (vertex-connected, counted on the welded working mesh): a
   /// contraction that would leave a component with fewer than its floor of faces (a closed one 4,
   /// an open one 1, or as many as it has if fewer) is refused. Components that a threshold pair

@@ -224,7 +224,7 @@ def _options(*, target_faces, target_ratio, target_vertices, max_error, max_erro
              max_distance=None, max_distance_relative=None,
              threshold_relative, weighting, placement, boundary_weight, lock_border, inversion, max_turn,
              allow_non_manifold, scheme, refit, threads, record, keep_components=True, prune=None,
-             prune_relative=None, exact_border=False):
+             prune_relative=None, exact_border=True):
     o = _qem.SimplifyOptions()
 
     def count(name, value):
@@ -341,7 +341,7 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
              boundary_weight: float = 1.0, lock_border: bool = False, inversion: str = "forbid",
              max_turn: float = 75.0, allow_non_manifold: bool = False, scheme: str = "passes",
              refit="light", threads: int = 0, keep_components: bool = True, prune: Optional[float] = None,
-             prune_relative: Optional[float] = None, exact_border: bool = False, attributes: Optional[dict] = None,
+             prune_relative: Optional[float] = None, exact_border: bool = True, attributes: Optional[dict] = None,
              attribute_weights: Optional[dict] = None, vertex_lock=None, return_mapping: bool = False,
              record: bool = False, progress: Optional[Callable[[float], Optional[bool]]] = None) -> SimplifyResult:
     """Simplifies a triangle mesh by quadric-error pair contraction (Garland & Heckbert 1997).
@@ -368,9 +368,11 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
       placement: "optimal", "segment", "midpoint", "endpoints".
       boundary_weight: weight of the planes that hold open borders in place (0 = none).
       lock_border: border vertices never move.
-      exact_border: border vertices stay on the input's border lines (at input vertices or sliding
-        along input border edges; corners fixed), as --exact-borders; False (the default) = GH97's
-        penalty planes alone (boundary_weight).
+      exact_border: True (the default): border vertices stay on the input's border lines (at input
+        vertices or sliding along input border edges); border ends and junctions fixed, corners
+        (turns above 45 degrees) kept until the error reaches their size, holes down to three
+        vertices closed once the error reaches their size (README, Boundaries). False = GH97's
+        penalty planes alone (boundary_weight), as --penalty-borders.
       inversion: "forbid", "penalize" or "off": contractions that turn a face by more than max_turn degrees.
       allow_non_manifold: skip the link condition (edge collapses may make non-manifold edges).
       scheme: "passes" (fast) or "greedy" (GH97's heap: strictly cheapest first).
@@ -579,7 +581,7 @@ def lod(vertices, faces, *, ratios=None, target_faces=None, refit="light", **opt
     defaults = dict(threshold=0.0, threshold_relative=None, weighting="area", placement="optimal",
                     boundary_weight=1.0, lock_border=False, inversion="forbid", max_turn=75.0,
                     allow_non_manifold=False, scheme="passes", threads=0, keep_components=True, prune=None,
-                    prune_relative=None, exact_border=False)
+                    prune_relative=None, exact_border=True)
     unknown = set(options) - set(defaults)
     if unknown:
         raise TypeError(f"lod() got unexpected keyword arguments: {', '.join(sorted(unknown))}")

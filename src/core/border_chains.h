@@ -26,6 +26,12 @@ struct BorderChains {
   std::vector<Vec3> pos;
   std::vector<std::uint32_t> neighbour;  ///< 2 per slot (kNoSlot: none)
   std::vector<std::uint8_t> corner;
+  /// Per soft corner's slot: its size (border_placement.h, corner_error); 0 elsewhere.
+  std::vector<double> corner_size;
+  /// Per slot: half the bounding-box diagonal of its input border loop when that loop is a simple
+  /// closed one (no hard corner on it), the size of the hole it bounds (border_placement.h,
+  /// hole_error); infinity otherwise.
+  std::vector<double> loop_radius;
 
   /// The point of `s`: computed the same way each time, so a vertex left at it keeps its bits.
   Vec3 at(const BorderSpot& s) const {

@@ -2,11 +2,22 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "core/collapse_checks.h"
 
 namespace qem::core {
+
+namespace {
+double squared_distance_to_segment(const Vec3& p, const Vec3& s, const Vec3& e) {
+  const Vec3 d = e - s, w = p - s;
+  const double len2 = dot(d, d);
+  const double t = len2 > 0 ? std::clamp(dot(w, d) / len2, 0.0, 1.0) : 0.0;
+  const Vec3 r = w - d * t;
+  return dot(r, r);
+}
+}  // namespace
 
 void mark_border_corners(WorkingMesh& m, const std::vector<Edge>& edges) {
   const std::size_t n = m.vertex_count();
@@ -19,7 +30,7 @@ void mark_border_corners(WorkingMesh& m, const std::vector<Edge>& edges) {
     if (count[v] < 255) ++count[v];
   };
   for (const Edge& e : edges) {
-    if (e.faces > 2) m.corner[e.lo] = m.corner[e.hi] = 1;  // non-manifold: where sheets meet
+    if (e.faces > 2) m.corner[e.lo] = m.corner[e.hi] = kHardCorner;  // non-manifold: where sheets meet
     if (e.faces != 1) continue;
     add(e.lo, e.hi), add(e.hi, e.lo);
   }
@@ -27,13 +38,13 @@ void mark_border_corners(WorkingMesh& m, const std::vector<Edge>& edges) {
   for (std::uint32_t v = 0; v < n; ++v) {
     if (count[v] == 0 || m.corner[v]) continue;
     if (count[v] != 2) {  // a border that ends, or two borders through one vertex
-      m.corner[v] = 1;
+      m.corner[v] = kHardCorner;
       continue;
     }
     const Vec3 in = m.pos[v] - m.pos[other[2 * std::size_t(v)]], out = m.pos[other[2 * std::size_t(v) + 1]] - m.pos[v];
     const double scale = std::sqrt(dot(in, in) * dot(out, out));
     // The turn between the incoming and outgoing directions (0 on a straight border).
-    if (!(dot(in, out) >= cos_corner * scale)) m.corner[v] = 1;
+    if (!(dot(in, out) >= cos_corner * scale)) m.corner[v] = kSoftCorner;
   }
   // The polylines: one slot per border vertex, in vertex order.
   BorderChains& ch = m.chains;
@@ -45,12 +56,69 @@ void mark_border_corners(WorkingMesh& m, const std::vector<Edge>& edges) {
     slot[v] = std::uint32_t(ch.pos.size());
     m.border_spot[v].from = slot[v];
     ch.pos.push_back(m.pos[v]);
-    ch.corner.push_back(m.corner[v] || m.held(v, false));
+    ch.corner.push_back(m.corner[v] != 0 || m.held(v, false));
   }
   ch.neighbour.assign(2 * ch.pos.size(), kNoSlot);
   for (std::uint32_t v = 0; v < n; ++v)
     for (int k = 0; k < 2 && slot[v] != kNoSlot; ++k)
       if (other[2 * std::size_t(v) + k] != kNoVertex) ch.neighbour[2 * std::size_t(slot[v]) + k] = slot[other[2 * std::size_t(v) + k]];
+  // Each soft corner's size: its distance from the line between the nearest corners (or held
+  // vertices) on either side along the input border, at most kCornerWalk edges away; on a loop
+  // with no other corner, its distance to the farthest slot. Scan noise is a corner between
+  // corners close by (a small size); a square's corner sits between the square's other corners.
+  ch.corner_size.assign(ch.pos.size(), 0);
+  for (std::uint32_t v = 0; v < n; ++v) {
+    if (slot[v] == kNoSlot || m.corner[v] != kSoftCorner) continue;
+    const std::uint32_t s0 = slot[v];
+    std::uint32_t end[2] = {kNoSlot, kNoSlot};
+    double farthest = 0;
+    bool around = false;
+    for (int side = 0; side < 2 && !around; ++side) {
+      std::uint32_t prev = s0, cur = ch.neighbour[2 * std::size_t(s0) + side];
+      for (std::size_t steps = 0; cur != kNoSlot && cur != s0; ++steps) {
+        farthest = std::max(farthest, std::sqrt(dot(ch.pos[cur] - ch.pos[s0], ch.pos[cur] - ch.pos[s0])));
+        end[side] = cur;
+        if (ch.corner[cur] || steps == kCornerWalk) break;
+        const std::uint32_t* nb = &ch.neighbour[2 * std::size_t(cur)];
+        const std::uint32_t next = nb[0] == prev ? nb[1] : nb[0];
+        prev = cur, cur = next;
+      }
+      around = cur == s0;
+    }
+    ch.corner_size[s0] = around || end[0] == kNoSlot || end[1] == kNoSlot
+                             ? farthest
+                             : std::sqrt(squared_distance_to_segment(ch.pos[s0], ch.pos[end[0]], ch.pos[end[1]]));
+  }
+  // Each simple closed loop's size (its slots all on two border edges, none a hard corner).
+  const std::size_t slots = ch.pos.size();
+  ch.loop_radius.assign(slots, std::numeric_limits<double>::infinity());
+  std::vector<std::uint8_t> simple(slots, 0), seen(slots, 0);
+  for (std::uint32_t v = 0; v < n; ++v)
+    if (slot[v] != kNoSlot) simple[slot[v]] = count[v] == 2 && m.corner[v] != kHardCorner && !m.held(v, false);
+  std::vector<std::uint32_t> loop;
+  for (std::uint32_t s0 = 0; s0 < slots; ++s0) {
+    if (seen[s0]) continue;
+    loop.clear();
+    bool closed = false;
+    for (std::uint32_t prev = kNoSlot, cur = s0; cur != kNoSlot && !seen[cur];) {
+      seen[cur] = 1;
+      loop.push_back(cur);
+      const std::uint32_t* nb = &ch.neighbour[2 * std::size_t(cur)];
+      const std::uint32_t next = nb[0] != prev ? nb[0] : nb[1];
+      prev = cur, cur = next;
+      closed = cur == s0;
+    }
+    if (!closed || loop.size() < 3) continue;
+    if (!std::all_of(loop.begin(), loop.end(), [&](std::uint32_t x) { return simple[x] != 0; })) continue;
+    Vec3 lo = ch.pos[loop[0]], hi = lo;
+    for (std::uint32_t x : loop) {
+      const Vec3& p = ch.pos[x];
+      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+    }
+    const double radius = 0.5 * std::sqrt(dot(hi - lo, hi - lo));
+    for (std::uint32_t x : loop) ch.loop_radius[x] = radius;
+  }
 }
 
 namespace {
@@ -107,14 +175,75 @@ std::vector<Piece> border_between(const BorderChains& ch, const BorderSpot& u, c
   return best;
 }
 
+// v's neighbour along the current border other than `not_this` (kNoVertex if none).
+std::uint32_t other_border_neighbour(const WorkingMesh& m, std::uint32_t v, std::uint32_t not_this) {
+  for (std::uint32_t f : m.vertex_faces[v]) {
+    if (!m.face_alive[f]) continue;
+    const std::uint32_t* t = m.face(f);
+    for (int k = 0; k < 3; ++k)
+      if (t[k] != v && t[k] != not_this && border_detail::is_border_edge(m, v, t[k])) return t[k];
+  }
+  return kNoVertex;
+}
+
 }  // namespace
+
+double corner_error(const Context& c_, std::uint32_t a, std::uint32_t b, const Vec3& x, double weight) {
+  const WorkingMesh& m = c_.mesh;
+  if (m.corner.empty()) return 0;
+  const auto same = [](const Vec3& p, const Vec3& q) { return p.x == q.x && p.y == q.y && p.z == q.z; };
+  double size = 0;
+  for (int end = 0; end < 2; ++end) {
+    const std::uint32_t e = end == 0 ? a : b;
+    // A soft corner never moved, so it is at its own slot.
+    if (m.corner[e] == kSoftCorner && !same(x, m.pos[e]) && m.border_spot[e].from != kNoSlot)
+      size = std::max(size, m.chains.corner_size[m.border_spot[e].from]);
+  }
+  return (weight > 0 ? weight : 1) * size * size;
+}
+
+std::uint32_t hole_closed_by(const WorkingMesh& m, std::uint32_t a, std::uint32_t b) {
+  if (m.corner.empty() || !m.boundary[a] || !m.boundary[b] || !border_detail::is_border_edge(m, a, b)) return kNoVertex;
+  const std::uint32_t ca = other_border_neighbour(m, a, b);
+  if (ca == kNoVertex || ca != other_border_neighbour(m, b, a)) return kNoVertex;
+  // c must not be the third corner of the face on (a, b): then the loop is that face's own border.
+  for (std::uint32_t f : m.vertex_faces[a])
+    if (m.face_alive[f] && m.face_has(f, b) && m.face_has(f, ca)) return kNoVertex;
+  // Only the hole of an input loop that is simple and closed has a size (BorderChains::loop_radius).
+  const std::uint32_t slot = m.border_spot[a].from;
+  if (slot == kNoSlot || !std::isfinite(m.chains.loop_radius[slot])) return kNoVertex;
+  return ca;
+}
+
+double hole_error(const WorkingMesh& m, std::uint32_t a, std::uint32_t b, double weight) {
+  if (hole_closed_by(m, a, b) == kNoVertex) return 0;  // not a hole that may close (the link condition refuses it)
+  const double r = m.chains.loop_radius[m.border_spot[a].from];
+  return (weight > 0 ? weight : 1) * r * r;
+}
+
+void update_border_after_closing(WorkingMesh& m, std::uint32_t v) {
+  bool on_border = false;
+  for (std::uint32_t f : m.vertex_faces[v]) {
+    if (!m.face_alive[f]) continue;
+    const std::uint32_t* t = m.face(f);
+    for (int k = 0; k < 3 && !on_border; ++k)
+      on_border = t[k] != v && border_detail::is_border_edge(m, v, t[k]);
+    if (on_border) break;
+  }
+  if (on_border) return;
+  m.boundary[v] = 0;  // interior now: free to move (its border planes still rank it)
+  if (m.corner[v] == kSoftCorner) m.corner[v] = 0;
+  m.border_spot[v] = BorderSpot{};
+}
 
 void place_along_border(const Context& c, std::uint32_t a, std::uint32_t b, const Quadric& q, Placed& placed) {
   const WorkingMesh& m = c.mesh;
   const BorderChains& ch = m.chains;
   std::vector<Placed> cand;  // stable-sorted below: ties go to the earlier
-  cand.push_back({m.pos[a], q.evaluate(m.pos[a]), m.border_spot[a]});
-  cand.push_back({m.pos[b], q.evaluate(m.pos[b]), m.border_spot[b]});
+  // Each candidate's error: Q there, or a soft corner's size if it removes one (corner_error).
+  const auto error_at = [&](const Vec3& x) { return std::max(q.evaluate(x), corner_error(c, a, b, x, q.weight)); };
+  cand.push_back({m.pos[a], error_at(m.pos[a]), m.border_spot[a]});
+  cand.push_back({m.pos[b], error_at(m.pos[b]), m.border_spot[b]});
   const BorderSpot& u = m.border_spot[a];
   const BorderSpot& v = m.border_spot[b];
   if (u.from != kNoSlot && v.from != kNoSlot) {
@@ -137,7 +266,7 @@ void place_along_border(const Context& c, std::uint32_t a, std::uint32_t b, cons
       if (s == 0) spot = {p.x, kNoSlot, 0};
       if (s == 1) spot = {p.y, kNoSlot, 0};
       const Vec3 at = ch.at(spot);
-      cand.push_back({at, q.evaluate(at), spot});
+      cand.push_back({at, error_at(at), spot});
     }
   }
   std::stable_sort(cand.begin(), cand.end(),

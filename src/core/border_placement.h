@@ -1,4 +1,4 @@
-// Exact borders (asked for: SimplifyOptions::exact_border, `--exact-borders`): an open border's vertices never
+// Exact borders (the default: SimplifyOptions::exact_border; `--penalty-borders` for GH97's penalty): an open border's vertices never
 // leave the input's border polylines. GH97 §6's border planes are a penalty that the optimal
 // placement trades against the faces' planes, so a border vertex drifts off its border and off
 // the plane of a flat patch; tiles simplified one by one then no longer meet. Here the planes
@@ -12,10 +12,14 @@
 //     polyline, and one that stays or lands on another's place keeps bit-identical coordinates;
 //   - two border vertices that do not share a border edge: never (it would join two stretches of
 //     border across the surface);
-//   - a corner (where the border turns by more than kCornerDegrees, where the border is not a
-//     simple chain, or on a non-manifold edge) is never removed nor moved: its pairs are placed
-//     at it, two corners never contract together, and no vertex slides past one.
-// Locked vertices (vertex_lock, --lock-border) count as corners.
+//   - a hard corner (where the border is not a simple chain, or on a non-manifold edge) is never
+//     removed nor moved: its pairs are placed at it, and no vertex slides past one;
+//   - a soft corner (where the border turns by more than kCornerDegrees) is kept the same way
+//     with an interior vertex, and no vertex slides past its input place; along the border it
+//     may be removed, at an error of at least its distance from the border that replaces it
+//     (corner_error): corners at the scale of the current error, so a scan's jagged hole loses
+//     its noise while a square keeps its corners.
+// Locked vertices (vertex_lock, --lock-border) count as hard corners.
 #pragma once
 
 #include <cstddef>
@@ -37,6 +41,10 @@ namespace qem::core {
 /// (docs/benchmarks.md, "Borders").
 inline constexpr double kCornerDegrees = 45;
 
+/// A soft corner's size is measured between the nearest corners at most this many input border
+/// edges away on either side (mark_border_corners).
+inline constexpr std::size_t kCornerWalk = 64;
+
 /// A border vertex slides at most this many input border edges per contraction (the stretch
 /// between the two ends is walked edge by edge); a longer stretch is placed at either end.
 inline constexpr std::size_t kMaxBorderWalk = 4096;
@@ -50,14 +58,20 @@ void mark_border_corners(WorkingMesh& mesh, const std::vector<Edge>& edges);
 /// lowest-error non-flipping point of the input border between them, ends included (above).
 void place_along_border(const Context& c, std::uint32_t a, std::uint32_t b, const Quadric& q, Placed& placed);
 
+/// mesh.corner values: a hard corner (a border's end, a vertex where borders meet, on a
+/// non-manifold edge) is never removed nor moved; a soft one (a turn above kCornerDegrees) stays
+/// until the run's error reaches its size (corner_error below).
+inline constexpr std::uint8_t kHardCorner = 1, kSoftCorner = 2;
+
 /// Where the contraction of (a, b) may go under exact borders.
 enum class BorderTarget : std::uint8_t { Free, AtA, AtB, AtEither, Never };
 
 namespace border_detail {
-enum class Role : std::uint8_t { Free, Border, Fixed };
+enum class Role : std::uint8_t { Free, Border, Corner, Fixed };
 inline Role role(const Context& c, std::uint32_t v) {
   const WorkingMesh& m = c.mesh;
-  if (m.corner[v] || m.held(v, c.settings.lock_border)) return Role::Fixed;
+  if (m.corner[v] == kHardCorner || m.held(v, c.settings.lock_border)) return Role::Fixed;
+  if (m.corner[v] == kSoftCorner) return Role::Corner;
   return m.boundary[v] ? Role::Border : Role::Free;
 }
 /// Exactly one live face has both a and b: (a, b) is an edge of the current border.
@@ -70,6 +84,8 @@ inline bool is_border_edge(const WorkingMesh& m, std::uint32_t a, std::uint32_t 
 }  // namespace border_detail
 
 /// The rule above for pair (a, b); Free when exact borders are off or neither end is on a border.
+/// A soft corner counts as a border vertex here: whether it may leave its place is priced by
+/// corner_error.
 inline BorderTarget border_target(const Context& c, std::uint32_t a, std::uint32_t b) {
   using border_detail::Role;
   if (!c.settings.exact_border) return BorderTarget::Free;
@@ -84,5 +100,30 @@ inline BorderTarget border_target(const Context& c, std::uint32_t a, std::uint32
   if (rb == Role::Fixed) return BorderTarget::AtB;
   return BorderTarget::AtEither;
 }
+
+/// Corners at the scale of the error: the contraction of border edge (a, b) to x removes a soft
+/// corner at a or b unless x is that corner's place. Its error is then at least the corner's size
+/// d (BorderChains::corner_size: its distance from the line between the nearest input corners on
+/// either side, a property of the input, so no pair's cost goes stale), as a quadric error
+/// over `weight` (weight * d^2: sqrt(Q / weight) is the error in distance units, cost_model.h),
+/// so the run removes a corner only once its error has grown to the corner's size: scan noise
+/// (jagged holes) goes early, a square's corners stay unless the target asks for more than their
+/// error. 0 when neither end is a soft corner that leaves.
+double corner_error(const Context& c, std::uint32_t a, std::uint32_t b, const Vec3& x, double weight);
+
+/// Small holes close at the scale of the error (as --prune removes parts in distance units): when
+/// an input hole (a simple closed border loop) is down to three vertices a, b, c, contracting its
+/// edge (a, b) joins its two other edges into one interior edge and the hole is gone. The link
+/// condition allows it (c is the one common neighbour it tolerates, collapse_checks.h), at an
+/// error of at least the hole's size: half its input loop's bounding-box diagonal, about the
+/// farthest the closing surface lies from the input (hole_error, weight * r^2 as in corner_error).
+/// So a hole closes only once the run's error has grown to its size: a scan's small holes go at
+/// coarse targets, where GH97's penalty would have pulled their vertices off the border anyway;
+/// every border that remains is exact. Returns c, or kNoVertex when (a, b) is not such an edge.
+std::uint32_t hole_closed_by(const WorkingMesh& m, std::uint32_t a, std::uint32_t b);
+/// The least error of the contraction of (a, b) when it closes a hole (above), else 0.
+double hole_error(const WorkingMesh& m, std::uint32_t a, std::uint32_t b, double weight);
+/// After a hole closed: v is a border vertex no more unless another border passes through it.
+void update_border_after_closing(WorkingMesh& m, std::uint32_t v);
 
 }  // namespace qem::core

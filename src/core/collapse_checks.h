@@ -40,8 +40,11 @@ inline bool flips(const WorkingMesh& m, std::uint32_t a, std::uint32_t b, const 
 /// not stack two faces onto the same three vertices, and an interior edge whose two ends both lie
 /// on a border must not pinch the border. Skipped (true) at aggregation joints and when the
 /// topology need not be kept. `marks` are per-vertex stamps; two fresh ones are taken from `stamp`.
+/// `closes`: the third vertex of a hole down to three vertices that this contraction closes
+/// (border_placement.h, hole_closed_by), the one common neighbour allowed; kNoVertex otherwise.
 inline bool link_condition_ok(const WorkingMesh& m, std::uint32_t a, std::uint32_t b, bool preserve_topology,
-                              bool& is_edge, std::vector<std::uint32_t>& marks, std::uint32_t& stamp) {
+                              bool& is_edge, std::vector<std::uint32_t>& marks, std::uint32_t& stamp,
+                              std::uint32_t closes = kNoVertex) {
   const std::uint32_t s_nbr = ++stamp, s_opp = ++stamp;
   std::size_t shared = 0;
   for (std::uint32_t f : m.vertex_faces[a]) {
@@ -67,8 +70,15 @@ inline bool link_condition_ok(const WorkingMesh& m, std::uint32_t a, std::uint32
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t x = t[k];
       if (x == b) continue;
-      if (marks[x] == s_nbr) return false;
+      if (marks[x] == s_nbr && x != closes) return false;
       if (marks[x] == s_opp) ++opp_corners;
+    }
+    // Closing a hole: b's face (b, closes, x) becomes (a, closes, x); a must not have that face
+    // already (a hole whose three faces meet at one apex would fold onto itself).
+    if (closes != kNoVertex && m.face_has(f, closes)) {
+      const std::uint32_t x = t[0] != b && t[0] != closes ? t[0] : t[1] != b && t[1] != closes ? t[1] : t[2];
+      for (std::uint32_t g : m.vertex_faces[a])
+        if (m.face_alive[g] && m.face_has(g, closes) && m.face_has(g, x)) return false;
     }
     // A face (b, x, y) with x, y both opposite corners: if a also has a face (a, x, y), the
     // collapse would stack two faces on the same vertices (the tetrahedron case).

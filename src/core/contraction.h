@@ -157,7 +157,9 @@ void contract(Context& c, Lists& lists, std::uint32_t p, const Quadric& q, const
   m.pos[a] = target;
   c.quadric[a] = q;
   m.boundary[a] |= m.boundary[b];
-  if (!m.corner.empty()) m.corner[a] |= m.corner[b];  // never set on b under exact borders
+  // Exact borders: a hard corner is never removed nor moved (so never b); a soft corner that moves
+  // or is removed is a corner no more (border_placement.h).
+  if (!m.corner.empty() && m.corner[a] == kSoftCorner && moves) m.corner[a] = 0;
   ++w.vertices_removed;
   m.aggregated[a] |= m.aggregated[b] | c.pairs.pairs[p].is_virtual;
 
@@ -196,7 +198,9 @@ bool try_contract(Context& c, Lists& lists, std::uint32_t p, Worker& w) {
   PairSet& ps = c.pairs;
   const std::uint32_t a = ps.pairs[p].v[0], b = ps.pairs[p].v[1];
   bool is_edge = false;
-  if (!link_condition_ok(c.mesh, a, b, c.settings.preserve_topology, is_edge, c.marks, w.stamp)) {
+  // Exact borders: a small hole down to three vertices may close (border_placement.h, hole_closed_by).
+  const std::uint32_t closes = c.settings.exact_border ? hole_closed_by(c.mesh, a, b) : kNoVertex;
+  if (!link_condition_ok(c.mesh, a, b, c.settings.preserve_topology, is_edge, c.marks, w.stamp, closes)) {
     ++w.blocked_topology;
     ps.block(p);
     return false;
@@ -221,6 +225,16 @@ bool try_contract(Context& c, Lists& lists, std::uint32_t p, Worker& w) {
     ps.block(p);
     return false;
   }
+  // Exact borders: a border pair's cost depends on more than its two ends. Its placement is the
+  // cheapest point that flips no face, so a neighbour's contraction can push it to a dearer one
+  // (one that removes a corner, corner_error), and a hole comes down to three vertices by a
+  // contraction elsewhere on its loop (hole_error). Neither re-costs this pair, so when its cost
+  // now exceeds the ranked one it is ranked again instead of being made out of order.
+  if (c.settings.exact_border && (c.mesh.boundary[a] || c.mesh.boundary[b]) &&
+      round_key(placed.error) > double(ps.cost[p])) {
+    lists.pair_changed(p);
+    return false;
+  }
   if (c.settings.inversion == InversionPolicy::Forbid && flips(c.mesh, a, b, placed.position, c.settings.cos_max_turn)) {
     ++w.blocked_inversion;
     ps.block(p);
@@ -243,6 +257,10 @@ bool try_contract(Context& c, Lists& lists, std::uint32_t p, Worker& w) {
   // Exact borders: where the survivor lies on the input's border (it slid, or took the place of
   // the other end; an interior vertex that came to a border vertex takes that one's).
   if (!c.mesh.border_spot.empty() && placed.spot.from != kNoSlot) c.mesh.border_spot[w.last_kept] = placed.spot;
+  if (closes != kNoVertex) {  // the hole is gone: its last vertices are interior now (unless on another border)
+    update_border_after_closing(c.mesh, w.last_kept);
+    update_border_after_closing(c.mesh, closes);
+  }
   ++w.contractions;
   if (c.observe_contractions) report_contraction(c, err, w);
   return true;

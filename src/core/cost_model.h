@@ -2,6 +2,7 @@
 // placed by the chosen policy, cost Q(position), honouring --lock-border and --inversion penalize.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <utility>
@@ -34,20 +35,32 @@ inline double normalized_error(double q_error, double weight) {
 bool place_with_wedges(const Context& c, std::uint32_t a, std::uint32_t b, const Quadric& q, Placed& placed);
 
 /// The quadric and placement of pair p. False if the pair can never move (both ends on a locked
-/// border, two corners or two stretches of border under exact borders, or, with attributes, a
+/// border, two hard corners or two stretches of border under exact borders, or, with attributes, a
 /// collapse that would move or close a seam); with one end on a locked border, that end is the
 /// placement; under exact borders, border_target decides (border_placement.h).
 inline bool place_pair(const Context& c, std::uint32_t p, Quadric& q, Placed& placed) {
   const std::uint32_t a = c.pairs.pairs[p].v[0], b = c.pairs.pairs[p].v[1];
   const WorkingMesh& m = c.mesh;
   q = c.quadric[a] + c.quadric[b];
-  if (c.wedges) return place_with_wedges(c, a, b, q, placed);
-  switch (border_target(c, a, b)) {
+  const BorderTarget border = border_target(c, a, b);
+  if (c.wedges) {
+    if (!place_with_wedges(c, a, b, q, placed)) return false;
+    if (border == BorderTarget::AtEither) placed.error = std::max(placed.error, hole_error(m, a, b, q.weight));
+    return true;
+  }
+  switch (border) {
     case BorderTarget::Free: break;
     case BorderTarget::Never: return false;
-    case BorderTarget::AtA: placed = {m.pos[a], q.evaluate(m.pos[a])}; return true;
-    case BorderTarget::AtB: placed = {m.pos[b], q.evaluate(m.pos[b])}; return true;
-    case BorderTarget::AtEither: place_along_border(c, a, b, q, placed); return true;
+    case BorderTarget::AtA:  // b may be a soft corner that leaves (corner_error)
+      placed = {m.pos[a], std::max(q.evaluate(m.pos[a]), corner_error(c, a, b, m.pos[a], q.weight))};
+      return true;
+    case BorderTarget::AtB:
+      placed = {m.pos[b], std::max(q.evaluate(m.pos[b]), corner_error(c, a, b, m.pos[b], q.weight))};
+      return true;
+    case BorderTarget::AtEither:
+      place_along_border(c, a, b, q, placed);
+      placed.error = std::max(placed.error, hole_error(m, a, b, q.weight));  // a hole down to three vertices
+      return true;
   }
   const bool held_a = m.held(a, c.settings.lock_border), held_b = m.held(b, c.settings.lock_border);
   if (held_a || held_b) {

@@ -1,5 +1,7 @@
 #include "core/cost_model.h"
 
+#include <algorithm>
+
 namespace qem::core {
 
 bool place_with_wedges(const Context& c, std::uint32_t a, std::uint32_t b, const Quadric& q, Placed& placed) {
@@ -34,7 +36,8 @@ bool place_with_wedges(const Context& c, std::uint32_t a, std::uint32_t b, const
     } while (w != wg.first[survivor]);
     const Placed candidate =
         free ? place(total, m.pos[a], m.pos[b], c.settings.placement)
-             : Placed{m.pos[survivor], total.evaluate(m.pos[survivor]) + crossing_error};
+             : Placed{m.pos[survivor], std::max(total.evaluate(m.pos[survivor]) + crossing_error,
+                                                corner_error(c, a, b, m.pos[survivor], q.weight))};
     if (!found || candidate.error < placed.error) placed = candidate;
     found = true;
     if (free) break;  // both directions place the same way

@@ -34,7 +34,7 @@ struct WorkingMesh {
   std::vector<std::uint32_t> source_vertex;  ///< input vertex of each working vertex
   std::vector<std::uint8_t> moved;           ///< left its input position (else written back exactly)
   std::vector<std::uint8_t> boundary;        ///< on a border edge (GH97 §6), inherited through merges
-  /// Under exact borders, never removed and never moved (border_placement.h); empty otherwise.
+  /// Under exact borders, kHardCorner or kSoftCorner (border_placement.h); empty otherwise.
   std::vector<std::uint8_t> corner;
   /// Under exact borders: the input's border polylines, and where on them each vertex lies
   /// (border_chains.h; a vertex off the borders has none); empty otherwise.
