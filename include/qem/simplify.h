@@ -197,6 +197,11 @@ struct SimplifyOptions {
 
   /// With attributes (MeshView::attributes), their weights in the error.
   AttributeWeights attribute_weights;
+  /// With attributes: after the last contraction (and the refit), the values of every vertex off
+  /// the seams are fitted, by least squares, to the input's attributes at the output's points
+  /// closest to the input's face centroids (Hoppe 1996 §4.2; docs/attributes.md, "The attribute
+  /// fit"). Positions and faces are not changed.
+  bool fit_attributes = true;
 
   /// Fill SimplifyResult::output_vertex_of_input (one entry per input vertex).
   bool map_input_vertices = false;
