@@ -254,7 +254,7 @@ TEST(Attributes, LinearUvsFollowTheMovedVertex) {
   SimplifyOptions o;
   o.target_ratio = 0.1;
   o.refit_rounds = 0;    // the refit moves vertices and keeps their values
-  o.fit_attributes = false;  // the fit (tested below) sets values by closest points, not by position
+  o.fit_attributes = false;  // (the default) the fit, tested below, sets values by closest points
   o.lock_border = true;  // the border's vertices would leave the chart, where the box holds them
   const SimplifyResult r = simplify(in, o);
   ASSERT_LE(r.mesh.face_count(), 116u);
@@ -289,8 +289,7 @@ TEST(Attributes, FitLowersTheAttributeErrorAndKeepsGeometryAndSeams) {
   in.attributes.push_back(colour);
   SimplifyOptions o;
   o.target_ratio = 0.1;
-  o.fit_attributes = false;
-  const SimplifyResult before = simplify(in, o);
+  const SimplifyResult before = simplify(in, o);  // the default: no fit
   o.fit_attributes = true;
   const SimplifyResult after = simplify(in, o);
   EXPECT_EQ(after.mesh.positions, before.mesh.positions);
