@@ -112,6 +112,11 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
       ->check(CLI::Range(0.0, 1e6));
   sub->add_flag("--no-refit", a.no_refit,
                 "No refit, not even the default's light one: every vertex stays where GH97 placed it");
+  sub->add_flag("--attribute-fit", a.attribute_fit,
+                "With attributes, after the run fit each vertex's values (off the seams) by least squares to "
+                "the input's attributes at the output's points closest to the input's faces, instead of "
+                "keeping those of its last contraction: lower UV, normal and colour errors, same positions; "
+                "costs time and memory (docs/attributes.md)");
 }
 
 namespace {
@@ -168,6 +173,7 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
     *weight = w;
   }
   opt.permissive_seams = a.seams == "permissive";
+  opt.fit_attributes = a.attribute_fit;
   for (const std::string& what : a.lock) {
     if (what == "seams") opt.lock_seams = true;
     else if (what == "borders") opt.lock_border = true;

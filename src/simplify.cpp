@@ -14,6 +14,7 @@
 #include "geometry/box.h"
 #include "geometry/frame.h"
 #include "qem/error.h"
+#include "refit/attribute_fit.h"
 #include "refit/refit_after_simplify.h"
 #include "refit/refit_points.h"
 
@@ -120,6 +121,11 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
   check_options(options);
   const bool refit = options.refit_rounds > 0;
   const bool bounded = std::isfinite(options.max_distance);
+  // The attribute fit (refit/attribute_fit.h) reads the input's attributes after the run: they
+  // are not released to it then.
+  const bool fit_values =
+      options.fit_attributes && refit_detail::has_fitted_attributes(input.attributes, options.attribute_weights);
+  if (fit_values) consumed_attributes = nullptr;
   // The refit fits the input's vertices weighted by their share of the area, and its guard (and
   // the distance bound's report) measures against the input's faces: taken before the core
   // releases a consumed input's faces.
@@ -129,10 +135,10 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
   hooks.observer = observer;
   hooks.consumed_indices = consumed_indices;
   hooks.consumed_attributes = consumed_attributes;
-  hooks.map_input_vertices = refit;
-  core::WedgeRefitData wedge_refit;  // with attributes, for the refit
-  if (refit && !input.attributes.empty()) hooks.wedge_refit = &wedge_refit;
-  if (refit || bounded)
+  hooks.map_input_vertices = refit || fit_values;
+  core::WedgeRefitData wedge_refit;  // with attributes, for the refit and the attribute fit
+  if ((refit || fit_values) && !input.attributes.empty()) hooks.wedge_refit = &wedge_refit;
+  if (refit || bounded || fit_values)
     hooks.before_release = [&](MeshView in) {
       if (refit) weights = refit_detail::vertex_areas(in);
       kept_indices.assign(in.indices.begin(), in.indices.end());
@@ -164,6 +170,15 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
     out.refit_rms_before = fit.rms_before;
     out.refit_rms_after = fit.rms_after;
     out.refit_rounds = fit.rounds;
+  }
+  if (fit_values && out.contractions > 0 && out.stop_reason != StopReason::Cancelled) {
+    // After the refit: the values fit the final positions. Seam and locked vertices keep theirs.
+    std::vector<std::uint8_t> held = wedge_refit.on_seam;
+    held.resize(out.mesh.vertex_count(), 0);
+    if (!options.vertex_lock.empty())
+      for (std::size_t v = 0; v < out.vertex_source.size(); ++v) held[v] |= options.vertex_lock[out.vertex_source[v]];
+    refit_detail::fit_attributes(input.positions, input_faces, input.attributes,
+                                 options.attribute_weights, out.output_vertex_of_input, held, out.mesh);
   }
   if (!options.map_input_vertices) std::vector<std::uint32_t>().swap(out.output_vertex_of_input);
   if (bounded) {
