@@ -259,6 +259,15 @@ class Refitter {
       ring_slot_[c] = fill[tri_[c]]++;
       ring_faces_[ring_slot_[c]] = std::uint32_t(c / 3);
     }
+    // A start for each vertex's search of the original: a face at an input vertex contracted into it.
+    if (surface_ && !near_vertex_.empty()) {
+      original_face_near_.assign(approx.vertex_count(), UINT32_MAX);
+      for (std::size_t i = 0; i < near_vertex_.size(); ++i) {
+        const std::uint32_t v = near_vertex_[i];
+        if (v < original_face_near_.size() && original_face_near_[v] == UINT32_MAX)
+          original_face_near_[v] = surface_->face_at(std::uint32_t(i));
+      }
+    }
     ready_ = true;
   }
 
@@ -545,9 +554,19 @@ class Refitter {
     std::vector<double> most(n + nf, 0.0);
     core::for_chunks(n + nf, kChunk, core::resolve_threads(opt_.threads), [&](std::size_t, std::size_t begin, std::size_t end) {
       std::uint32_t hint = UINT32_MAX;
-      for (std::size_t i = begin; i < end; ++i) most[i] = surface_->distance(sample(x, i), &hint);
+      for (std::size_t i = begin; i < end; ++i) most[i] = distance_to_original(x, i, hint);
     });
     return most.empty() ? 0.0 : *std::max_element(most.begin(), most.end());
+  }
+
+  // The distance from sample i of x to the original. The search starts at a face of the original
+  // near the sample's (first) vertex, or else at `hint`, the answer of the chunk's last search; it
+  // returns the closest face wherever it starts (ties by index), so the start only saves work.
+  double distance_to_original(const std::vector<double>& x, std::size_t i, std::uint32_t& hint) const {
+    const std::size_t n = approx_.vertex_count();
+    const std::uint32_t v = i < n ? std::uint32_t(i) : tri_[3 * (i - n)];
+    if (v < original_face_near_.size() && original_face_near_[v] != UINT32_MAX) hint = original_face_near_[v];
+    return surface_->distance(sample(x, i), &hint);
   }
 
   // Sample i of x: vertex i, or the centroid of face i - vertex count.
@@ -576,7 +595,7 @@ class Refitter {
           bad[i] = 0;
           const std::uint32_t* t = i < n ? nullptr : &tri_[3 * (i - n)];
           if (t ? !(moved(t[0]) || moved(t[1]) || moved(t[2])) : !moved(std::uint32_t(i))) continue;
-          bad[i] = surface_->distance(sample(next, i), &hint) > limit_ ||
+          bad[i] = distance_to_original(next, i, hint) > limit_ ||
                    (t && std::isfinite(max_distance_) &&
                     !surface_->triangle_within(at(next, t[0]), at(next, t[1]), at(next, t[2]), max_distance_));
         }
@@ -629,6 +648,7 @@ class Refitter {
   std::span<const std::uint32_t> near_vertex_;
   const Frame frame_;      // of the points: x_ = frame_.to_frame(approx_'s positions)
   const core::SurfaceDistance* surface_;  // the original, in frame_ (null: no distance guard)
+  std::vector<std::uint32_t> original_face_near_;  // per vertex: a face of surface_ near it, or UINT32_MAX
   const double max_distance_;             // RefitOptions::max_distance in frame_
   double limit_ = HUGE_VAL;               // a sample may not move farther than this from the original
   double far_ = HUGE_VAL;                 // a point farther than this from the approximation pulls nothing
@@ -667,12 +687,14 @@ void check_options(const RefitOptions& options) {
 core::SurfaceDistance surface_in_frame(std::span<const double> positions, std::span<const std::uint32_t> indices,
                                        const Frame& frame) {
   std::vector<double> corners(3 * indices.size());
+  std::vector<std::uint32_t> face_at(positions.size() / 3, UINT32_MAX);
   for (std::size_t c = 0; c < indices.size(); ++c) {
     const double* p = &positions[3 * std::size_t(indices[c])];
     const Vec3 q = frame.to_frame({p[0], p[1], p[2]});
     corners[3 * c] = q.x, corners[3 * c + 1] = q.y, corners[3 * c + 2] = q.z;
+    if (face_at[indices[c]] == UINT32_MAX) face_at[indices[c]] = std::uint32_t(c / 3);
   }
-  return core::SurfaceDistance(corners);
+  return core::SurfaceDistance(corners, std::move(face_at));
 }
 
 RefitResult refit_to_points(const FitPoints& points, Mesh& approx, const RefitOptions& options,
