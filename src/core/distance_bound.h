@@ -48,6 +48,19 @@ class SurfaceDistance {
     const double q[3] = {p.x, p.y, p.z};
     return std::sqrt(tree_.closest(q, hint).d2);
   }
+  /// Whether p is within d of the surface: distance(p, &hint) <= d, decided for the price of one
+  /// triangle when triangle `hint` (not UINT32_MAX) is itself within d (the minimum over all
+  /// triangles is then too); else `hint` is set as by distance().
+  bool within(const Vec3& p, double d, std::uint32_t& hint) const {
+    const double q[3] = {p.x, p.y, p.z};
+    if (hint != UINT32_MAX && std::sqrt(tree_.triangle_d2(q, hint)) <= d) return true;
+    return distance(p, &hint) <= d;
+  }
+  /// Distance from p to triangle t of the surface (at least distance(p)).
+  double distance_to(const Vec3& p, std::uint32_t t) const {
+    const double q[3] = {p.x, p.y, p.z};
+    return std::sqrt(tree_.triangle_d2(q, t));
+  }
   /// Whether every point of triangle abc is certified within d of the surface (see above).
   bool triangle_within(const Vec3& a, const Vec3& b, const Vec3& c, double d) const {
     return piece_within(a, b, c, d, 0);

@@ -37,6 +37,12 @@ class TriangleBvh {
   /// consecutive queries are near each other. `*hint` is set to the closest triangle found.
   Hit closest(const double p[3], std::uint32_t* hint) const;
 
+  /// The squared distance from `p` to (input) triangle `id`: the number closest() compares.
+  double triangle_d2(const double p[3], std::uint32_t id) const {
+    double point[3];
+    return slot_d2(p, slot_of_[id], point);
+  }
+
   /// Appends to `out` the (input) index of every triangle within sqrt(max_d2) of `p`, in no order.
   void within(const double p[3], double max_d2, std::vector<std::uint32_t>& out) const;
 

@@ -554,19 +554,27 @@ class Refitter {
     std::vector<double> most(n + nf, 0.0);
     core::for_chunks(n + nf, kChunk, core::resolve_threads(opt_.threads), [&](std::size_t, std::size_t begin, std::size_t end) {
       std::uint32_t hint = UINT32_MAX;
-      for (std::size_t i = begin; i < end; ++i) most[i] = distance_to_original(x, i, hint);
+      double most_here = 0;  // of this chunk, so far
+      for (std::size_t i = begin; i < end; ++i) {
+        const Vec3 p = sample(x, i);
+        start_search(i, hint);
+        // No farther from its start face than the largest so far: it cannot be the largest (its
+        // distance is at most that face's), and the search is skipped.
+        if (hint != UINT32_MAX && surface_->distance_to(p, hint) <= most_here) continue;
+        most[i] = surface_->distance(p, &hint);
+        most_here = std::max(most_here, most[i]);
+      }
     });
     return most.empty() ? 0.0 : *std::max_element(most.begin(), most.end());
   }
 
-  // The distance from sample i of x to the original. The search starts at a face of the original
-  // near the sample's (first) vertex, or else at `hint`, the answer of the chunk's last search; it
-  // returns the closest face wherever it starts (ties by index), so the start only saves work.
-  double distance_to_original(const std::vector<double>& x, std::size_t i, std::uint32_t& hint) const {
+  // Where the search of the original for sample i starts: a face of the original near the
+  // sample's (first) vertex, or else `hint` as it is (the answer of the chunk's last search). A
+  // search returns the closest face wherever it starts (ties by index): the start only saves work.
+  void start_search(std::size_t i, std::uint32_t& hint) const {
     const std::size_t n = approx_.vertex_count();
     const std::uint32_t v = i < n ? std::uint32_t(i) : tri_[3 * (i - n)];
     if (v < original_face_near_.size() && original_face_near_[v] != UINT32_MAX) hint = original_face_near_[v];
-    return surface_->distance(sample(x, i), &hint);
   }
 
   // Sample i of x: vertex i, or the centroid of face i - vertex count.
@@ -595,7 +603,8 @@ class Refitter {
           bad[i] = 0;
           const std::uint32_t* t = i < n ? nullptr : &tri_[3 * (i - n)];
           if (t ? !(moved(t[0]) || moved(t[1]) || moved(t[2])) : !moved(std::uint32_t(i))) continue;
-          bad[i] = distance_to_original(next, i, hint) > limit_ ||
+          start_search(i, hint);
+          bad[i] = !surface_->within(sample(next, i), limit_, hint) ||
                    (t && std::isfinite(max_distance_) &&
                     !surface_->triangle_within(at(next, t[0]), at(next, t[1]), at(next, t[2]), max_distance_));
         }
