@@ -87,7 +87,7 @@ TEST(Measure, BvhStackedAndClusteredTrianglesMatchBruteForce) {
   const auto add = [&](Vec3 a, Vec3 b, Vec3 c) {
     for (const Vec3& v : {a, b, c}) corners.insert(corners.end(), {v.x, v.y, v.z});
   };
-  add({1e3, 1e3, 1e3}, {1e3 + 1, 1e3, 1e3}, {1e3, 1e3 + 1, 1e3});  // far away
+  add({1e3, 1e3, 1e3}, {1e3 + 1, 1e3, 1e3}, {1e3, 1e3 + 1, 1e3});               // far away
   for (int copy = 0; copy < 300; ++copy) add({0, 0, 0}, {1, 0, 0}, {0, 1, 0});  // stacked: exact ties
   measure_detail::Rng rng(5);
   for (int i = 0; i < 500; ++i) {  // a cluster of tiny triangles
@@ -126,7 +126,8 @@ TEST(Measure, SurfaceWithinAgreesWithDistance) {
     const Vec3 p{2.4 * rng.uniform() - 1.2, 2.4 * rng.uniform() - 1.2, 2.4 * rng.uniform() - 1.2};
     const double d = 0.3 * rng.uniform();
     std::uint32_t none = UINT32_MAX,
-                  start = std::min(std::uint32_t(rng.uniform() * double(s.triangle_count())), std::uint32_t(s.triangle_count() - 1));
+                  start = std::min(std::uint32_t(rng.uniform() * double(s.triangle_count())),
+                                   std::uint32_t(s.triangle_count() - 1));
     const double exact = surface.distance(p, &none);
     EXPECT_EQ(surface.within(p, d, start), exact <= d) << i;
     EXPECT_GE(surface.distance_to(p, start), exact);

@@ -12,8 +12,8 @@ namespace qem::measure_detail {
 
 namespace {
 
-constexpr std::uint32_t kLeaf = 4;      // triangles per leaf at most
-constexpr std::uint32_t kGrid = 1024;   // Morton cells per axis: 30-bit codes
+constexpr std::uint32_t kLeaf = 4;     // triangles per leaf at most
+constexpr std::uint32_t kGrid = 1024;  // Morton cells per axis: 30-bit codes
 // Query stacks: a search holds at most depth + 1 entries, and the depth stays below 30 + 32.
 constexpr int kStack = 128;
 
@@ -94,9 +94,10 @@ TriangleBvh::TriangleBvh(const std::vector<double>& corners) {
     } else {
       const std::uint32_t bit = std::uint32_t(1) << (31 - std::countl_zero(lo_code ^ hi_code));
       // The codes share every bit above `bit`, so `bit` is off, then on, along the range.
-      mid = std::uint32_t(std::partition_point(sorted_code.begin() + task.begin, sorted_code.begin() + task.end,
-                                               [&](std::uint32_t c) { return (c & bit) == 0; }) -
-                          sorted_code.begin());
+      mid =
+          std::uint32_t(std::partition_point(sorted_code.begin() + task.begin, sorted_code.begin() + task.end,
+                                             [&](std::uint32_t c) { return (c & bit) == 0; }) -
+                        sorted_code.begin());
     }
     const std::uint32_t left = std::uint32_t(nodes_.size());
     nodes_.push_back({});
@@ -115,7 +116,8 @@ TriangleBvh::TriangleBvh(const std::vector<double>& corners) {
     } else {
       for (std::uint32_t c = node.first; c < node.first + 2; ++c) {
         const Node& child = nodes_[c];
-        for (int k = 0; k < 3; ++k) b.lo[k] = std::min(b.lo[k], child.lo[k]), b.hi[k] = std::max(b.hi[k], child.hi[k]);
+        for (int k = 0; k < 3; ++k)
+          b.lo[k] = std::min(b.lo[k], child.lo[k]), b.hi[k] = std::max(b.hi[k], child.hi[k]);
       }
     }
     for (int k = 0; k < 3; ++k) node.lo[k] = b.lo[k], node.hi[k] = b.hi[k];

@@ -558,24 +558,25 @@ class Refitter {
     const std::size_t n = approx_.vertex_count(), nf = tri_.size() / 3;
     std::vector<double> most(n + nf, 0.0);
     guard_face_.assign(n + nf, UINT32_MAX);
-    core::for_chunks(n + nf, kChunk, core::resolve_threads(opt_.threads), [&](std::size_t, std::size_t begin, std::size_t end) {
-      std::uint32_t last = UINT32_MAX;  // the chunk's last answer
-      double most_here = 0;             // of this chunk, so far
-      for (std::size_t i = begin; i < end; ++i) {
-        const Vec3 p = sample(x, i);
-        double start_distance;
-        std::uint32_t face = start_face(p, i, last, start_distance);
-        // No farther from its start face than the largest so far: it cannot be the largest (its
-        // distance is at most that face's), and the search is skipped.
-        if (face != UINT32_MAX && start_distance <= most_here) {
-          guard_face_[i] = face;
-          continue;
-        }
-        most[i] = surface_->distance(p, &face);
-        guard_face_[i] = last = face;
-        most_here = std::max(most_here, most[i]);
-      }
-    });
+    core::for_chunks(n + nf, kChunk, core::resolve_threads(opt_.threads),
+                     [&](std::size_t, std::size_t begin, std::size_t end) {
+                       std::uint32_t last = UINT32_MAX;  // the chunk's last answer
+                       double most_here = 0;             // of this chunk, so far
+                       for (std::size_t i = begin; i < end; ++i) {
+                         const Vec3 p = sample(x, i);
+                         double start_distance;
+                         std::uint32_t face = start_face(p, i, last, start_distance);
+                         // No farther from its start face than the largest so far: it cannot be the largest
+                         // (its distance is at most that face's), and the search is skipped.
+                         if (face != UINT32_MAX && start_distance <= most_here) {
+                           guard_face_[i] = face;
+                           continue;
+                         }
+                         most[i] = surface_->distance(p, &face);
+                         guard_face_[i] = last = face;
+                         most_here = std::max(most_here, most[i]);
+                       }
+                     });
     return most.empty() ? 0.0 : *std::max_element(most.begin(), most.end());
   }
 
@@ -616,18 +617,21 @@ class Refitter {
     std::vector<std::uint8_t> bad(n + nf);
     for (bool again = true; again;) {
       again = false;
-      core::for_chunks(n + nf, kChunk, core::resolve_threads(opt_.threads), [&](std::size_t, std::size_t begin, std::size_t end) {
-        for (std::size_t i = begin; i < end; ++i) {
-          bad[i] = 0;
-          const std::uint32_t* t = i < n ? nullptr : &tri_[3 * (i - n)];
-          if (t ? !(moved(t[0]) || moved(t[1]) || moved(t[2])) : !moved(std::uint32_t(i))) continue;
-          // The search starts at the sample's face from before the move (moves are small).
-          std::uint32_t& face = guard_face_[i];
-          bad[i] = !surface_->within(sample(next, i), limit_, face) ||
-                   (t && std::isfinite(max_distance_) &&
-                    !surface_->triangle_within(at(next, t[0]), at(next, t[1]), at(next, t[2]), max_distance_));
-        }
-      });
+      core::for_chunks(n + nf, kChunk, core::resolve_threads(opt_.threads),
+                       [&](std::size_t, std::size_t begin, std::size_t end) {
+                         for (std::size_t i = begin; i < end; ++i) {
+                           bad[i] = 0;
+                           const std::uint32_t* t = i < n ? nullptr : &tri_[3 * (i - n)];
+                           if (t ? !(moved(t[0]) || moved(t[1]) || moved(t[2])) : !moved(std::uint32_t(i)))
+                             continue;
+                           // The search starts at the sample's face from before the move (moves are small).
+                           std::uint32_t& face = guard_face_[i];
+                           bad[i] = !surface_->within(sample(next, i), limit_, face) ||
+                                    (t && std::isfinite(max_distance_) &&
+                                     !surface_->triangle_within(at(next, t[0]), at(next, t[1]),
+                                                                at(next, t[2]), max_distance_));
+                         }
+                       });
       const auto undo = [&](std::uint32_t v) {
         if (!moved(v)) return;
         for (int k = 0; k < 3; ++k) next[3 * v + k] = x_[3 * v + k];
