@@ -11,6 +11,7 @@
 #include <cstring>
 #include <string>
 
+#include "core/distance_bound.h"
 #include "measure/bvh.h"
 #include "measure/point_triangle.h"
 #include "measure/rng.h"
@@ -76,6 +77,64 @@ TEST(Measure, BvhMatchesBruteForce) {
     const double dx = hit.point[0] - p[0], dy = hit.point[1] - p[1], dz = hit.point[2] - p[2];
     EXPECT_NEAR(dx * dx + dy * dy + dz * dz, best, 1e-15);
   }
+}
+
+// The Morton-ordered build splits a range of equal codes in half: many triangles with one centre
+// (stacked copies), a dense cluster beside a far triangle, and exact ties all give the brute
+// force's answer, ties to the lowest index.
+TEST(Measure, BvhStackedAndClusteredTrianglesMatchBruteForce) {
+  std::vector<double> corners;
+  const auto add = [&](Vec3 a, Vec3 b, Vec3 c) {
+    for (const Vec3& v : {a, b, c}) corners.insert(corners.end(), {v.x, v.y, v.z});
+  };
+  add({1e3, 1e3, 1e3}, {1e3 + 1, 1e3, 1e3}, {1e3, 1e3 + 1, 1e3});               // far away
+  for (int copy = 0; copy < 300; ++copy) add({0, 0, 0}, {1, 0, 0}, {0, 1, 0});  // stacked: exact ties
+  measure_detail::Rng rng(5);
+  for (int i = 0; i < 500; ++i) {  // a cluster of tiny triangles
+    const Vec3 o{1e-6 * rng.uniform(), 2 + 1e-6 * rng.uniform(), 1e-6 * rng.uniform()};
+    add(o, o + Vec3{1e-8, 0, 0}, o + Vec3{0, 0, 1e-8});
+  }
+  const measure_detail::TriangleBvh bvh(corners);
+  for (int i = 0; i < 500; ++i) {
+    const double p[3] = {3 * rng.uniform() - 1, 3 * rng.uniform() - 1, 3 * rng.uniform() - 1};
+    double best = INFINITY;
+    std::uint32_t best_t = UINT32_MAX;
+    for (std::size_t t = 0; t < corners.size() / 9; ++t) {
+      const double* c = &corners[9 * t];
+      const Vec3 q = closest_point_on_triangle({p[0], p[1], p[2]}, {c[0], c[1], c[2]}, {c[3], c[4], c[5]},
+                                               {c[6], c[7], c[8]});
+      const double d2 = measure_detail::squared_distance({p[0], p[1], p[2]}, q);
+      if (d2 < best) best = d2, best_t = std::uint32_t(t);
+    }
+    std::uint32_t hint = 17;  // a stacked copy: the answer must still be the lowest index
+    const auto cold = bvh.closest(p), warm = bvh.closest(p, &hint);
+    ASSERT_EQ(cold.d2, best) << i;
+    ASSERT_EQ(cold.triangle, best_t) << i;
+    ASSERT_EQ(warm.triangle, best_t) << i;
+  }
+}
+
+// SurfaceDistance::within decides from the start face when it can: the same answer as comparing
+// the distance, whatever face it starts from.
+TEST(Measure, SurfaceWithinAgreesWithDistance) {
+  const Mesh sphere = test::icosphere(3);
+  const measure_detail::Surface s = measure_detail::make_surface(sphere, "sphere");
+  const core::SurfaceDistance surface(s.corners);
+  measure_detail::Rng rng(13);
+  int inside = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const Vec3 p{2.4 * rng.uniform() - 1.2, 2.4 * rng.uniform() - 1.2, 2.4 * rng.uniform() - 1.2};
+    const double d = 0.3 * rng.uniform();
+    std::uint32_t none = UINT32_MAX,
+                  start = std::min(std::uint32_t(rng.uniform() * double(s.triangle_count())),
+                                   std::uint32_t(s.triangle_count() - 1));
+    const double exact = surface.distance(p, &none);
+    EXPECT_EQ(surface.within(p, d, start), exact <= d) << i;
+    EXPECT_GE(surface.distance_to(p, start), exact);
+    inside += exact <= d;
+  }
+  EXPECT_GT(inside, 100);  // both answers occur
+  EXPECT_LT(inside, 1900);
 }
 
 TEST(Measure, BvhWarmStartGivesSameAnswer) {

@@ -17,6 +17,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "core/working_mesh.h"
@@ -32,12 +33,33 @@ class SurfaceDistance {
   SurfaceDistance() = default;
   /// `corners`: 9 doubles per triangle of the surface (a.xyz b.xyz c.xyz).
   explicit SurfaceDistance(const std::vector<double>& corners) : tree_(corners) {}
+  /// With, for each vertex of the surface's mesh, one triangle that has it (UINT32_MAX: none): a
+  /// start for searches from points known to lie near a vertex (face_at).
+  SurfaceDistance(const std::vector<double>& corners, std::vector<std::uint32_t> face_at_vertex)
+      : tree_(corners), face_at_vertex_(std::move(face_at_vertex)) {}
   bool empty() const { return tree_.empty(); }
+  /// A triangle that has vertex v, or UINT32_MAX (unknown).
+  std::uint32_t face_at(std::uint32_t v) const {
+    return v < face_at_vertex_.size() ? face_at_vertex_[v] : UINT32_MAX;
+  }
 
   /// Distance from p to the surface; `hint` as TriangleBvh::closest (warm start).
   double distance(const Vec3& p, std::uint32_t* hint) const {
     const double q[3] = {p.x, p.y, p.z};
     return std::sqrt(tree_.closest(q, hint).d2);
+  }
+  /// Whether p is within d of the surface: distance(p, &hint) <= d, decided for the price of one
+  /// triangle when triangle `hint` (not UINT32_MAX) is itself within d (the minimum over all
+  /// triangles is then too); else `hint` is set as by distance().
+  bool within(const Vec3& p, double d, std::uint32_t& hint) const {
+    const double q[3] = {p.x, p.y, p.z};
+    if (hint != UINT32_MAX && std::sqrt(tree_.triangle_d2(q, hint)) <= d) return true;
+    return distance(p, &hint) <= d;
+  }
+  /// Distance from p to triangle t of the surface (at least distance(p)).
+  double distance_to(const Vec3& p, std::uint32_t t) const {
+    const double q[3] = {p.x, p.y, p.z};
+    return std::sqrt(tree_.triangle_d2(q, t));
   }
   /// Whether every point of triangle abc is certified within d of the surface (see above).
   bool triangle_within(const Vec3& a, const Vec3& b, const Vec3& c, double d) const {
@@ -53,6 +75,7 @@ class SurfaceDistance {
   bool piece_within(const Vec3& a, const Vec3& b, const Vec3& c, double d, int depth, std::uint32_t parent) const;
 
   measure_detail::TriangleBvh tree_;
+  std::vector<std::uint32_t> face_at_vertex_;
 };
 
 /// The corners of the live faces of `mesh` (9 doubles per face), for a SurfaceDistance.

@@ -23,7 +23,14 @@ struct PackedNormal {
       const double fx = (1 - std::abs(y)) * (x >= 0 ? 1 : -1), fy = (1 - std::abs(x)) * (y >= 0 ? 1 : -1);
       x = fx, y = fy;
     }
-    return {std::int16_t(std::lround(x * 32767)), std::int16_t(std::lround(y * 32767))};
+    return {round_half_away(x * 32767), round_half_away(y * 32767)};
+  }
+  /// std::lround for |x| <= 32767, without the library call: x - trunc(x) is exact.
+  static std::int16_t round_half_away(double x) {
+    if (!(std::abs(x) <= 32767)) return 0;  // NaN (an infinite normal), as lround's result cast
+    const int t = int(x);
+    const double rest = x - t;
+    return std::int16_t(rest >= 0.5 ? t + 1 : rest <= -0.5 ? t - 1 : t);
   }
   bool none() const { return u == kNone; }
   /// The direction (not unit length).

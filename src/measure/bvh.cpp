@@ -1,19 +1,20 @@
 #include "measure/bvh.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
+#include "core/radix_sort.h"
+#include "core/spatial_order.h"
 #include "measure/point_triangle.h"
 
 namespace qem::measure_detail {
 
 namespace {
 
-constexpr int kBins = 16;           // SAH bins per split: 8-32 give the same tree quality (Wald 2007)
-constexpr std::uint32_t kLeaf = 4;  // triangles per leaf at most
-// Below this depth splits switch from SAH (which may peel off a few triangles per level on skewed
-// inputs) to object medians, so the depth stays below kSahDepth + 32 and fits the query stack.
-constexpr std::uint32_t kSahDepth = 48;
+constexpr std::uint32_t kLeaf = 4;     // triangles per leaf at most
+constexpr std::uint32_t kGrid = 1024;  // Morton cells per axis: 30-bit codes
+// Query stacks: a search holds at most depth + 1 entries, and the depth stays below 30 + 32.
 constexpr int kStack = 128;
 
 struct Bounds {
@@ -24,10 +25,6 @@ struct Bounds {
   }
   void grow(const Bounds& b) {
     for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], b.lo[k]), hi[k] = std::max(hi[k], b.hi[k]);
-  }
-  double half_area() const {
-    const double dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
-    return dx < 0 ? 0 : dx * dy + dy * dz + dz * dx;
   }
 };
 
@@ -46,125 +43,90 @@ inline double box_d2(const double* p, const double* lo, const double* hi) {
 TriangleBvh::TriangleBvh(const std::vector<double>& corners) {
   const std::uint32_t n = std::uint32_t(corners.size() / 9);
   if (n == 0) return;
-  // Build items are partitioned in place, so every pass over a node's range reads contiguous memory.
-  struct Item {
-    Bounds box;
-    double centroid[3];
-    std::uint32_t id;
-  };
-  std::vector<Item> items(n);
-  Bounds root, root_c;
+  // Each triangle's box, and the box of their centres (the grid of the Morton codes).
+  std::vector<Bounds> box(n);
+  Bounds centres;
   for (std::uint32_t t = 0; t < n; ++t) {
-    Item& it = items[t];
-    for (int c = 0; c < 3; ++c) it.box.grow(&corners[9 * std::size_t(t) + 3 * c]);
-    for (int k = 0; k < 3; ++k) it.centroid[k] = 0.5 * (it.box.lo[k] + it.box.hi[k]);
-    it.id = t;
-    root.grow(it.box);
-    root_c.grow(it.centroid);
+    for (int c = 0; c < 3; ++c) box[t].grow(&corners[9 * std::size_t(t) + 3 * c]);
+    const double centre[3] = {0.5 * (box[t].lo[0] + box[t].hi[0]), 0.5 * (box[t].lo[1] + box[t].hi[1]),
+                              0.5 * (box[t].lo[2] + box[t].hi[2])};
+    centres.grow(centre);
   }
-  auto range_bounds = [&](std::uint32_t begin, std::uint32_t end, Bounds& box, Bounds& cbox) {
-    box = cbox = Bounds{};
-    for (std::uint32_t i = begin; i < end; ++i) box.grow(items[i].box), cbox.grow(items[i].centroid);
-  };
+  // Morton codes of the centres on a 1024^3 grid over their box (one scale for all axes: cubic
+  // cells), triangles sorted by code, ties by index (a stable radix sort).
+  const double extent =
+      std::max({centres.hi[0] - centres.lo[0], centres.hi[1] - centres.lo[1], centres.hi[2] - centres.lo[2]});
+  const double scale = extent > 0 ? double(kGrid - 1) / extent : 0;
+  std::vector<std::uint32_t> code(n), order(n), scratch;
+  for (std::uint32_t t = 0; t < n; ++t) {
+    std::uint32_t m = 0;
+    for (int k = 0; k < 3; ++k) {
+      // Clamped before the conversion: NaN and out-of-range doubles must never reach the cast.
+      const double c = (0.5 * (box[t].lo[k] + box[t].hi[k]) - centres.lo[k]) * scale;
+      const std::uint64_t cell = c >= 0 ? std::uint64_t(std::min(c, double(kGrid - 1))) : 0;
+      m |= std::uint32_t(core::spread_bits_3d(cell)) << k;
+    }
+    code[t] = m;
+    order[t] = t;
+  }
+  core::radix_sort_by_key(order, scratch, [&](std::uint32_t t) { return code[t]; });
+  std::vector<std::uint32_t> sorted_code(n);
+  for (std::uint32_t i = 0; i < n; ++i) sorted_code[i] = code[order[i]];
 
+  // Top down: a range splits where its codes' highest differing bit turns on (a spatial median,
+  // as in an octree); a range of equal codes splits in half. The depth stays below 30 + log2(n).
   nodes_.reserve(2 * std::size_t(n) / kLeaf + 1);
   nodes_.push_back({});
   struct Task {
-    std::uint32_t node, begin, end, depth;
-    Bounds box, cbox;  ///< of the triangles and of their centroids, known from the parent's bins
+    std::uint32_t node, begin, end;
   };
-  std::vector<Task> stack{{0, 0, n, 0, root, root_c}};
+  std::vector<Task> stack{{0, 0, n}};
   while (!stack.empty()) {
     const Task task = stack.back();
     stack.pop_back();
-    const Bounds& cbounds = task.cbox;
-    Node& node = nodes_[task.node];
-    for (int k = 0; k < 3; ++k) node.lo[k] = task.box.lo[k], node.hi[k] = task.box.hi[k];
-    node.first = task.begin;
-    node.count = task.end - task.begin;
-    if (node.count <= kLeaf) continue;
-
-    // Binned SAH on the axis of largest centroid extent.
-    int axis = 0;
-    for (int k = 1; k < 3; ++k)
-      if (cbounds.hi[k] - cbounds.lo[k] > cbounds.hi[axis] - cbounds.lo[axis]) axis = k;
-    const double extent = cbounds.hi[axis] - cbounds.lo[axis];
+    nodes_[task.node].first = task.begin;
+    nodes_[task.node].count = task.end - task.begin;
+    if (task.end - task.begin <= kLeaf) continue;
+    const std::uint32_t lo_code = sorted_code[task.begin], hi_code = sorted_code[task.end - 1];
     std::uint32_t mid;
-    Bounds lbox, lcbox, rbox, rcbox;
-    bool bounds_known = false;
-    if (!(extent > 0)) {
-      // All centroids coincide: no plane separates them; halve by index to keep leaves small.
+    if (lo_code == hi_code) {
       mid = task.begin + (task.end - task.begin) / 2;
-    } else if (task.depth >= kSahDepth) {
-      mid = task.begin + (task.end - task.begin) / 2;
-      std::nth_element(items.begin() + task.begin, items.begin() + mid, items.begin() + task.end,
-                       [&](const Item& a, const Item& b) {
-                         return a.centroid[axis] < b.centroid[axis] ||
-                                (a.centroid[axis] == b.centroid[axis] && a.id < b.id);
-                       });
     } else {
-      const double scale = kBins / extent;
-      auto bin_of = [&](const Item& it) {
-        return std::min(kBins - 1, int((it.centroid[axis] - cbounds.lo[axis]) * scale));
-      };
-      Bounds bin_box[kBins], bin_cbox[kBins];
-      std::uint32_t bin_count[kBins] = {};
-      for (std::uint32_t i = task.begin; i < task.end; ++i) {
-        const int b = bin_of(items[i]);
-        bin_box[b].grow(items[i].box);
-        bin_cbox[b].grow(items[i].centroid);
-        ++bin_count[b];
-      }
-      // Sweep from the right for the suffix costs, then from the left to pick the cheapest plane.
-      double right_cost[kBins];
-      Bounds acc;
-      std::uint32_t cnt = 0;
-      for (int b = kBins - 1; b > 0; --b) {
-        acc.grow(bin_box[b]);
-        cnt += bin_count[b];
-        right_cost[b] = cnt ? acc.half_area() * cnt : 0;
-      }
-      acc = Bounds{};
-      cnt = 0;
-      int best = -1;
-      double best_cost = INFINITY;
-      for (int b = 0; b < kBins - 1; ++b) {
-        acc.grow(bin_box[b]);
-        cnt += bin_count[b];
-        const double cost = (cnt ? acc.half_area() * cnt : 0) + right_cost[b + 1];
-        if (cost < best_cost) best_cost = cost, best = b;
-      }
-      auto it = std::partition(items.begin() + task.begin, items.begin() + task.end,
-                               [&](const Item& item) { return bin_of(item) <= best; });
-      mid = std::uint32_t(it - items.begin());
-      if (mid == task.begin || mid == task.end) {
-        mid = task.begin + (task.end - task.begin) / 2;
-      } else {
-        for (int b = 0; b < kBins; ++b) {
-          (b <= best ? lbox : rbox).grow(bin_box[b]);
-          (b <= best ? lcbox : rcbox).grow(bin_cbox[b]);
-        }
-        bounds_known = true;
-      }
-    }
-    if (!bounds_known) {
-      range_bounds(task.begin, mid, lbox, lcbox);
-      range_bounds(mid, task.end, rbox, rcbox);
+      const std::uint32_t bit = std::uint32_t(1) << (31 - std::countl_zero(lo_code ^ hi_code));
+      // The codes share every bit above `bit`, so `bit` is off, then on, along the range.
+      mid =
+          std::uint32_t(std::partition_point(sorted_code.begin() + task.begin, sorted_code.begin() + task.end,
+                                             [&](std::uint32_t c) { return (c & bit) == 0; }) -
+                        sorted_code.begin());
     }
     const std::uint32_t left = std::uint32_t(nodes_.size());
     nodes_.push_back({});
     nodes_.push_back({});
-    nodes_[task.node].first = left;  // `node` may dangle after push_back: index again
+    nodes_[task.node].first = left;
     nodes_[task.node].count = 0;
-    stack.push_back({left + 1, mid, task.end, task.depth + 1, rbox, rcbox});
-    stack.push_back({left, task.begin, mid, task.depth + 1, lbox, lcbox});
+    stack.push_back({left + 1, mid, task.end});
+    stack.push_back({left, task.begin, mid});
+  }
+  // Boxes bottom up: children come after their parent in the array.
+  for (std::size_t i = nodes_.size(); i-- > 0;) {
+    Node& node = nodes_[i];
+    Bounds b;
+    if (node.count > 0) {
+      for (std::uint32_t k = node.first; k < node.first + node.count; ++k) b.grow(box[order[k]]);
+    } else {
+      for (std::uint32_t c = node.first; c < node.first + 2; ++c) {
+        const Node& child = nodes_[c];
+        for (int k = 0; k < 3; ++k)
+          b.lo[k] = std::min(b.lo[k], child.lo[k]), b.hi[k] = std::max(b.hi[k], child.hi[k]);
+      }
+    }
+    for (int k = 0; k < 3; ++k) node.lo[k] = b.lo[k], node.hi[k] = b.hi[k];
   }
 
   tris_.resize(9 * std::size_t(n));
-  ids_.resize(n);
+  ids_ = std::move(order);
   slot_of_.resize(n);
   for (std::uint32_t i = 0; i < n; ++i) {
-    ids_[i] = items[i].id;
     std::copy_n(&corners[9 * std::size_t(ids_[i])], 9, &tris_[9 * std::size_t(i)]);
     slot_of_[ids_[i]] = i;
   }

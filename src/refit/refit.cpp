@@ -259,6 +259,18 @@ class Refitter {
       ring_slot_[c] = fill[tri_[c]]++;
       ring_faces_[ring_slot_[c]] = std::uint32_t(c / 3);
     }
+    // A start for each vertex's search of the original: of the faces at the input vertices
+    // contracted into it (one each), the nearest.
+    if (surface_ && !near_vertex_.empty()) {
+      original_face_near_.assign(approx.vertex_count(), UINT32_MAX);
+      std::vector<double> nearest(approx.vertex_count(), HUGE_VAL);
+      for (std::size_t i = 0; i < near_vertex_.size(); ++i) {
+        const std::uint32_t v = near_vertex_[i], f = surface_->face_at(std::uint32_t(i));
+        if (v >= original_face_near_.size() || f == UINT32_MAX) continue;
+        const double d = surface_->distance_to(at(x_, v), f);
+        if (d < nearest[v]) nearest[v] = d, original_face_near_[v] = f;
+      }
+    }
     ready_ = true;
   }
 
@@ -539,15 +551,50 @@ class Refitter {
     return true;
   }
 
-  // The largest distance to the original over the vertices and face centroids of x.
-  double largest_distance(const std::vector<double>& x) const {
+  // The largest distance to the original over the vertices and face centroids of x. Leaves in
+  // guard_face_ a face of the original near each sample (the closest, where it was searched for),
+  // where the guard's searches start.
+  double largest_distance(const std::vector<double>& x) {
     const std::size_t n = approx_.vertex_count(), nf = tri_.size() / 3;
     std::vector<double> most(n + nf, 0.0);
-    core::for_chunks(n + nf, kChunk, core::resolve_threads(opt_.threads), [&](std::size_t, std::size_t begin, std::size_t end) {
-      std::uint32_t hint = UINT32_MAX;
-      for (std::size_t i = begin; i < end; ++i) most[i] = surface_->distance(sample(x, i), &hint);
-    });
+    guard_face_.assign(n + nf, UINT32_MAX);
+    core::for_chunks(n + nf, kChunk, core::resolve_threads(opt_.threads),
+                     [&](std::size_t, std::size_t begin, std::size_t end) {
+                       std::uint32_t last = UINT32_MAX;  // the chunk's last answer
+                       double most_here = 0;             // of this chunk, so far
+                       for (std::size_t i = begin; i < end; ++i) {
+                         const Vec3 p = sample(x, i);
+                         double start_distance;
+                         std::uint32_t face = start_face(p, i, last, start_distance);
+                         // No farther from its start face than the largest so far: it cannot be the largest
+                         // (its distance is at most that face's), and the search is skipped.
+                         if (face != UINT32_MAX && start_distance <= most_here) {
+                           guard_face_[i] = face;
+                           continue;
+                         }
+                         most[i] = surface_->distance(p, &face);
+                         guard_face_[i] = last = face;
+                         most_here = std::max(most_here, most[i]);
+                       }
+                     });
     return most.empty() ? 0.0 : *std::max_element(most.begin(), most.end());
+  }
+
+  // Where the search of the original for sample i (at p) starts: of a face of the original at an
+  // input vertex contracted into the sample's (first) vertex and `last`, the one nearer p
+  // (UINT32_MAX: neither), its distance in `d`. A search returns the closest face wherever it
+  // starts (ties by index): the start only saves work.
+  std::uint32_t start_face(const Vec3& p, std::size_t i, std::uint32_t last, double& d) const {
+    const std::size_t n = approx_.vertex_count();
+    const std::uint32_t v = i < n ? std::uint32_t(i) : tri_[3 * (i - n)];
+    std::uint32_t face = last;
+    d = face == UINT32_MAX ? HUGE_VAL : surface_->distance_to(p, face);
+    const std::uint32_t near = v < original_face_near_.size() ? original_face_near_[v] : UINT32_MAX;
+    if (near != UINT32_MAX && near != face) {
+      const double dn = surface_->distance_to(p, near);
+      if (dn < d) d = dn, face = near;
+    }
+    return face;
   }
 
   // Sample i of x: vertex i, or the centroid of face i - vertex count.
@@ -561,7 +608,7 @@ class Refitter {
   // Undoes the moves that take a vertex or a face centroid farther from the original than limit_,
   // or a face out of max_distance, until none does (each sweep that finds one undoes at least one
   // move). Returns the vertices held.
-  std::size_t hold_far_from_original(std::vector<double>& next) const {
+  std::size_t hold_far_from_original(std::vector<double>& next) {
     const std::size_t n = approx_.vertex_count(), nf = tri_.size() / 3;
     const auto moved = [&](std::uint32_t v) {
       return next[3 * v] != x_[3 * v] || next[3 * v + 1] != x_[3 * v + 1] || next[3 * v + 2] != x_[3 * v + 2];
@@ -570,17 +617,21 @@ class Refitter {
     std::vector<std::uint8_t> bad(n + nf);
     for (bool again = true; again;) {
       again = false;
-      core::for_chunks(n + nf, kChunk, core::resolve_threads(opt_.threads), [&](std::size_t, std::size_t begin, std::size_t end) {
-        std::uint32_t hint = UINT32_MAX;
-        for (std::size_t i = begin; i < end; ++i) {
-          bad[i] = 0;
-          const std::uint32_t* t = i < n ? nullptr : &tri_[3 * (i - n)];
-          if (t ? !(moved(t[0]) || moved(t[1]) || moved(t[2])) : !moved(std::uint32_t(i))) continue;
-          bad[i] = surface_->distance(sample(next, i), &hint) > limit_ ||
-                   (t && std::isfinite(max_distance_) &&
-                    !surface_->triangle_within(at(next, t[0]), at(next, t[1]), at(next, t[2]), max_distance_));
-        }
-      });
+      core::for_chunks(n + nf, kChunk, core::resolve_threads(opt_.threads),
+                       [&](std::size_t, std::size_t begin, std::size_t end) {
+                         for (std::size_t i = begin; i < end; ++i) {
+                           bad[i] = 0;
+                           const std::uint32_t* t = i < n ? nullptr : &tri_[3 * (i - n)];
+                           if (t ? !(moved(t[0]) || moved(t[1]) || moved(t[2])) : !moved(std::uint32_t(i)))
+                             continue;
+                           // The search starts at the sample's face from before the move (moves are small).
+                           std::uint32_t& face = guard_face_[i];
+                           bad[i] = !surface_->within(sample(next, i), limit_, face) ||
+                                    (t && std::isfinite(max_distance_) &&
+                                     !surface_->triangle_within(at(next, t[0]), at(next, t[1]),
+                                                                at(next, t[2]), max_distance_));
+                         }
+                       });
       const auto undo = [&](std::uint32_t v) {
         if (!moved(v)) return;
         for (int k = 0; k < 3; ++k) next[3 * v + k] = x_[3 * v + k];
@@ -629,6 +680,8 @@ class Refitter {
   std::span<const std::uint32_t> near_vertex_;
   const Frame frame_;      // of the points: x_ = frame_.to_frame(approx_'s positions)
   const core::SurfaceDistance* surface_;  // the original, in frame_ (null: no distance guard)
+  std::vector<std::uint32_t> original_face_near_;  // per vertex: a face of surface_ near it, or UINT32_MAX
+  std::vector<std::uint32_t> guard_face_;  // per sample (largest_distance): where its next search starts
   const double max_distance_;             // RefitOptions::max_distance in frame_
   double limit_ = HUGE_VAL;               // a sample may not move farther than this from the original
   double far_ = HUGE_VAL;                 // a point farther than this from the approximation pulls nothing
@@ -667,12 +720,14 @@ void check_options(const RefitOptions& options) {
 core::SurfaceDistance surface_in_frame(std::span<const double> positions, std::span<const std::uint32_t> indices,
                                        const Frame& frame) {
   std::vector<double> corners(3 * indices.size());
+  std::vector<std::uint32_t> face_at(positions.size() / 3, UINT32_MAX);
   for (std::size_t c = 0; c < indices.size(); ++c) {
     const double* p = &positions[3 * std::size_t(indices[c])];
     const Vec3 q = frame.to_frame({p[0], p[1], p[2]});
     corners[3 * c] = q.x, corners[3 * c + 1] = q.y, corners[3 * c + 2] = q.z;
+    if (face_at[indices[c]] == UINT32_MAX) face_at[indices[c]] = std::uint32_t(c / 3);
   }
-  return core::SurfaceDistance(corners);
+  return core::SurfaceDistance(corners, std::move(face_at));
 }
 
 RefitResult refit_to_points(const FitPoints& points, Mesh& approx, const RefitOptions& options,
