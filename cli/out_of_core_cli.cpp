@@ -6,6 +6,7 @@
 #include <cstdlib>
 
 #include "cli_util.h"
+#include "partition_cli.h"
 #include "qem/error.h"
 #include "qem/io.h"
 #include "qem/out_of_core.h"
@@ -39,21 +40,7 @@ int run_out_of_core(const std::string& input, const std::string& output, const S
   if (!args.memory_limit.empty()) ooc.memory_limit = parse_memory_size(args.memory_limit);
   ooc.temp_dir = args.temp_dir;
   ooc.phase2_faces_per_target = args.phase2_size;
-  if (args.partition == "off")
-    ooc.parts = 1;
-  else if (args.partition != "auto") {
-    std::size_t used = 0;
-    unsigned long parts = 0;
-    try {
-      parts = std::stoul(args.partition, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != args.partition.size() || parts == 0 || parts > 4096)
-      throw Error("--partition must be auto, off or a number of parts from 1 to 4096, not '" +
-                  args.partition + "'");
-    ooc.parts = unsigned(parts);
-  }
+  ooc.parts = asked_parts(args.partition);  // 0 = automatic
   if (ooc.temp_dir.empty() && !std::getenv("TMPDIR")) {
     const auto slash = output.find_last_of('/');
     ooc.temp_dir = slash == std::string::npos ? "." : output.substr(0, slash + 1);

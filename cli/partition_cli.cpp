@@ -17,21 +17,27 @@ void add_partition_option(CLI::App* sub, PartitionArgs& args) {
       ->capture_default_str();
 }
 
-unsigned choose_parts(const PartitionArgs& args, MeshView mesh, const SimplifyOptions& options, bool record) {
-  if (args.partition == "off") return 1;
-  if (args.partition == "auto") {
-    if (record || !partition_refusal(mesh, options).empty()) return 1;
-    return automatic_parts(mesh.face_count());
-  }
+unsigned asked_parts(const std::string& partition) {
+  if (partition == "auto") return 0;
+  if (partition == "off") return 1;
   std::size_t used = 0;
   unsigned long parts = 0;
   try {
-    parts = std::stoul(args.partition, &used);
+    parts = std::stoul(partition, &used);
   } catch (const std::exception&) {
     used = 0;
   }
-  if (used != args.partition.size() || parts == 0 || parts > 4096)
-    throw Error("--partition must be auto, off or a number of parts from 1 to 4096, not '" + args.partition + "'");
+  if (used != partition.size() || parts == 0 || parts > 4096)
+    throw Error("--partition must be auto, off or a number of parts from 1 to 4096, not '" + partition + "'");
+  return unsigned(parts);
+}
+
+unsigned choose_parts(const PartitionArgs& args, MeshView mesh, const SimplifyOptions& options, bool record) {
+  const unsigned parts = asked_parts(args.partition);
+  if (parts == 0) {
+    if (record || !partition_refusal(mesh, options).empty()) return 1;
+    return automatic_parts(mesh.face_count());
+  }
   if (parts == 1) return 1;
   if (record)
     throw Error("--partition " + args.partition +

@@ -17,6 +17,10 @@ struct PartitionArgs {
 
 void add_partition_option(CLI::App* sub, PartitionArgs& args);
 
+/// The number --partition asks for: 0 for `auto`, 1 for `off`, else N (1 to 4096); throws
+/// qem::Error for anything else.
+unsigned asked_parts(const std::string& partition);
+
 /// The number of parts for this run, 1 = in core: `off` and `1` give 1; `auto` gives
 /// automatic_parts(faces) when the mesh and options allow a partition (partition_refusal) and no
 /// record is kept, else 1; a number N > 1 gives N, and throws qem::Error saying why when the mesh
