@@ -142,10 +142,17 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
   // drawn. Every run of a primitive (watched and final) has the same bound, so that they refuse the
   // same contractions.
   const bool relative_per_primitive = gltf_options.per_primitive && options.max_distance_is_relative;
+  // The scene's diagonal, for the relative criteria of the shared mode (merging the scene is not
+  // free: done once, and only when needed).
+  const bool scene_relative = !gltf_options.per_primitive &&
+                              ((options.max_distance_is_relative && std::isfinite(options.max_distance)) ||
+                               (options.max_error_is_relative && std::isfinite(options.max_error)));
+  const double scene_diagonal = scene_relative ? bounding_box(doc.scene_mesh()).diagonal() : 1;
   double world_max_distance = options.max_distance;
   if (options.max_distance_is_relative && std::isfinite(world_max_distance) && !gltf_options.per_primitive)
-    world_max_distance *= bounding_box(doc.scene_mesh()).diagonal();
-  const auto with_shared_locks = [&](SimplifyOptions o, std::size_t j) {
+    world_max_distance *= scene_diagonal;
+  // The options every run of primitive j starts from: its shared-vertex locks and the bound.
+  const auto primitive_options = [&](SimplifyOptions o, std::size_t j) {
     if (!shared[j].empty()) o.vertex_lock = shared[j];
     if (!relative_per_primitive) {
       o.max_distance = local_error(world_max_distance, info[jobs[j]].world_scale);
@@ -157,14 +164,14 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
   // The error limit in world units (relative: of the scene's diagonal, in shared mode).
   double world_max_error = options.max_error;
   if (options.max_error_is_relative && std::isfinite(world_max_error) && !gltf_options.per_primitive)
-    world_max_error *= bounding_box(doc.scene_mesh()).diagonal();
+    world_max_error *= scene_diagonal;
 
   // Per primitive: the options of its final run, and (shared budget) its watched run's curve.
   std::vector<std::optional<SimplifyOptions>> final_options(jobs.size());
   std::vector<ErrorCurve> curves;
   if (gltf_options.per_primitive) {
     for (std::size_t j = 0; j < jobs.size(); ++j) {
-      SimplifyOptions o = with_shared_locks(options, j);
+      SimplifyOptions o = primitive_options(options, j);
       o.threads = inner_threads;
       if (!o.max_error_is_relative) o.max_error = local_error(o.max_error, info[jobs[j]].world_scale);
       final_options[j] = o;
@@ -188,7 +195,7 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
 
     if (jobs.size() == 1) {
       // One primitive: the scene's target is its own, and there is nothing to share.
-      SimplifyOptions o = with_shared_locks(options, 0);
+      SimplifyOptions o = primitive_options(options, 0);
       o.target_ratio = 0, o.target_vertices = 0;
       o.target_faces = face_target ? std::max<std::size_t>(1, target) : 0;
       o.max_error = local_error(world_max_error, info[jobs[0]].world_scale);
@@ -202,7 +209,7 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
           face_target && total_faces > 0 ? 0.25 * double(target) / double(total_faces) : 0;
       auto watch = [&](std::size_t j, std::size_t floor_faces) {
         curves[j] = ErrorCurve(info[jobs[j]].world_scale);
-        SimplifyOptions o = with_shared_locks(options, j);
+        SimplifyOptions o = primitive_options(options, j);
         o.target_ratio = 0, o.target_vertices = 0;
         o.target_faces = std::max<std::size_t>(1, floor_faces);
         o.max_error = local_error(world_max_error, info[jobs[j]].world_scale);
@@ -281,7 +288,7 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
       // same error limit, which blocks the same pairs.
       for (std::size_t j = 0; j < jobs.size(); ++j) {
         if (faces[j] >= curves[j].initial) continue;  // nothing to do: left as it is
-        SimplifyOptions o = with_shared_locks(options, j);
+        SimplifyOptions o = primitive_options(options, j);
         o.target_ratio = 0, o.target_vertices = 0;
         o.target_faces = std::max<std::size_t>(1, faces[j]);
         o.max_error = local_error(world_max_error, info[jobs[j]].world_scale);

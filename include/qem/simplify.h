@@ -200,8 +200,8 @@ struct SimplifyOptions {
   /// off the seams, by least squares, to the input's attributes at the output's points closest to
   /// points of the input's faces (Hoppe 1996 §4.2; docs/attributes.md, "The attribute fit").
   /// Positions and faces are not changed. Off by default: it keeps the input's attributes and
-  /// faces through the run and adds a projection per input face (+11 % memory, about +20 % time
-  /// on a 1M-face mesh with normals and UVs; docs/attributes.md).
+  /// faces through the run and adds a projection per input face, whose cost on a large mesh was
+  /// not measured on a quiet machine yet (docs/attributes.md, docs/benchmarks.md).
   bool fit_attributes = false;
 
   /// Fill SimplifyResult::output_vertex_of_input (one entry per input vertex).
