@@ -206,6 +206,35 @@ TEST(Borders, SlidBorderVertexLiesOnAnInputBorderEdge) {
   EXPECT_GT(slid, 0u);
 }
 
+// A border vertex contracted with an interior vertex may slide along its own polyline
+// (border_placement.h, place_on_own_border), not only stay. Every other border vertex of the half
+// disc is locked (a hard corner), so no border vertex can slide along a border edge: an unlocked
+// one either stays, goes into a locked neighbour, or slides with an interior vertex. Some do, and
+// each lies on an input border edge.
+TEST(Borders, BorderVertexSlidesWithAnInteriorOne) {
+  const Mesh in = half_disc();
+  const std::vector<std::pair<Point, Point>> in_border = border_edges(in);
+  std::set<Point> inputs;
+  for (std::size_t v = 0; v < in.vertex_count(); ++v) inputs.insert(vertex(in, v));
+  std::vector<std::uint8_t> lock(in.vertex_count(), 0);
+  std::set<std::uint32_t> on_border;
+  for (const auto& [edge, n] : test::edge_face_counts(in))
+    if (n == 1) on_border.insert(edge.first), on_border.insert(edge.second);
+  for (std::uint32_t v : on_border) lock[v] = v % 2;
+  SimplifyOptions o;
+  o.target_ratio = 0.1;
+  o.refit_rounds = 0;
+  o.vertex_lock = lock;
+  const SimplifyResult r = simplify(in, o);
+  std::size_t slid = 0;
+  for (std::uint32_t v : border_vertices(r.mesh)) {
+    const Point p = vertex(r.mesh, v);
+    EXPECT_LE(distance_to_edges(p, in_border), 2e-12) << "vertex " << v;
+    slid += !inputs.count(p);
+  }
+  EXPECT_GT(slid, 0u);
+}
+
 /// The bumpy square (20 x 20 cells) with two square holes: a small one (cell 4, 4) and a large one
 /// (cells 10-14 in both directions).
 Mesh square_with_holes() {

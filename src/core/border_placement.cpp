@@ -236,48 +236,78 @@ void update_border_after_closing(WorkingMesh& m, std::uint32_t v) {
   m.border_spot[v] = BorderSpot{};
 }
 
+namespace {
+
+// Appends, for each piece of input border (the way from u to v, border_between), the minimiser of
+// q along it (GH97 §4's segment placement) unless it is the way's start or end (u's and v's own
+// places, which the caller handles).
+template <class ErrorAt>
+void add_piece_minima(const BorderChains& ch, const std::vector<Piece>& pieces, const Quadric& q, const ErrorAt& error_at,
+                      std::vector<Placed>& cand) {
+  const double trace = q.a00 + q.a11 + q.a22;
+  for (std::size_t i = 0; i < pieces.size(); ++i) {
+    const Piece& p = pieces[i];
+    // Q along the edge, x + s d: Q(x) + 2 s (A x + b).d + s^2 d^T A d (as place_on_segment).
+    const Vec3 x = ch.pos[p.x], d = ch.pos[p.y] - x;
+    const double curvature = dot(d, q.apply_a(d));
+    double s;
+    if (curvature > 1e-12 * trace * dot(d, d)) {
+      const Vec3 g = q.apply_a(x) + Vec3(q.b0, q.b1, q.b2);
+      s = std::clamp(-dot(g, d) / curvature, p.lo, p.hi);
+    } else {
+      s = q.evaluate(x + d * p.lo) <= q.evaluate(x + d * p.hi) ? p.lo : p.hi;
+    }
+    if ((i == 0 && s == p.lo) || (i + 1 == pieces.size() && s == p.hi)) continue;  // u or v: the caller's
+    BorderSpot spot{p.x, p.y, s};
+    if (s == 0) spot = {p.x, kNoSlot, 0};
+    if (s == 1) spot = {p.y, kNoSlot, 0};
+    const Vec3 at = ch.at(spot);
+    cand.push_back({at, error_at(at), spot});
+  }
+}
+
+// The lowest-error candidate that keeps every face's side (GH97 §6); if none does, the lowest
+// (refused later). Stable: ties go to the earlier.
+void choose(const Context& c, std::uint32_t a, std::uint32_t b, std::vector<Placed>& cand, Placed& placed) {
+  std::stable_sort(cand.begin(), cand.end(), [](const Placed& l, const Placed& r) { return l.error < r.error; });
+  for (const Placed& k : cand)
+    if (!flips(c.mesh, a, b, k.position, c.settings.cos_max_turn)) {
+      placed = k;
+      return;
+    }
+  placed = cand.front();
+}
+
+}  // namespace
+
 void place_along_border(const Context& c, std::uint32_t a, std::uint32_t b, const Quadric& q, Placed& placed) {
   const WorkingMesh& m = c.mesh;
-  const BorderChains& ch = m.chains;
-  std::vector<Placed> cand;  // stable-sorted below: ties go to the earlier
+  std::vector<Placed> cand;
   // Each candidate's error: Q there, or a soft corner's size if it removes one (corner_error).
   const auto error_at = [&](const Vec3& x) { return std::max(q.evaluate(x), corner_error(c, a, b, x, q.weight)); };
   cand.push_back({m.pos[a], error_at(m.pos[a]), m.border_spot[a]});
   cand.push_back({m.pos[b], error_at(m.pos[b]), m.border_spot[b]});
   const BorderSpot& u = m.border_spot[a];
   const BorderSpot& v = m.border_spot[b];
-  if (u.from != kNoSlot && v.from != kNoSlot) {
-    const std::vector<Piece> pieces = border_between(ch, u, v);
-    const double trace = q.a00 + q.a11 + q.a22;
-    for (std::size_t i = 0; i < pieces.size(); ++i) {
-      const Piece& p = pieces[i];
-      // Q along the edge, x + s d: Q(x) + 2 s (A x + b).d + s^2 d^T A d (as place_on_segment).
-      const Vec3 x = ch.pos[p.x], d = ch.pos[p.y] - x;
-      const double curvature = dot(d, q.apply_a(d));
-      double s;
-      if (curvature > 1e-12 * trace * dot(d, d)) {
-        const Vec3 g = q.apply_a(x) + Vec3(q.b0, q.b1, q.b2);
-        s = std::clamp(-dot(g, d) / curvature, p.lo, p.hi);
-      } else {
-        s = q.evaluate(x + d * p.lo) <= q.evaluate(x + d * p.hi) ? p.lo : p.hi;
-      }
-      if ((i == 0 && s == p.lo) || (i + 1 == pieces.size() && s == p.hi)) continue;  // u or v: above
-      BorderSpot spot{p.x, p.y, s};
-      if (s == 0) spot = {p.x, kNoSlot, 0};
-      if (s == 1) spot = {p.y, kNoSlot, 0};
-      const Vec3 at = ch.at(spot);
-      cand.push_back({at, error_at(at), spot});
-    }
+  if (u.from != kNoSlot && v.from != kNoSlot) add_piece_minima(m.chains, border_between(m.chains, u, v), q, error_at, cand);
+  choose(c, a, b, cand, placed);
+}
+
+void place_on_own_border(const Context& c, std::uint32_t a, std::uint32_t b, const Quadric& q, Placed& placed) {
+  const WorkingMesh& m = c.mesh;
+  std::vector<Placed> cand;
+  cand.push_back({m.pos[a], q.evaluate(m.pos[a]), m.border_spot[a]});
+  const BorderSpot& u = m.border_spot[a];
+  if (u.from != kNoSlot && !(u.to == kNoSlot && m.chains.corner[u.from])) {
+    const auto error_at = [&](const Vec3& x) { return q.evaluate(x); };
+    // a's two neighbours along the current border; it may slide toward either, short of it.
+    const std::uint32_t n0 = other_border_neighbour(m, a, kNoVertex);
+    const std::uint32_t n1 = n0 == kNoVertex ? kNoVertex : other_border_neighbour(m, a, n0);
+    for (std::uint32_t n : {n0, n1})
+      if (n != kNoVertex && m.border_spot[n].from != kNoSlot)
+        add_piece_minima(m.chains, border_between(m.chains, u, m.border_spot[n]), q, error_at, cand);
   }
-  std::stable_sort(cand.begin(), cand.end(),
-                   [](const Placed& l, const Placed& r) { return l.error < r.error; });
-  // The lowest error that keeps every face's side (GH97 §6); if none does, the lowest (refused).
-  for (const Placed& k : cand)
-    if (!flips(m, a, b, k.position, c.settings.cos_max_turn)) {
-      placed = k;
-      return;
-    }
-  placed = cand.front();
+  choose(c, a, b, cand, placed);
 }
 
 }  // namespace qem::core

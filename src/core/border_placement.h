@@ -4,7 +4,10 @@
 // the plane of a flat patch; tiles simplified one by one then no longer meet. Here the planes
 // still rank the contractions (they say what cutting a curved border costs), but a contraction
 // that involves a border vertex is placed on the input's border (border_chains.h):
-//   - a border vertex and an interior one: at the border vertex;
+//   - a border vertex and an interior one: at the minimiser of the quadric restricted to the
+//     border vertex's own input border between its two current border neighbours (neither
+//     reached), or at the border vertex, whichever has the lowest error and flips no face
+//     (place_on_own_border; a corner stays at its place);
 //   - the two ends of a border edge: at the minimiser of the quadric restricted to the input
 //     border between them (each input border edge of that stretch, GH97 §4's segment placement
 //     on each), or at either end, whichever has the lowest error and turns no face by more than
@@ -57,6 +60,11 @@ void mark_border_corners(WorkingMesh& mesh, const std::vector<Edge>& edges);
 /// The placement of border edge (a, b) whose ends may both move (BorderTarget::AtEither): the
 /// lowest-error non-flipping point of the input border between them, ends included (above).
 void place_along_border(const Context& c, std::uint32_t a, std::uint32_t b, const Quadric& q, Placed& placed);
+
+/// The placement of (a, b) where a is a border vertex (not a corner) and b an interior one: the
+/// lowest-error non-flipping point of a's own input border between its two current border
+/// neighbours (neither reached), a's place included: a slides along its polyline.
+void place_on_own_border(const Context& c, std::uint32_t a, std::uint32_t b, const Quadric& q, Placed& placed);
 
 /// mesh.corner values: a hard corner (a border's end, a vertex where borders meet, on a
 /// non-manifold edge) is never removed nor moved; a soft one (a turn above kCornerDegrees) stays

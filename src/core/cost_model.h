@@ -52,9 +52,17 @@ inline bool place_pair(const Context& c, std::uint32_t p, Quadric& q, Placed& pl
     case BorderTarget::Free: break;
     case BorderTarget::Never: return false;
     case BorderTarget::AtA:  // b may be a soft corner that leaves (corner_error)
+      if (border_detail::role(c, a) == border_detail::Role::Border && !m.boundary[b]) {  // a slides along its border
+        place_on_own_border(c, a, b, q, placed);
+        return true;
+      }
       placed = {m.pos[a], std::max(q.evaluate(m.pos[a]), corner_error(c, a, b, m.pos[a], q.weight))};
       return true;
     case BorderTarget::AtB:
+      if (border_detail::role(c, b) == border_detail::Role::Border && !m.boundary[a]) {
+        place_on_own_border(c, b, a, q, placed);
+        return true;
+      }
       placed = {m.pos[b], std::max(q.evaluate(m.pos[b]), corner_error(c, a, b, m.pos[b], q.weight))};
       return true;
     case BorderTarget::AtEither:
