@@ -81,6 +81,27 @@ inline bool place_pair(const Context& c, std::uint32_t p, Quadric& q, Placed& pl
   return true;
 }
 
+/// Whether pair p can never be contracted, whatever happens around it: both ends held (a locked
+/// border, vertex_lock) or, under exact borders, both hard corners. place_pair's other refusals
+/// last only as long as the neighbourhood that causes them: a collapse that would move or close a
+/// seam is allowed once the faces on one side of the seam are gone (Wedges::drop_unused), and two
+/// border vertices joined by an interior edge share a border edge once the vertex between them is
+/// gone. Those pairs are blocked (retried when their neighbourhood changes), not locked.
+inline bool never_contracts(const Context& c, std::uint32_t p) {
+  using border_detail::Role;
+  const std::uint32_t a = c.pairs.pairs[p].v[0], b = c.pairs.pairs[p].v[1];
+  const WorkingMesh& m = c.mesh;
+  if (m.held(a, c.settings.lock_border) && m.held(b, c.settings.lock_border)) return true;
+  return c.settings.exact_border && !m.corner.empty() && border_detail::role(c, a) == Role::Fixed &&
+         border_detail::role(c, b) == Role::Fixed;
+}
+
+/// Pair p was refused a placement (pair_cost false): locked if it never_contracts, else blocked
+/// (its ends' has_blocked are set by the caller, see PairSet::block).
+inline PairState refused_state(const Context& c, std::uint32_t p) {
+  return never_contracts(c, p) ? kLocked : kBlocked;
+}
+
 /// The ranking key of pair p: the quadric error at its placement, plus, when inversions are
 /// penalised and it would flip a face, a penalty that sorts it after every clean contraction.
 inline bool pair_cost(const Context& c, std::uint32_t p, double& cost) {

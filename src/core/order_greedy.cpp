@@ -23,8 +23,9 @@ struct GreedyLists {
   void pair_removed(std::uint32_t p) { heap.remove(p); }
   void pair_changed(std::uint32_t p) {
     double cost;
-    if (!pair_cost(c, p, cost)) {
-      c.pairs.pairs[p].state = kLocked;
+    if (!pair_cost(c, p, cost)) {  // never (locked), or not while its neighbourhood stays (blocked)
+      if (refused_state(c, p) == kBlocked) c.pairs.block(p);
+      else c.pairs.pairs[p].state = kLocked;
       heap.remove(p);
       return;
     }
@@ -56,6 +57,7 @@ void run_greedy(Context& c, const std::vector<std::uint8_t>* stale) {
     }
     double cost;
     if (pair_cost(c, p, cost)) heap.push_unordered(p, cost), ps.cost[p] = float(cost);
+    else if (refused_state(c, p) == kBlocked) ps.block(p);
     else ps.pairs[p].state = kLocked;
   }
   heap.heapify();

@@ -24,19 +24,29 @@ constexpr double kPassCostSlack = 1.5;   // times the cost at that share, at the
 constexpr std::size_t kBands = 8;
 
 // The cost of every pair marked dirty, on all threads (each pair is independent, so the result
-// does not depend on the thread count).
+// does not depend on the thread count). A pair refused a placement is locked or blocked
+// (refused_state); the blocked ones' ends are marked afterwards, in one thread (two pairs of one
+// vertex may sit in different chunks).
 void recost_dirty_pairs(Context& c, PassState& s) {
   PairSet& ps = c.pairs;
-  for_chunks(ps.pairs.size(), std::size_t(1) << 16, c.settings.threads, [&](std::size_t, std::size_t begin, std::size_t end) {
+  constexpr std::size_t kChunk = std::size_t(1) << 16;
+  std::vector<std::vector<std::uint32_t>> blocked((ps.pairs.size() + kChunk - 1) / kChunk);
+  for_chunks(ps.pairs.size(), kChunk, c.settings.threads, [&](std::size_t chunk, std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       const std::uint32_t p = std::uint32_t(i);
       if (ps.pairs[p].state != kCandidate || !s.dirty[p]) continue;
       s.dirty[p] = 0;
       double cost;
-      if (pair_cost(c, p, cost)) ps.cost[p] = float(cost);
-      else ps.pairs[p].state = kLocked;
+      if (pair_cost(c, p, cost)) {
+        ps.cost[p] = float(cost);
+      } else {
+        ps.pairs[p].state = refused_state(c, p);
+        if (ps.pairs[p].state == kBlocked) blocked[chunk].push_back(p);
+      }
     }
   });
+  for (const std::vector<std::uint32_t>& list : blocked)
+    for (std::uint32_t p : list) ps.block(p);
 }
 
 // This pass's contractions: the candidates sorted by cost (a radix sort), then, cheapest first,

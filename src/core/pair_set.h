@@ -15,7 +15,7 @@ enum PairState : std::uint8_t {
   kCandidate,  // may be contracted; ranked by its cost
   kBlocked,    // rejected at its last check (topology, inversion, error limit); retried when its
                // neighbourhood changes
-  kLocked,     // can never be contracted (both ends on a locked border)
+  kLocked,     // can never be contracted (both ends held or hard corners: never_contracts)
   kDead,       // contracted, or merged into a duplicate
 };
 
