@@ -342,7 +342,8 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
              max_turn: float = 75.0, allow_non_manifold: bool = False, scheme: str = "passes",
              refit="light", threads: int = 0, keep_components: bool = True, prune: Optional[float] = None,
              prune_relative: Optional[float] = None, exact_border: bool = True, attributes: Optional[dict] = None,
-             attribute_weights: Optional[dict] = None, vertex_lock=None, return_mapping: bool = False,
+             attribute_weights: Optional[dict] = None, fit_attributes: bool = False, vertex_lock=None,
+             return_mapping: bool = False,
              record: bool = False, progress: Optional[Callable[[float], Optional[bool]]] = None) -> SimplifyResult:
     """Simplifies a triangle mesh by quadric-error pair contraction (Garland & Heckbert 1997).
 
@@ -394,6 +395,10 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
       attribute_weights: {"normal": w, "uv": w, "color": w, "scalar": w}: what a unit of each
         attribute costs against a unit of distance (1/w costs one bounding-box diagonal); the
         library's defaults otherwise.
+      fit_attributes: after the run (and the refit), fit each off-seam vertex's attribute values by
+        least squares to the input's values at the points of the output closest to the input's
+        faces (Hoppe 1996 §4.2; the command line's --attribute-fit). Positions and faces stay; seam
+        and locked vertices keep their values. Off by default (docs/attributes.md, "The attribute fit").
       vertex_lock: (n,) truth values: a locked vertex never moves and is never removed.
       return_mapping: fill result.vertex_source, face_source and output_vertex_of_input.
       record: keep the contraction sequence in result.record (a qem.Record; no refit then).
@@ -426,6 +431,7 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
     if refit == "light" and attributes:
         options.refit_rounds = 0
     options.map_input_vertices = bool(return_mapping)
+    options.fit_attributes = bool(fit_attributes)
     if attribute_weights is not None:
         options.attribute_weights = attribute_weights
     d = _qem.simplify(vertices, faces, options, _attribute_list(attributes), bool(record), progress, vertex_lock)

@@ -93,6 +93,10 @@ class Measure:
     area_approx: float
     samples_original: int
     samples_approx: int
+    uv_rms: Optional[float]
+    normal_rms_deg: Optional[float]
+    color_rms: Optional[float]
+    seam_cracks: int
 
 class Info:
     vertices: int
@@ -148,8 +152,10 @@ def simplify(
     keep_components: bool = ...,
     prune: Optional[float] = ...,
     prune_relative: Optional[float] = ...,
+    exact_border: bool = ...,
     attributes: Optional[Mapping[str, Union[np.ndarray, Tuple[np.ndarray, str]]]] = ...,
     attribute_weights: Optional[Mapping[str, float]] = ...,
+    fit_attributes: bool = ...,
     vertex_lock: Optional[npt.ArrayLike] = ...,
     return_mapping: bool = ...,
     record: bool = ...,
