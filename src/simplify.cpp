@@ -17,7 +17,6 @@
 #include "refit/attribute_fit.h"
 #include "refit/refit_after_simplify.h"
 #include "refit/refit_points.h"
-#include "simplify_carried.h"
 
 namespace qem {
 
@@ -118,8 +117,7 @@ RefitResult refit_with_seams(const refit_detail::FitPoints& points, SimplifyResu
 
 SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options, SimplifyObserver* observer,
                                   std::vector<std::uint32_t>* consumed_indices,
-                                  std::vector<VertexAttribute>* consumed_attributes,
-                                  const core::CarriedQuadrics* carried = nullptr) {
+                                  std::vector<VertexAttribute>* consumed_attributes) {
   check_options(options);
   const bool refit = options.refit_rounds > 0;
   const bool bounded = std::isfinite(options.max_distance);
@@ -137,7 +135,6 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
   hooks.observer = observer;
   hooks.consumed_indices = consumed_indices;
   hooks.consumed_attributes = consumed_attributes;
-  hooks.carried_quadrics = carried;
   hooks.map_input_vertices = refit || fit_values;
   core::WedgeRefitData wedge_refit;  // with attributes, for the refit and the attribute fit
   if ((refit || fit_values) && !input.attributes.empty()) hooks.wedge_refit = &wedge_refit;
@@ -203,20 +200,6 @@ SimplifyResult simplify(Mesh&& input, const SimplifyOptions& options, SimplifyOb
   out.mesh.material_library = std::move(input.material_library);
   return out;
 }
-
-namespace detail {
-
-SimplifyResult simplify_carrying(MeshView input, const SimplifyOptions& options, const core::CarriedQuadrics& carried,
-                                 SimplifyObserver* observer) {
-  return simplify_and_refit(input, options, observer, nullptr, nullptr, &carried);
-}
-
-SimplifyResult simplify_carrying(Mesh&& input, const SimplifyOptions& options, const core::CarriedQuadrics& carried,
-                                 SimplifyObserver* observer) {
-  return simplify_and_refit(input, options, observer, &input.indices, &input.attributes, &carried);
-}
-
-}  // namespace detail
 
 void ContractionRecorder::on_start(std::span<const std::uint32_t> input_faces) {
   log = ContractionLog{};

@@ -43,11 +43,6 @@ struct OutOfCoreOptions {
   /// Parts of phase 2 (qem/partition.h): 0 = automatic_parts of the clustered faces (when the
   /// options allow a partitioned run), 1 = one in-core run.
   unsigned parts = 0;
-  /// Garland & Shaffer 2002 §3: phase 2 starts each vertex from its cell's quadric (the planes of
-  /// every input face that touched the cell) instead of the clustered faces' own, when the options
-  /// weight by area (the cells' quadrics are area-weighted). false: from the clustered faces, as
-  /// before (for comparison; it also leaves the budget the quadrics' 88 bytes a cell).
-  bool carry_quadrics = true;
   /// Called about once a second (and at each phase change); returning false cancels the run
   /// (qem::Error "cancelled"), after which no temporary file is left.
   std::function<bool(const OutOfCoreProgress&)> progress;

@@ -36,25 +36,6 @@ std::vector<Quadric> face_quadrics(const WorkingMesh& m, Weighting weighting) {
   return quadric;
 }
 
-std::vector<Quadric> carried_quadrics(const WorkingMesh& m, const CarriedQuadrics& carried) {
-  // Q(p - origin) with p = center + scale x: Q = scale^2 x^T A x + 2 scale x.(A t + b) + Q(t),
-  // t = center - origin; the frame's quadric is that over scale^4 (weights over scale^2).
-  const Vec3 t = m.frame.center - carried.origin;
-  const double s = m.frame.scale, s2 = s * s, s3 = s2 * s, s4 = s2 * s2;
-  std::vector<Quadric> quadric(m.pos.size());
-  for (std::uint32_t v = 0; v < m.pos.size(); ++v) {
-    const Quadric& q = carried.per_vertex[m.source_vertex[v]];
-    const Vec3 at = q.apply_a(t);
-    Quadric& f = quadric[v];
-    f.a00 = q.a00 / s2, f.a01 = q.a01 / s2, f.a02 = q.a02 / s2;
-    f.a11 = q.a11 / s2, f.a12 = q.a12 / s2, f.a22 = q.a22 / s2;
-    f.b0 = (at.x + q.b0) / s3, f.b1 = (at.y + q.b1) / s3, f.b2 = (at.z + q.b2) / s3;
-    f.c = (dot(t, at) + 2 * (q.b0 * t.x + q.b1 * t.y + q.b2 * t.z) + q.c) / s4;
-    f.weight = q.weight / s2;
-  }
-  return quadric;
-}
-
 void add_boundary_planes(WorkingMesh& m, const std::vector<Edge>& edges, double weight, Weighting weighting,
                          std::vector<Quadric>& quadric) {
   for (const Edge& e : edges) {

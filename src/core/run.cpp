@@ -57,12 +57,6 @@ void lock_vertices(std::span<const std::uint8_t> lock, MeshView input, const Wed
 
 SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHooks& hooks) {
   validate(options);
-  if (hooks.carried_quadrics) {
-    if (!input.attributes.empty()) throw Error("carried quadrics are for meshes without vertex attributes");
-    if (hooks.carried_quadrics->per_vertex.size() != input.vertex_count())
-      throw Error("carried quadrics: " + std::to_string(hooks.carried_quadrics->per_vertex.size()) + " for " +
-                  std::to_string(input.vertex_count()) + " vertices");
-  }
   SimplifyResult result;
   std::vector<std::uint32_t> internal;  // with attributes: each input vertex's working vertex
   WorkingMesh mesh = prepare_input(input, &internal);  // check, drop degenerate and duplicate faces, frame
@@ -112,11 +106,7 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   mesh.rebuild_face_lists();
   std::vector<Edge> edges;
   side_by_side(  // GH97 §5 (HG99 §2) and the edges of §3.2: independent, so side by side
-      settings.threads,
-      [&] {
-        quadric = hooks.carried_quadrics ? carried_quadrics(mesh, *hooks.carried_quadrics)
-                                         : face_quadrics(mesh, settings.weighting);
-      },
+      settings.threads, [&] { quadric = face_quadrics(mesh, settings.weighting); },
       [&] { edges = unique_edges(mesh.tri, mesh.vertex_faces, mesh.vertex_count()); });
   add_boundary_planes(mesh, edges, settings.boundary_weight, settings.weighting, quadric);  // GH97 §6
   if (settings.exact_border) mark_border_corners(mesh, edges);

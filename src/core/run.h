@@ -6,7 +6,6 @@
 #include <functional>
 #include <vector>
 
-#include "core/fundamental_quadrics.h"
 #include "core/wedges.h"
 #include "qem/simplify.h"
 
@@ -29,9 +28,6 @@ struct RunHooks {
   bool map_input_vertices = false;
   /// With attributes: filled with what the refit needs of each output vertex (wedges.h).
   WedgeRefitData* wedge_refit = nullptr;
-  /// Initial vertex quadrics in place of the faces' (Garland & Shaffer 2002's second phase): one
-  /// per input vertex. Only without attributes (a working vertex is then one input vertex).
-  const CarriedQuadrics* carried_quadrics = nullptr;
   /// For the tests: called after each band of a pass with the state the lists are read through,
   /// and with an empty one after the greedy order (alone, or as the passes' tail).
   std::function<void(const Context&, const PassState&)> after_band;

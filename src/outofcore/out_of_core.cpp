@@ -1,7 +1,6 @@
 // Garland & Shaffer 2002's two phases: Lindstrom 2000 out-of-core clustering
 // (outofcore/parallel_clustering.h, the grid sized here from a sample), then GH97 in core
-// (qem::simplify, or part by part) on the clustered mesh, each vertex starting from its cell's
-// quadric (Garland & Shaffer 2002 §3).
+// (qem::simplify, or part by part) on the clustered mesh.
 #include "qem/out_of_core.h"
 
 #include <fcntl.h>
@@ -31,7 +30,6 @@
 #include "outofcore/temp_file.h"
 #include "qem/error.h"
 #include "qem/partition.h"
-#include "simplify_carried.h"
 
 namespace qem {
 namespace {
@@ -52,11 +50,9 @@ constexpr double kInCoreBytesPerFace = 180;
 /// half full). Phase 2 per cell: about 1.6 faces (measured on the spheres), each taking the
 /// in-core path's bytes plus the clustered mesh handed to it and the pairing of its faces; 2 GB
 /// held 8 million clustered faces at 1.99 GB peak with 2 faces a cell and 180 bytes a face, hence
-/// the margin. Carrying the cells' quadrics into phase 2 adds one quadric a cell (11 doubles), held
-/// until phase 2's last pass starts.
+/// the margin.
 constexpr double kClusterBytesPerCell = 160;
 constexpr double kPhase2BytesPerCell = 520;
-constexpr double kCarriedBytesPerCell = sizeof(core::Quadric);
 /// The finest grid: 2^20 cells along the longest side (keys hold 21 bits an axis).
 constexpr double kFinestResolution = double(1 << 20);
 
@@ -388,13 +384,10 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
   std::size_t layout_row = 0, layout_at[3] = {0, 0, 0};
   const bool map_input = !soup && in.float_vertex_layout(layout_offset, layout_row, layout_at);
   const bool positions_in_memory = !soup && !map_input && 12.0 * double(nv) <= budget / 3;
-  // The cells' quadrics are area-weighted (HG99 §2): carried when phase 2 weights by area too.
-  const bool carry = ooc.carry_quadrics && options.weighting == Weighting::Area;
-  const double phase2_bytes_per_cell = kPhase2BytesPerCell + (carry ? kCarriedBytesPerCell : 0.0);
 
   const double phase1_room = budget - (positions_in_memory ? 12.0 * double(nv) : 0.0);
   std::uint64_t max_cells = std::uint64_t(
-      std::max(0.0, std::min(phase1_room / kClusterBytesPerCell, budget / phase2_bytes_per_cell)));
+      std::max(0.0, std::min(phase1_room / kClusterBytesPerCell, budget / kPhase2BytesPerCell)));
   // Phase 2's time: the clustered mesh need not be larger than a multiple of the target (about
   // two faces a cell on a closed surface).
   const double target =
@@ -524,15 +517,6 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
     for (std::thread& h : helpers) h.join();
   }
   clustered_mesh.indices = outofcore::read_clustered_faces(clustering, faces);
-  // Garland & Shaffer 2002 §3: each cell's quadric, the sum of the planes of every input face that
-  // touched it, is its vertex's initial quadric in phase 2, so that phase 2 still sees the detail
-  // the clustering averaged away (recomputed from the clustered faces it would not). In the cells'
-  // local coordinates: from the box corner `lo` (parallel_clustering.cpp).
-  std::vector<core::Quadric> cell_quadrics;
-  if (carry) {
-    cell_quadrics.resize(cells.size());
-    for (std::uint32_t i = 0; i < cells.size(); ++i) cell_quadrics[i] = cells.cell(i).quadric;
-  }
   cells.release();
   drop_paired_faces(clustered_mesh.indices);
   report.clustered_faces = clustered_mesh.face_count();
@@ -546,7 +530,6 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
                          : partition_refusal(clustered_mesh, options).empty()
                              ? automatic_parts(clustered_mesh.face_count())
                              : 1;
-  const core::CarriedQuadrics carried{cell_quadrics, Vec3(lo[0], lo[1], lo[2])};
   SimplifyResult r;
   if (parts > 1) {
     PartitionOptions po;
@@ -556,13 +539,11 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
       return true;
     };
     PartitionReport pr;
-    r = carry ? detail::simplify_partitioned_carrying(clustered_mesh, options, po, carried, &pr)
-              : simplify_partitioned(clustered_mesh, options, po, &pr);
+    r = simplify_partitioned(clustered_mesh, options, po, &pr);
     report.parts = pr.parts;
   } else {
     Phase2Observer observer(progress);
-    r = carry ? detail::simplify_carrying(std::move(clustered_mesh), options, carried, &observer)
-              : simplify(std::move(clustered_mesh), options, &observer);
+    r = simplify(std::move(clustered_mesh), options, &observer);
     report.parts = 1;
   }
   lap("simplifying");

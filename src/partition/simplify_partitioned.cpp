@@ -18,7 +18,6 @@
 #include "qem/partition.h"
 #include "refit/refit_after_simplify.h"
 #include "refit/refit_points.h"
-#include "simplify_carried.h"
 
 namespace qem {
 
@@ -50,13 +49,9 @@ double thread_cpu_seconds() {
   return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
-MeshPartResult simplify_one_part(const MeshPart& part, const SimplifyOptions& options,
-                                 const core::CarriedQuadrics* carried);
-
 void run_parts_on_threads(std::span<const MeshPart> parts, const SimplifyOptions& options,
                           std::span<MeshPartResult> results,
-                          const std::function<bool(unsigned, unsigned)>& progress, PartitionReport& report,
-                          const core::CarriedQuadrics* carried) {
+                          const std::function<bool(unsigned, unsigned)>& progress, PartitionReport& report) {
   // One part per thread, each single-threaded: the parts are the parallelism.
   SimplifyOptions one = options;
   one.threads = 1;
@@ -67,7 +62,7 @@ void run_parts_on_threads(std::span<const MeshPart> parts, const SimplifyOptions
   core::for_chunks(parts.size(), 1, core::resolve_threads(options.threads), [&](std::size_t p, std::size_t, std::size_t) {
     if (cancelled) return;
     const double cpu0 = thread_cpu_seconds();
-    results[p] = simplify_one_part(parts[p], one, carried);
+    results[p] = simplify_part(parts[p], one);
     const double cpu = thread_cpu_seconds() - cpu0;
     const unsigned d = ++done;
     std::lock_guard<std::mutex> lock(report_lock);
@@ -80,9 +75,9 @@ void run_parts_on_threads(std::span<const MeshPart> parts, const SimplifyOptions
   if (cancelled) throw Error("cancelled");
 }
 
-// simplify_part, starting from the carried quadrics of the part's vertices when there are some.
-MeshPartResult simplify_one_part(const MeshPart& part, const SimplifyOptions& options,
-                                 const core::CarriedQuadrics* carried) {
+}  // namespace
+
+MeshPartResult simplify_part(const MeshPart& part, const SimplifyOptions& options) {
   SimplifyOptions o = options;
   o.target_faces = part.target_faces;
   o.target_ratio = 0;
@@ -90,14 +85,7 @@ MeshPartResult simplify_one_part(const MeshPart& part, const SimplifyOptions& op
   o.vertex_lock = part.locked;
   o.refit_rounds = 0;  // the refit fits the final result to the whole input
   o.map_input_vertices = true;
-  SimplifyResult r;
-  if (carried) {
-    std::vector<core::Quadric> own(part.input_vertex.size());
-    for (std::size_t v = 0; v < own.size(); ++v) own[v] = carried->per_vertex[part.input_vertex[v]];
-    r = detail::simplify_carrying(MeshView(part.mesh), o, core::CarriedQuadrics{own, carried->origin});
-  } else {
-    r = simplify(MeshView(part.mesh), o);
-  }
+  SimplifyResult r = simplify(MeshView(part.mesh), o);
   MeshPartResult out;
   out.mesh = std::move(r.mesh);
   out.vertex_source = std::move(r.vertex_source);
@@ -112,9 +100,8 @@ MeshPartResult simplify_one_part(const MeshPart& part, const SimplifyOptions& op
   return out;
 }
 
-SimplifyResult finish_parts(MeshView input, const SimplifyOptions& options, std::span<const MeshPart> parts,
-                            std::span<const MeshPartResult> results, PartitionReport* report,
-                            const core::CarriedQuadrics* carried) {
+SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options, std::span<const MeshPart> parts,
+                                  std::span<const MeshPartResult> results, PartitionReport* report) {
   if (parts.size() != results.size()) throw Error("finish_partitioned: one result per part is needed");
   constexpr std::uint32_t kNone = SimplifyResult::kUnmapped;
   // Weld: a vertex of a part's output that started as a cut vertex never moved and was never
@@ -175,25 +162,8 @@ SimplifyResult finish_parts(MeshView input, const SimplifyOptions& options, std:
     for (std::size_t v = 0; v < lock.size(); ++v) lock[v] = options.vertex_lock[merged_source[v]];
     o.vertex_lock = lock;
   }
-  // With carried quadrics, each merged vertex starts from the sum of those of the input vertices
-  // it took in (GH97 §4: a contraction's quadric is the sum of its ends'), each input vertex counted
-  // once (a cut vertex is in several parts, always the same merged vertex).
-  std::vector<core::Quadric> merged_quadric;
-  if (carried) {
-    merged_quadric.resize(merged_source.size());
-    std::vector<std::uint8_t> counted(input.vertex_count(), 0);
-    for (std::size_t p = 0; p < parts.size(); ++p)
-      for (std::size_t l = 0; l < parts[p].input_vertex.size(); ++l) {
-        const std::uint32_t g = parts[p].input_vertex[l], u = results[p].output_vertex_of_input[l];
-        if (counted[g] || u == kNone) continue;
-        counted[g] = 1;
-        merged_quadric[merged_of[p].at(u)] += carried->per_vertex[g];
-      }
-  }
   const auto start = std::chrono::steady_clock::now();
-  SimplifyResult last =
-      carried ? detail::simplify_carrying(std::move(merged), o, core::CarriedQuadrics{merged_quadric, carried->origin})
-              : simplify(std::move(merged), o);
+  SimplifyResult last = simplify(std::move(merged), o);
   if (report) report->final_seconds = seconds_since(start);
 
   result.mesh = std::move(last.mesh);
@@ -249,55 +219,30 @@ SimplifyResult finish_parts(MeshView input, const SimplifyOptions& options, std:
   return result;
 }
 
-SimplifyResult partitioned(MeshView input, const SimplifyOptions& options, const PartitionOptions& partition,
-                           PartitionReport* report, const core::CarriedQuadrics* carried) {
+SimplifyResult simplify_partitioned(MeshView input, const SimplifyOptions& options, const PartitionOptions& partition,
+                                    PartitionReport* report) {
   check_options(options);
   PartitionReport local_report;
   PartitionReport& rep = report ? *report : local_report;
   const unsigned part_count = partition.parts > 0 ? partition.parts : automatic_parts(input.face_count());
   if (part_count <= 1) {
     rep.parts = 1;
-    return carried ? detail::simplify_carrying(input, options, *carried) : simplify(input, options);
+    return simplify(input, options);
   }
   auto start = std::chrono::steady_clock::now();
   const std::vector<MeshPart> parts = split_mesh(input, options, part_count, &rep);
   rep.split_seconds = seconds_since(start);
   start = std::chrono::steady_clock::now();
   std::vector<MeshPartResult> results(parts.size());
-  if (partition.run_parts && !carried) {
+  if (partition.run_parts) {
     partition.run_parts(parts, options, results);
     if (partition.progress && !partition.progress(unsigned(parts.size()), unsigned(parts.size())))
       throw Error("cancelled");
   } else {
-    run_parts_on_threads(parts, options, results, partition.progress, rep, carried);
+    run_parts_on_threads(parts, options, results, partition.progress, rep);
   }
   rep.parts_seconds = seconds_since(start);
-  return finish_parts(input, options, parts, results, &rep, carried);
-}
-
-}  // namespace
-
-MeshPartResult simplify_part(const MeshPart& part, const SimplifyOptions& options) {
-  return simplify_one_part(part, options, nullptr);
-}
-
-SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options, std::span<const MeshPart> parts,
-                                  std::span<const MeshPartResult> results, PartitionReport* report) {
-  return finish_parts(input, options, parts, results, report, nullptr);
-}
-
-SimplifyResult simplify_partitioned(MeshView input, const SimplifyOptions& options, const PartitionOptions& partition,
-                                    PartitionReport* report) {
-  return partitioned(input, options, partition, report, nullptr);
-}
-
-SimplifyResult detail::simplify_partitioned_carrying(MeshView input, const SimplifyOptions& options,
-                                                     const PartitionOptions& partition,
-                                                     const core::CarriedQuadrics& carried, PartitionReport* report) {
-  if (carried.per_vertex.size() != input.vertex_count())
-    throw Error("carried quadrics: " + std::to_string(carried.per_vertex.size()) + " for " +
-                std::to_string(input.vertex_count()) + " vertices");
-  return partitioned(input, options, partition, report, &carried);
+  return finish_partitioned(input, options, parts, results, &rep);
 }
 
 }  // namespace qem
