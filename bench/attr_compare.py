@@ -14,8 +14,8 @@ meshoptimizer's face count and the row is judged on that output ("qem at peer si
 document, whose measured count includes every instance of a mesh, -f is corrected up to twice by the
 reached/asked ratio). The faces column then reads "qem asked / qem at peer size / meshopt / gltft"
 and "E q/m asked" keeps the first run's E ratio; every other qem column is the judged output. If qem
-cannot reach the peer's size (it stops above it), the faces column marks it with "!", the row is
-judged at qem's larger size and the summary lists it. E q/g compares
+cannot reach the peer's size (it stops above it), the faces column marks it with "!" and the row
+does not meet the goal (a larger mesh's lower error proves nothing); the summary lists it. E q/g compares
 the first qem run with gltf-transform (both asked for the same target).
 
 The peer folder is a copy of ../shared/bench/peers/js after `npm ci` (it holds
@@ -337,6 +337,9 @@ def verdict(rows):
                 why.append(f'{k} {q[k]:.3g} > {m[k]:.3g}')
         if q.get('seam_cracks'):
             why.append(f"{q['seam_cracks']} cracks")
+        qf, mf = q.get('approx_faces'), m.get('approx_faces')
+        if row.get('qem_eq_unequal') and qf is not None and mf is not None and qf > mf:
+            why.append(f'stops at {qf} faces, above meshoptimizer\'s {mf}')  # a larger mesh's error proves nothing
         if why:
             fails.append(f"{row['asset']} {row['ratio']:g}: " + ', '.join(why))
     er = [ratio_of(judged(r).get('E'), r.get('meshopt', {}).get('E')) for r in rows]
