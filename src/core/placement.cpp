@@ -6,48 +6,8 @@
 
 namespace qem::core {
 
-namespace {
-
-// A is treated as invertible when its smallest eigenvalue is at least this fraction of its
-// largest. The test is on a ratio, so scaling the model by s (A scales by s^2 or s^0 depending on
-// the weighting) never changes the decision. QSlim 2.1's absolute determinant test (1e-12) is what
-// rejects most optimal solves on small-scale models; this one cannot.
-constexpr double kMinEigenRatio = 1e-7;
-
-// When det(A) alone proves A well conditioned, the closed-form inverse is used and the
-// eigen-decomposition skipped. With eigenvalues 0 <= l0 <= l1 <= l2 summing to the trace t,
-// l1 l2 <= (t/2)^2 and l2 <= t, so l0 / l2 >= 4 det / t^3 = (4/27) det / (t/3)^3. Above
-// kFastRatio that is at least 1.5e-6: fifteen times kMinEigenRatio, so the eigen test would accept
-// A too, and a condition number below 7e5, so the cofactor solve keeps at least 10 of the 16
-// digits, far more than the float output and keys hold. The bound is what decides for most pairs
-// of a smooth surface (two small eigenvalues); creases and corners get the eigen test.
-constexpr double kFastRatio = 1e-5;
-
-bool solve_closed_form(const Quadric& q, Vec3& out, double det) {
-  // Cofactor inverse of the symmetric A, applied to -b.
-  double i00 = q.a11 * q.a22 - q.a12 * q.a12;
-  double i01 = q.a02 * q.a12 - q.a01 * q.a22;
-  double i02 = q.a01 * q.a12 - q.a02 * q.a11;
-  double i11 = q.a00 * q.a22 - q.a02 * q.a02;
-  double i12 = q.a01 * q.a02 - q.a00 * q.a12;
-  double i22 = q.a00 * q.a11 - q.a01 * q.a01;
-  double inv = -1.0 / det;
-  out = {(i00 * q.b0 + i01 * q.b1 + i02 * q.b2) * inv, (i01 * q.b0 + i11 * q.b1 + i12 * q.b2) * inv,
-         (i02 * q.b0 + i12 * q.b1 + i22 * q.b2) * inv};
-  return std::isfinite(out.x) && std::isfinite(out.y) && std::isfinite(out.z);
-}
-
-}  // namespace
-
-bool place_optimal(const Quadric& q, Vec3& out) {
-  double trace = q.a00 + q.a11 + q.a22;
-  if (!(trace > 0)) return false;
-  double det = q.a00 * (q.a11 * q.a22 - q.a12 * q.a12) - q.a01 * (q.a01 * q.a22 - q.a12 * q.a02) +
-               q.a02 * (q.a01 * q.a12 - q.a11 * q.a02);
-  double t3 = trace / 3;
-  if (det > kFastRatio * t3 * t3 * t3) return solve_closed_form(q, out, det);
-
-  // Near-singular: decide on the eigenvalues themselves (relative), then solve in the eigenbasis.
+bool place_optimal_near_singular(const Quadric& q, Vec3& out) {
+  // Decided on the eigenvalues themselves (relative), then solved in the eigenbasis.
   Eigen::Matrix3d a;
   a << q.a00, q.a01, q.a02, q.a01, q.a11, q.a12, q.a02, q.a12, q.a22;
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
@@ -84,28 +44,6 @@ Placed place_at_endpoints(const Quadric& q, const Vec3& p1, const Vec3& p2) {
   double em = q.evaluate(mid);
   if (em < best.error) best = {mid, em};
   return best;
-}
-
-Placed place(const Quadric& q, const Vec3& p1, const Vec3& p2, Placement policy) {
-  Placed out;
-  switch (policy) {
-    case Placement::Optimal:
-      if (place_optimal(q, out.position)) {
-        out.error = q.evaluate(out.position);
-        return out;
-      }
-      [[fallthrough]];
-    case Placement::Segment:
-      if (place_on_segment(q, p1, p2, out)) return out;
-      return place_at_endpoints(q, p1, p2);
-    case Placement::Midpoint: {
-      Vec3 mid = (p1 + p2) * 0.5;
-      return {mid, q.evaluate(mid)};
-    }
-    case Placement::Endpoints:
-      return place_at_endpoints(q, p1, p2);
-  }
-  return place_at_endpoints(q, p1, p2);
 }
 
 }  // namespace qem::core

@@ -1,6 +1,8 @@
 // Choosing the position of the vertex that replaces a contracted pair (GH97 §4).
 #pragma once
 
+#include <cmath>
+
 #include "core/border_chains.h"
 #include "core/quadric.h"
 #include "qem/simplify.h"
@@ -17,19 +19,77 @@ struct Placed {
   BorderSpot spot;
 };
 
-/// Places the contraction of (p1, p2) under quadric q according to `policy`.
-/// Optimal: the minimiser of q when A is well conditioned (a scale-relative test on its
-/// eigenvalues, so the same mesh at any scale makes the same choices); otherwise the best point on
-/// the segment p1-p2; otherwise the best of p1, p2 and the midpoint (GH97 §4's fallback chain).
-Placed place(const Quadric& q, const Vec3& p1, const Vec3& p2, Placement policy);
-
 /// The best point on segment p1-p2 (GH97 §4), or false if q is flat along the segment.
 bool place_on_segment(const Quadric& q, const Vec3& p1, const Vec3& p2, Placed& out);
 
 /// The best of p1, p2 and their midpoint ("fixed placement" in GH97 Fig. 6).
 Placed place_at_endpoints(const Quadric& q, const Vec3& p1, const Vec3& p2);
 
-/// Minimiser of q if A is invertible in the scale-relative sense, else false.
-bool place_optimal(const Quadric& q, Vec3& out);
+/// place_optimal's decision and solve for an A that det(A) alone does not prove well conditioned
+/// (on its eigenvalues).
+bool place_optimal_near_singular(const Quadric& q, Vec3& out);
+
+// A is treated as invertible when its smallest eigenvalue is at least this fraction of its
+// largest. The test is on a ratio, so scaling the model by s (A scales by s^2 or s^0 depending on
+// the weighting) never changes the decision. QSlim 2.1's absolute determinant test (1e-12) is what
+// rejects most optimal solves on small-scale models; this one cannot.
+inline constexpr double kMinEigenRatio = 1e-7;
+
+// When det(A) alone proves A well conditioned, the closed-form inverse is used and the
+// eigen-decomposition skipped. With eigenvalues 0 <= l0 <= l1 <= l2 summing to the trace t,
+// l1 l2 <= (t/2)^2 and l2 <= t, so l0 / l2 >= 4 det / t^3 = (4/27) det / (t/3)^3. Above
+// kFastRatio that is at least 1.5e-6: fifteen times kMinEigenRatio, so the eigen test would accept
+// A too, and a condition number below 7e5, so the cofactor solve keeps at least 10 of the 16
+// digits, far more than the float output and keys hold. The bound is what decides for most pairs
+// of a smooth surface (two small eigenvalues); creases and corners get the eigen test.
+inline constexpr double kFastRatio = 1e-5;
+
+/// Minimiser of q if A is invertible in the scale-relative sense, else false. Inline (as place):
+/// every pair's cost runs it.
+inline bool place_optimal(const Quadric& q, Vec3& out) {
+  const double trace = q.a00 + q.a11 + q.a22;
+  if (!(trace > 0)) return false;
+  const double det = q.a00 * (q.a11 * q.a22 - q.a12 * q.a12) - q.a01 * (q.a01 * q.a22 - q.a12 * q.a02) +
+                     q.a02 * (q.a01 * q.a12 - q.a11 * q.a02);
+  const double t3 = trace / 3;
+  if (!(det > kFastRatio * t3 * t3 * t3)) return place_optimal_near_singular(q, out);
+  // Cofactor inverse of the symmetric A, applied to -b.
+  const double i00 = q.a11 * q.a22 - q.a12 * q.a12;
+  const double i01 = q.a02 * q.a12 - q.a01 * q.a22;
+  const double i02 = q.a01 * q.a12 - q.a02 * q.a11;
+  const double i11 = q.a00 * q.a22 - q.a02 * q.a02;
+  const double i12 = q.a01 * q.a02 - q.a00 * q.a12;
+  const double i22 = q.a00 * q.a11 - q.a01 * q.a01;
+  const double inv = -1.0 / det;
+  out = {(i00 * q.b0 + i01 * q.b1 + i02 * q.b2) * inv, (i01 * q.b0 + i11 * q.b1 + i12 * q.b2) * inv,
+         (i02 * q.b0 + i12 * q.b1 + i22 * q.b2) * inv};
+  return std::isfinite(out.x) && std::isfinite(out.y) && std::isfinite(out.z);
+}
+
+/// Places the contraction of (p1, p2) under quadric q according to `policy`.
+/// Optimal: the minimiser of q when A is well conditioned (a scale-relative test on its
+/// eigenvalues, so the same mesh at any scale makes the same choices); otherwise the best point on
+/// the segment p1-p2; otherwise the best of p1, p2 and the midpoint (GH97 §4's fallback chain).
+inline Placed place(const Quadric& q, const Vec3& p1, const Vec3& p2, Placement policy) {
+  Placed out;
+  switch (policy) {
+    case Placement::Optimal:
+      if (place_optimal(q, out.position)) {
+        out.error = q.evaluate(out.position);
+        return out;
+      }
+      [[fallthrough]];
+    case Placement::Segment:
+      if (place_on_segment(q, p1, p2, out)) return out;
+      return place_at_endpoints(q, p1, p2);
+    case Placement::Midpoint: {
+      const Vec3 mid = (p1 + p2) * 0.5;
+      return {mid, q.evaluate(mid)};
+    }
+    case Placement::Endpoints:
+      return place_at_endpoints(q, p1, p2);
+  }
+  return place_at_endpoints(q, p1, p2);
+}
 
 }  // namespace qem::core

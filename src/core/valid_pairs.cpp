@@ -30,7 +30,10 @@ std::vector<Edge> unique_edges(const std::vector<std::uint32_t>& triangles, cons
         }
       }
     }
-    std::sort(edges.begin() + first, edges.end(), [](const Edge& a, const Edge& b) { return a.hi < b.hi; });
+    // By the upper end: an insertion sort, as a vertex has a few edges to higher vertices, each
+    // upper end once (so any sort gives this order).
+    for (std::size_t k = first + 1; k < edges.size(); ++k)
+      for (std::size_t j = k; j > first && edges[j].hi < edges[j - 1].hi; --j) std::swap(edges[j], edges[j - 1]);
   }
   return edges;
 }

@@ -83,10 +83,12 @@ std::vector<std::uint32_t> number_vertices(MeshView in, std::vector<std::uint32_
 void add_faces(MeshView in, const std::vector<std::uint32_t>& internal, bool welded, WorkingMesh& m) {
   const std::size_t nf = in.face_count(), n = m.pos.size();
   auto sorted_corners = [&](std::size_t f) {
-    std::array<std::uint32_t, 3> t{internal[in.indices[3 * f]], internal[in.indices[3 * f + 1]],
-                                   internal[in.indices[3 * f + 2]]};
-    std::sort(t.begin(), t.end());
-    return t;
+    std::uint32_t x = internal[in.indices[3 * f]], y = internal[in.indices[3 * f + 1]],
+                  z = internal[in.indices[3 * f + 2]];
+    if (x > y) std::swap(x, y);  // three compare-exchanges sort three
+    if (y > z) std::swap(y, z);
+    if (x > y) std::swap(x, y);
+    return std::array<std::uint32_t, 3>{x, y, z};
   };
   // On working vertices: with attributes, two corners of different input vertices may share a
   // position (welded), and the face is degenerate too.
@@ -118,7 +120,10 @@ void add_faces(MeshView in, const std::vector<std::uint32_t>& internal, bool wel
     bucket.clear();
     for (std::uint32_t k = bucket_start[i]; k < bucket_start[i + 1]; ++k)
       bucket.push_back({sorted_corners(bucketed[k]), bucketed[k]});
-    std::sort(bucket.begin(), bucket.end());
+    // An insertion sort: a bucket holds a few faces (those whose lowest vertex is i); the pairs
+    // differ in their face, so any sort gives this one order.
+    for (std::size_t k = 1; k < bucket.size(); ++k)
+      for (std::size_t j = k; j > 0 && bucket[j] < bucket[j - 1]; --j) std::swap(bucket[j], bucket[j - 1]);
     for (std::size_t k = 0; k < bucket.size(); ++k) {
       if (k > 0 && bucket[k].first == bucket[k - 1].first) {
         ++m.dropped_duplicate;

@@ -107,12 +107,24 @@ TriangleBvh::TriangleBvh(const std::vector<double>& corners) {
     stack.push_back({left + 1, mid, task.end});
     stack.push_back({left, task.begin, mid});
   }
+  // The triangles in leaf order, so that a leaf reads contiguous memory (here, for its box, too).
+  tris_.resize(9 * std::size_t(n));
+  slot_of_.resize(n);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const double* from = &corners[9 * std::size_t(order[i])];
+    double* to = &tris_[9 * std::size_t(i)];
+    for (int k = 0; k < 9; ++k) to[k] = from[k];
+    slot_of_[order[i]] = i;
+  }
+  ids_ = std::move(order);
+  std::vector<Bounds>().swap(box);
   // Boxes bottom up: children come after their parent in the array.
   for (std::size_t i = nodes_.size(); i-- > 0;) {
     Node& node = nodes_[i];
     Bounds b;
     if (node.count > 0) {
-      for (std::uint32_t k = node.first; k < node.first + node.count; ++k) b.grow(box[order[k]]);
+      for (std::uint32_t k = node.first; k < node.first + node.count; ++k)
+        for (int c = 0; c < 3; ++c) b.grow(&tris_[9 * std::size_t(k) + 3 * c]);
     } else {
       for (std::uint32_t c = node.first; c < node.first + 2; ++c) {
         const Node& child = nodes_[c];
@@ -121,14 +133,6 @@ TriangleBvh::TriangleBvh(const std::vector<double>& corners) {
       }
     }
     for (int k = 0; k < 3; ++k) node.lo[k] = b.lo[k], node.hi[k] = b.hi[k];
-  }
-
-  tris_.resize(9 * std::size_t(n));
-  ids_ = std::move(order);
-  slot_of_.resize(n);
-  for (std::uint32_t i = 0; i < n; ++i) {
-    std::copy_n(&corners[9 * std::size_t(ids_[i])], 9, &tris_[9 * std::size_t(i)]);
-    slot_of_[ids_[i]] = i;
   }
 }
 
