@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <numbers>
 #include <set>
 #include <string>
 #include <vector>
@@ -233,6 +234,30 @@ TEST(Borders, BorderVertexSlidesWithAnInteriorOne) {
     slid += !inputs.count(p);
   }
   EXPECT_GT(slid, 0u);
+}
+
+TEST(Borders, FanHubKeepsTheBorderExact) {
+  // A disc fanned from one hub (a triangulated n-gon, as the readers make of a polygon): every
+  // border vertex pairs with the hub, whose faces are too many to test each slide against, so
+  // they stay at their input places; the border stays on the input circle's polyline and the
+  // run reaches its target.
+  const std::uint32_t n = 400;
+  Mesh in;
+  in.positions = {0, 0, 0.1};
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const double t = 2 * std::numbers::pi * i / n;
+    in.positions.insert(in.positions.end(), {std::cos(t), std::sin(t), 0});
+  }
+  for (std::uint32_t i = 0; i < n; ++i) in.indices.insert(in.indices.end(), {0, 1 + i, 1 + (i + 1) % n});
+  const std::vector<std::pair<Point, Point>> in_border = border_edges(in);
+  SimplifyOptions o;
+  o.target_faces = 40;
+  const SimplifyResult r = simplify(in, o);
+  EXPECT_LE(r.mesh.face_count(), 40u);
+  EXPECT_EQ(test::validity_problem(r.mesh), "");
+  const std::set<std::uint32_t> rim = border_vertices(r.mesh);
+  EXPECT_GE(rim.size(), 3u);
+  for (std::uint32_t v : rim) EXPECT_LE(distance_to_edges(vertex(r.mesh, v), in_border), 2e-12) << "vertex " << v;
 }
 
 /// The bumpy square (20 x 20 cells) with two square holes: a small one (cell 4, 4) and a large one

@@ -297,6 +297,14 @@ void place_on_own_border(const Context& c, std::uint32_t a, std::uint32_t b, con
   const WorkingMesh& m = c.mesh;
   std::vector<Placed> cand;
   cand.push_back({m.pos[a], q.evaluate(m.pos[a]), m.border_spot[a]});
+  // Each slide is tested against every face around a and b (choose); around a fan's hub (a
+  // triangulated n-gon: any number of faces) that test, on every re-cost of the hub's pairs,
+  // would make the run quadratic in the hub's valence, so there a stays, as a held end does.
+  constexpr std::size_t kMaxSlideFaces = 64;
+  if (m.vertex_faces[a].size() + m.vertex_faces[b].size() > kMaxSlideFaces) {
+    placed = cand.front();  // checked for flips when it is made, as any placement
+    return;
+  }
   const BorderSpot& u = m.border_spot[a];
   if (u.from != kNoSlot && !(u.to == kNoSlot && m.chains.corner[u.from])) {
     const auto error_at = [&](const Vec3& x) { return q.evaluate(x); };

@@ -6,6 +6,7 @@
 
 #include <nanoflann.hpp>
 
+#include "core/small_sort.h"
 #include "qem/error.h"
 
 namespace qem::core {
@@ -30,10 +31,8 @@ std::vector<Edge> unique_edges(const std::vector<std::uint32_t>& triangles, cons
         }
       }
     }
-    // By the upper end: an insertion sort, as a vertex has a few edges to higher vertices, each
-    // upper end once (so any sort gives this order).
-    for (std::size_t k = first + 1; k < edges.size(); ++k)
-      for (std::size_t j = k; j > first && edges[j].hi < edges[j - 1].hi; --j) std::swap(edges[j], edges[j - 1]);
+    // By the upper end, each upper end once (so any sort gives this order).
+    sort_small(edges.begin() + first, edges.end(), [](const Edge& a, const Edge& b) { return a.hi < b.hi; });
   }
   return edges;
 }

@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <limits>
 
 #include "check_mesh.h"
+#include "core/small_sort.h"
 #include "core/spatial_order.h"
 #include "qem/error.h"
 
@@ -120,10 +122,8 @@ void add_faces(MeshView in, const std::vector<std::uint32_t>& internal, bool wel
     bucket.clear();
     for (std::uint32_t k = bucket_start[i]; k < bucket_start[i + 1]; ++k)
       bucket.push_back({sorted_corners(bucketed[k]), bucketed[k]});
-    // An insertion sort: a bucket holds a few faces (those whose lowest vertex is i); the pairs
-    // differ in their face, so any sort gives this one order.
-    for (std::size_t k = 1; k < bucket.size(); ++k)
-      for (std::size_t j = k; j > 0 && bucket[j] < bucket[j - 1]; --j) std::swap(bucket[j], bucket[j - 1]);
+    // The pairs differ in their face, so any sort gives this one order.
+    sort_small(bucket.begin(), bucket.end(), std::less<>());
     for (std::size_t k = 0; k < bucket.size(); ++k) {
       if (k > 0 && bucket[k].first == bucket[k - 1].first) {
         ++m.dropped_duplicate;
