@@ -34,9 +34,10 @@ inline double normalized_error(double q_error, double weight) {
 /// sides together). False if neither direction is allowed.
 bool place_with_wedges(const Context& c, std::uint32_t a, std::uint32_t b, const Quadric& q, Placed& placed);
 
-/// The quadric and placement of pair p. False if the pair can never move (both ends on a locked
-/// border, two hard corners or two stretches of border under exact borders, or, with attributes, a
-/// collapse that would move or close a seam); with one end on a locked border, that end is the
+/// The quadric and placement of pair p. False if the pair cannot be placed now (both ends on a
+/// locked border, two hard corners or two stretches of border under exact borders, or, with
+/// attributes, a collapse that would move or close a seam; refused_state says whether that lasts);
+/// with one end on a locked border, that end is the
 /// placement; under exact borders, border_target decides (border_placement.h).
 inline bool place_pair(const Context& c, std::uint32_t p, Quadric& q, Placed& placed) {
   const std::uint32_t a = c.pairs.pairs[p].v[0], b = c.pairs.pairs[p].v[1];
@@ -51,20 +52,16 @@ inline bool place_pair(const Context& c, std::uint32_t p, Quadric& q, Placed& pl
   switch (border) {
     case BorderTarget::Free: break;
     case BorderTarget::Never: return false;
-    case BorderTarget::AtA:  // b may be a soft corner that leaves (corner_error)
-      if (border_detail::role(c, a) == border_detail::Role::Border && !m.boundary[b]) {  // a slides along its border
-        place_on_own_border(c, a, b, q, placed);
-        return true;
-      }
-      placed = {m.pos[a], std::max(q.evaluate(m.pos[a]), corner_error(c, a, b, m.pos[a], q.weight))};
+    case BorderTarget::AtA:  // the other end may be a soft corner that leaves (corner_error)
+    case BorderTarget::AtB: {
+      const bool at_a = border == BorderTarget::AtA;
+      const std::uint32_t keep = at_a ? a : b, other = at_a ? b : a;
+      if (border_detail::role(c, keep) == border_detail::Role::Border && !m.boundary[other])
+        place_on_own_border(c, keep, other, q, placed);  // keep slides along its border
+      else
+        placed = {m.pos[keep], std::max(q.evaluate(m.pos[keep]), corner_error(c, a, b, m.pos[keep], q.weight))};
       return true;
-    case BorderTarget::AtB:
-      if (border_detail::role(c, b) == border_detail::Role::Border && !m.boundary[a]) {
-        place_on_own_border(c, b, a, q, placed);
-        return true;
-      }
-      placed = {m.pos[b], std::max(q.evaluate(m.pos[b]), corner_error(c, a, b, m.pos[b], q.weight))};
-      return true;
+    }
     case BorderTarget::AtEither:
       place_along_border(c, a, b, q, placed);
       placed.error = std::max(placed.error, hole_error(m, a, b, q.weight));  // a hole down to three vertices
@@ -100,6 +97,13 @@ inline bool never_contracts(const Context& c, std::uint32_t p) {
 /// (its ends' has_blocked are set by the caller, see PairSet::block).
 inline PairState refused_state(const Context& c, std::uint32_t p) {
   return never_contracts(c, p) ? kLocked : kBlocked;
+}
+
+/// Marks pair p, refused a placement, locked or blocked (refused_state), in one thread: blocking
+/// also flags its ends.
+inline void refuse(Context& c, std::uint32_t p) {
+  if (refused_state(c, p) == kBlocked) c.pairs.block(p);
+  else c.pairs.pairs[p].state = kLocked;
 }
 
 /// The ranking key of pair p: the quadric error at its placement, plus, when inversions are

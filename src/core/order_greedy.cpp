@@ -24,8 +24,7 @@ struct GreedyLists {
   void pair_changed(std::uint32_t p) {
     double cost;
     if (!pair_cost(c, p, cost)) {  // never (locked), or not while its neighbourhood stays (blocked)
-      if (refused_state(c, p) == kBlocked) c.pairs.block(p);
-      else c.pairs.pairs[p].state = kLocked;
+      refuse(c, p);
       heap.remove(p);
       return;
     }
@@ -57,8 +56,7 @@ void run_greedy(Context& c, const std::vector<std::uint8_t>* stale) {
     }
     double cost;
     if (pair_cost(c, p, cost)) heap.push_unordered(p, cost), ps.cost[p] = float(cost);
-    else if (refused_state(c, p) == kBlocked) ps.block(p);
-    else ps.pairs[p].state = kLocked;
+    else refuse(c, p);
   }
   heap.heapify();
 

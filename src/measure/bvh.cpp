@@ -111,9 +111,7 @@ TriangleBvh::TriangleBvh(const std::vector<double>& corners) {
   tris_.resize(9 * std::size_t(n));
   slot_of_.resize(n);
   for (std::uint32_t i = 0; i < n; ++i) {
-    const double* from = &corners[9 * std::size_t(order[i])];
-    double* to = &tris_[9 * std::size_t(i)];
-    for (int k = 0; k < 9; ++k) to[k] = from[k];
+    std::copy_n(&corners[9 * std::size_t(order[i])], 9, &tris_[9 * std::size_t(i)]);
     slot_of_[order[i]] = i;
   }
   ids_ = std::move(order);
