@@ -485,8 +485,8 @@ TEST_P(MaxDistanceCorpus, MeasuredDistanceNeverExceedsTheBound) {
     SimplifyOptions o;
     o.max_distance = d;
     o.max_distance_is_relative = true;
-    o.refit_rounds = 1;
-    o.refit_points_per_vertex = 2;
+    o.refit_rounds = 2;
+    o.refit_points_per_vertex = 8;
     const SimplifyResult r = simplify(in, o);
     MeasureOptions mo;
     mo.samples = 300000;

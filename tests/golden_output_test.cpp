@@ -106,7 +106,7 @@ std::vector<Config> configs(std::size_t faces) {
         });
         add(base + "/light-refit", [&](SimplifyOptions& o) {
           common(o);
-          o.refit_rounds = 1, o.refit_points_per_vertex = 2;
+          o.refit_rounds = 2, o.refit_points_per_vertex = 8;  // the command line's default
         });
       }
   // One of each other option, in the default order.

@@ -48,8 +48,8 @@ SimplifyOptions ratio(double r, unsigned threads = 2) {
   SimplifyOptions o;
   o.target_ratio = r;
   o.threads = threads;
-  o.refit_rounds = 1;  // the command line's default refit
-  o.refit_points_per_vertex = 2;
+  o.refit_rounds = 2;  // the command line's default refit
+  o.refit_points_per_vertex = 8;
   return o;
 }
 

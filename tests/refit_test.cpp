@@ -471,7 +471,7 @@ TEST(Refit, CliDefaultIsALightRefitWithOptimalPlacementOnly) {
   // The default is the light refit (below: it lowers the fit's error).
   const std::string fitted = made("default.obj", "");
   EXPECT_FALSE(fitted.empty());
-  EXPECT_TRUE(fitted == made("light.obj", "--refit-rounds 1 --refit-sample 2"));
+  EXPECT_TRUE(fitted == made("light.obj", "--refit-rounds 2 --refit-sample 8"));
   const std::string plain = made("plain.obj", "--no-refit");
   EXPECT_NE(fitted, plain);
   const SimplifyResult gh97 = [&] {
@@ -485,7 +485,7 @@ TEST(Refit, CliDefaultIsALightRefitWithOptimalPlacementOnly) {
   }()) << "--no-refit differs from the library's default (GH97 as published)";
   ASSERT_EQ(run("simplify " + in + " " + dir + "/j.obj --faces 600 --json > " + dir + "/line.json"), 0);
   const std::string line = slurp(dir + "/line.json");
-  EXPECT_NE(line.find("\"refit_rounds\":1,"), std::string::npos) << line;
+  EXPECT_NE(line.find("\"refit_rounds\":2,"), std::string::npos) << line;
   const auto number_after = [&](const std::string& key) {
     const std::size_t at = line.find("\"" + key + "\":");
     return at == std::string::npos ? NAN : std::stod(line.substr(at + key.size() + 3));

@@ -187,7 +187,7 @@ struct SimplifyOptions {
   /// material boundaries, mirror lines); the other vertices move with their values unchanged
   /// (docs/attributes.md, "Seams, locks and the refit"). An observer's contractions are those made
   /// before it: a replayed level is the unrefitted mesh (refit it with qem::refit to match). The
-  /// command line's default is a light refit, refit_rounds = 1 with refit_points_per_vertex = 2
+  /// command line's default is a light refit, refit_rounds = 2 with refit_points_per_vertex = 8
   /// (what it costs and gains: docs/benchmarks.md).
   unsigned refit_rounds = 0;
   /// The refit's input points per output vertex, 0 = every input vertex (RefitOptions::

@@ -189,7 +189,7 @@ _OPTION_NAMES = {option: tuple(_qem.option_names(option)) for option in ("weight
 
 # The command line's default refit (cli/algorithm_options.h): one round, about 2 input vertices
 # per output vertex, made only with optimal placement. "full" is `--refit`: 3 rounds, every vertex.
-_REFIT = {"light": (1, 2.0), "full": (3, 0.0), "none": (0, 0.0)}
+_REFIT = {"light": (2, 8.0), "full": (3, 0.0), "none": (0, 0.0)}
 
 _KIND_OF_NAME = [
     (r"NORMAL", "normal"),
@@ -378,7 +378,7 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
       allow_non_manifold: skip the link condition (edge collapses may make non-manifold edges).
       scheme: "passes" (fast) or "greedy" (GH97's heap: strictly cheapest first).
       refit: after the last contraction move the vertices to fit the input surface, faces fixed:
-        "light" (default, as the command line: 1 round on ~2 input vertices per output vertex, only
+        "light" (default, as the command line: 2 rounds on ~8 input vertices per output vertex, only
         with optimal placement, without record and without attributes), "full" (3 rounds, every vertex), "none", or
         (rounds, points_per_vertex).
       threads: threads for the parallel parts (0 = all cores); the result is the same for any count.

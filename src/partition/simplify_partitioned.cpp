@@ -200,9 +200,13 @@ SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options
   for (std::uint8_t s : seen) referenced += s;
   result.input_vertices = referenced;
 
-  // The refit fits the result to the whole input, as simplify's own refit does.
+  // The refit fits the result to the whole input, as simplify's own refit does, with the input's
+  // surface: without it the refit has no Hausdorff guard and far points still pull, and it raised
+  // the one-sided distance by a third on a bumpy sphere where simplify's refit keeps it.
   if (options.refit_rounds > 0 && result.contractions > 0) {
     const refit_detail::FitPoints points(input.positions, refit_detail::vertex_areas(input));
+    const core::SurfaceDistance surface =
+        refit_detail::surface_in_frame(input.positions, input.indices, points.frame());
     RefitOptions refit_options = refit_options_for(options);
     std::vector<std::uint8_t> fixed;
     if (!options.vertex_lock.empty()) {
@@ -210,7 +214,7 @@ SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options
       for (std::size_t v = 0; v < fixed.size(); ++v) fixed[v] = options.vertex_lock[result.vertex_source[v]];
       refit_options.fixed_vertices = fixed;
     }
-    const RefitResult fit = refit_detail::refit_to_points(points, result.mesh, refit_options, went);
+    const RefitResult fit = refit_detail::refit_to_points(points, result.mesh, refit_options, went, &surface);
     result.refit_rms_before = fit.rms_before;
     result.refit_rms_after = fit.rms_after;
     result.refit_rounds = fit.rounds;
