@@ -1,16 +1,17 @@
-// Work split into fixed-size chunks on std::threads. The chunks do not depend on the thread count,
-// so anything computed per chunk (a warm-started query run, a partial sum combined in chunk order)
-// is bit-identical for any number of threads. The one thread helper of the library.
+// Work split into fixed-size chunks on the process's threads (thread_pool.h). The chunks do not
+// depend on the thread count, so anything computed per chunk (a warm-started query run, a partial
+// sum combined in chunk order) is bit-identical for any number of threads. With thread_pool.h, the
+// library's one thread helper.
 #pragma once
 
 #include <algorithm>
 #include <atomic>
 #include <cstddef>
 #include <exception>
-#include <future>
-#include <system_error>
 #include <thread>
 #include <vector>
+
+#include "core/thread_pool.h"
 
 namespace qem::core {
 
@@ -38,19 +39,13 @@ void for_chunks(std::size_t n, std::size_t chunk_size, unsigned threads, Fn&& fn
     }
   };
   const unsigned extra = unsigned(std::min<std::size_t>(threads, chunks)) - (chunks > 0 ? 1 : 0);
-  std::vector<std::thread> pool;
-  try {
-    for (unsigned t = 0; t < extra; ++t) pool.emplace_back(work, t + 1);
-  } catch (const std::system_error&) {
-  }
-  work(0);
-  for (std::thread& t : pool) t.join();
+  run_with_helpers(extra, work);
   for (const std::exception_ptr& failure : failures)
     if (failure) std::rethrow_exception(failure);
 }
 
-/// Two independent pieces of work: side by side when there are threads (the first on a helper
-/// thread), else one after the other. Either way the result is the same.
+/// Two independent pieces of work: side by side when there are threads (one of them on a helper
+/// thread, if one is free), else one after the other. Either way the result is the same.
 template <class First, class Second>
 void side_by_side(unsigned threads, First first, Second second) {
   if (threads < 2) {
@@ -58,9 +53,7 @@ void side_by_side(unsigned threads, First first, Second second) {
     second();
     return;
   }
-  std::future<void> first_done = std::async(std::launch::async, first);
-  second();
-  first_done.get();
+  for_chunks(2, 1, 2, [&](std::size_t part, std::size_t, std::size_t) { part == 0 ? first() : second(); });
 }
 
 }  // namespace qem::core
