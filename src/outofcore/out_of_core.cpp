@@ -278,15 +278,18 @@ core::Quadric with_border(const outofcore::CellSums& cell, double cell_size) {
   return q;
 }
 
-/// Keeps a cell's representative `x` (its quadric's minimum) inside the cell [c0, c1]: when it lies
-/// outside, it moves to where the segment from the corners' `mean` (inside the cell, on the
-/// surface up to its roughness) to `x` (on the quadric's best-fitting planes) leaves the cell, so
-/// it stays between two points near the surface. Clamping each coordinate on its own moves it
-/// along the axes instead, off any surface oblique to them by up to a cell's size: on a noisy scan,
-/// where the noise gives every cell's quadric full rank and puts a few per cent of the minima
-/// outside their cells, such points were the farthest of the output from the input (Hausdorff
-/// 2.2x the in-core run's on the jittered 1.3M sphere at 10 %, docs/out-of-core.md).
-void pull_into_cell(const double mean[3], const double c0[3], const double c1[3], double x[3]) {
+/// Keeps a cell's representative `x` (the minimum of its quadric `q`) inside the cell [c0, c1].
+/// Two candidates, the one of lower error under `q` kept: `x` clamped coordinate by coordinate,
+/// and the point where the segment from the corners' `mean` (inside the cell, on the surface up to
+/// its roughness) to `x` (on the quadric's best-fitting planes) leaves the cell. Clamping alone
+/// moves the point along the axes, off any surface oblique to them by up to a cell's size: on a
+/// noisy scan, where the noise gives every cell's quadric full rank and puts a few per cent of the
+/// minima outside their cells, such points were the farthest of the output from the input
+/// (Hausdorff 2.2x the in-core run's on the jittered 1.3M sphere at 10 %, docs/out-of-core.md).
+/// The segment alone moves a border cell's point off the border when its minimum leaves the cell
+/// across another wall, the mean lying inside the border; there clamping is the better.
+void pull_into_cell(const core::Quadric& q, const double mean[3], const double c0[3], const double c1[3],
+                    double x[3]) {
   // A non-finite minimum (not expected from the truncated pseudo-inverse) keeps the mean.
   if (!std::isfinite(x[0] + x[1] + x[2])) std::copy(mean, mean + 3, x);
   double t = 1;  // the fraction of the segment mean -> x kept
@@ -295,9 +298,16 @@ void pull_into_cell(const double mean[3], const double c0[3], const double c1[3]
     if (x[a] > c1[a] && d > 0) t = std::min(t, (c1[a] - mean[a]) / d);
     if (x[a] < c0[a] && d < 0) t = std::min(t, (c0[a] - mean[a]) / d);
   }
+  if (t >= 1) return;  // inside
   t = std::max(t, 0.0);
-  // The final clamp only catches rounding (and a mean a rounding outside its cell).
-  for (int a = 0; a < 3; ++a) x[a] = std::clamp(mean[a] + t * (x[a] - mean[a]), c0[a], c1[a]);
+  // The final clamps only catch rounding (and a mean a rounding outside its cell).
+  double pulled[3], clamped[3];
+  for (int a = 0; a < 3; ++a) {
+    pulled[a] = std::clamp(mean[a] + t * (x[a] - mean[a]), c0[a], c1[a]);
+    clamped[a] = std::clamp(x[a], c0[a], c1[a]);
+  }
+  const auto error = [&](const double* p) { return q.evaluate(Vec3{p[0], p[1], p[2]}); };
+  std::copy_n(error(clamped) < error(pulled) ? clamped : pulled, 3, x);
 }
 
 /// Clustering maps the closed input surface onto a surface that is closed in the mod-2 sense:
@@ -549,12 +559,13 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
       const double mean[3] = {cell.sum[0] / cell.corners, cell.sum[1] / cell.corners,
                               cell.sum[2] / cell.corners};
       double x[3];
-      cluster_detail::minimize_around(with_border(cell, cell_size), mean, x);
+      const core::Quadric q = with_border(cell, cell_size);
+      cluster_detail::minimize_around(q, mean, x);
       std::uint64_t k[3];
       outofcore::unpack_cell(cells.key(i), k);
       const double c0[3] = {double(k[0]) * cell_size, double(k[1]) * cell_size, double(k[2]) * cell_size};
       const double c1[3] = {c0[0] + cell_size, c0[1] + cell_size, c0[2] + cell_size};
-      pull_into_cell(mean, c0, c1, x);
+      pull_into_cell(q, mean, c0, c1, x);
       for (int a = 0; a < 3; ++a) clustered_mesh.positions[3 * i + a] = lo[a] + x[a];
     }
   };
