@@ -33,15 +33,22 @@ inline CellKey coarser_cell(CellKey key, int levels) {
 }
 
 /// What a cell accumulates (Lindstrom 2000 §3): the quadric of its faces and the sum of their
-/// corners in it, whose mean is where the cell's vertex is sought.
+/// corners in it, whose mean is where the cell's vertex is sought. Also the sums of the directed
+/// edges (b - a) and of their moments (a x b, the Plücker coordinates of the line a -> b) of its
+/// faces' edges with an end in it: an edge between two faces comes once in each direction and
+/// cancels, so what remains is the input's border through the cell (consistently oriented faces
+/// assumed), from which the cell's vertex is kept on that border.
 struct CellSums {
   core::Quadric quadric;
   double sum[3] = {0, 0, 0};
   double corners = 0;
+  double edge[3] = {0, 0, 0};
+  double moment[3] = {0, 0, 0};
   CellSums& operator+=(const CellSums& o) {
     quadric += o.quadric;
     sum[0] += o.sum[0], sum[1] += o.sum[1], sum[2] += o.sum[2];
     corners += o.corners;
+    for (int a = 0; a < 3; ++a) edge[a] += o.edge[a], moment[a] += o.moment[a];
     return *this;
   }
 };

@@ -24,6 +24,7 @@
 
 #include "cluster/cluster_quadric.h"
 #include "core/quadric.h"
+#include "geometry/vec3.h"
 #include "outofcore/cell_table.h"
 #include "outofcore/mesh_stream.h"
 #include "outofcore/parallel_clustering.h"
@@ -46,12 +47,12 @@ using outofcore::TempFile;
 /// Peak memory of the in-core path per input face (load, working mesh, heap, refit), the figure
 /// measured for issue 20; the decision in-core / out-of-core uses it.
 constexpr double kInCoreBytesPerFace = 180;
-/// Phase 1 per occupied cell: its quadric and corner sum (15 doubles) and its hash slot (at most
-/// half full). Phase 2 per cell: about 1.6 faces (measured on the spheres), each taking the
+/// Phase 1 per occupied cell: its quadric, corner sum and edge sums (21 doubles) and its hash
+/// slot (at most half full). Phase 2 per cell: about 1.6 faces (measured on the spheres), each taking the
 /// in-core path's bytes plus the clustered mesh handed to it and the pairing of its faces; 2 GB
 /// held 8 million clustered faces at 1.99 GB peak with 2 faces a cell and 180 bytes a face, hence
 /// the margin.
-constexpr double kClusterBytesPerCell = 160;
+constexpr double kClusterBytesPerCell = 208;
 constexpr double kPhase2BytesPerCell = 520;
 /// The finest grid: 2^20 cells along the longest side (keys hold 21 bits an axis).
 constexpr double kFinestResolution = double(1 << 20);
@@ -248,6 +249,65 @@ double starting_cell_size(const std::vector<float>& sample, const double lo[3], 
   }
   const double estimate = resolution * std::sqrt(double(goal_cells) / cells);
   return extent / std::min(kFinestResolution, estimate);
+}
+
+/// The cell's quadric, plus, where the input's border crosses the cell, the squared distance to the
+/// border's line (GH97 §4's border planes, in the form a stream allows). The interior edges
+/// cancelled in the cell's edge sums; what remains, D = sum(b - a) and M = sum(a x b) over the
+/// border's edges, gives the line through (D x M) / |D|^2 along D (exact for a straight border).
+/// Without it a border cell's quadric is flat across the border and its vertex keeps the corners'
+/// mean, up to a cell inside: the clustered border shrank by up to a cell, the output's farthest
+/// points from the input on an open surface. Weighted by the quadric's trace (its faces' area),
+/// as strong as the surface's own planes. A border shorter than a quarter of the cell (or sums
+/// left by rounding) adds nothing.
+core::Quadric with_border(const outofcore::CellSums& cell, double cell_size) {
+  core::Quadric q = cell.quadric;
+  const Vec3 D{cell.edge[0], cell.edge[1], cell.edge[2]}, M{cell.moment[0], cell.moment[1], cell.moment[2]};
+  const double dd = dot(D, D);
+  if (!(dd > 0.0625 * cell_size * cell_size)) return q;
+  const Vec3 d = D / std::sqrt(dd), c = cross(D, M) / dd;
+  const double w = q.a00 + q.a11 + q.a22;
+  // w (|x - c|^2 - ((x - c).d)^2) = x^T A x + 2 b.x + c0 with A = w (I - d d^T), b = -A c.
+  core::Quadric line;
+  line.a00 = w * (1 - d.x * d.x), line.a01 = -w * d.x * d.y, line.a02 = -w * d.x * d.z;
+  line.a11 = w * (1 - d.y * d.y), line.a12 = -w * d.y * d.z, line.a22 = w * (1 - d.z * d.z);
+  const Vec3 ac = line.apply_a(c);
+  line.b0 = -ac.x, line.b1 = -ac.y, line.b2 = -ac.z;
+  line.c = dot(c, ac);
+  q += line;
+  return q;
+}
+
+/// Keeps a cell's representative `x` (the minimum of its quadric `q`) inside the cell [c0, c1].
+/// Two candidates, the one of lower error under `q` kept: `x` clamped coordinate by coordinate,
+/// and the point where the segment from the corners' `mean` (inside the cell, on the surface up to
+/// its roughness) to `x` (on the quadric's best-fitting planes) leaves the cell. Clamping alone
+/// moves the point along the axes, off any surface oblique to them by up to a cell's size: on a
+/// noisy scan, where the noise gives every cell's quadric full rank and puts a few per cent of the
+/// minima outside their cells, such points were the farthest of the output from the input
+/// (Hausdorff 2.2x the in-core run's on the jittered 1.3M sphere at 10 %, docs/out-of-core.md).
+/// The segment alone moves a border cell's point off the border when its minimum leaves the cell
+/// across another wall, the mean lying inside the border; there clamping is the better.
+void pull_into_cell(const core::Quadric& q, const double mean[3], const double c0[3], const double c1[3],
+                    double x[3]) {
+  // A non-finite minimum (not expected from the truncated pseudo-inverse) keeps the mean.
+  if (!std::isfinite(x[0] + x[1] + x[2])) std::copy(mean, mean + 3, x);
+  double t = 1;  // the fraction of the segment mean -> x kept
+  for (int a = 0; a < 3; ++a) {
+    const double d = x[a] - mean[a];
+    if (x[a] > c1[a] && d > 0) t = std::min(t, (c1[a] - mean[a]) / d);
+    if (x[a] < c0[a] && d < 0) t = std::min(t, (c0[a] - mean[a]) / d);
+  }
+  if (t >= 1) return;  // inside
+  t = std::max(t, 0.0);
+  // The final clamps only catch rounding (and a mean a rounding outside its cell).
+  double pulled[3], clamped[3];
+  for (int a = 0; a < 3; ++a) {
+    pulled[a] = std::clamp(mean[a] + t * (x[a] - mean[a]), c0[a], c1[a]);
+    clamped[a] = std::clamp(x[a], c0[a], c1[a]);
+  }
+  const auto error = [&](const double* p) { return q.evaluate(Vec3{p[0], p[1], p[2]}); };
+  std::copy_n(error(clamped) < error(pulled) ? clamped : pulled, 3, x);
 }
 
 /// Clustering maps the closed input surface onto a surface that is closed in the mod-2 sense:
@@ -499,13 +559,14 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
       const double mean[3] = {cell.sum[0] / cell.corners, cell.sum[1] / cell.corners,
                               cell.sum[2] / cell.corners};
       double x[3];
-      cluster_detail::minimize_around(cell.quadric, mean, x);
+      const core::Quadric q = with_border(cell, cell_size);
+      cluster_detail::minimize_around(q, mean, x);
       std::uint64_t k[3];
       outofcore::unpack_cell(cells.key(i), k);
-      for (int a = 0; a < 3; ++a) {
-        const double c0 = double(k[a]) * cell_size, c1 = c0 + cell_size;
-        clustered_mesh.positions[3 * i + a] = lo[a] + std::clamp(x[a], c0, c1);
-      }
+      const double c0[3] = {double(k[0]) * cell_size, double(k[1]) * cell_size, double(k[2]) * cell_size};
+      const double c1[3] = {c0[0] + cell_size, c0[1] + cell_size, c0[2] + cell_size};
+      pull_into_cell(q, mean, c0, c1, x);
+      for (int a = 0; a < 3; ++a) clustered_mesh.positions[3 * i + a] = lo[a] + x[a];
     }
   };
   {

@@ -119,6 +119,18 @@ struct ParallelClustering::Block {
         cell.sum[0] += corner[k]->x, cell.sum[1] += corner[k]->y, cell.sum[2] += corner[k]->z;
         cell.corners += 1;
       }
+      // The directed edges, each to the cells of its two ends (once when they share one).
+      for (int k = 0; k < 3; ++k) {
+        const Vec3& from = *corner[k];
+        const Vec3& to = *corner[(k + 1) % 3];
+        const Vec3 e = to - from, m = cross(from, to);
+        const std::uint32_t ends[2] = {id[k], id[(k + 1) % 3]};
+        for (int j = 0; j < (ends[0] == ends[1] ? 1 : 2); ++j) {
+          CellSums& cell = cells.sums[ends[j]];
+          cell.edge[0] += e.x, cell.edge[1] += e.y, cell.edge[2] += e.z;
+          cell.moment[0] += m.x, cell.moment[1] += m.y, cell.moment[2] += m.z;
+        }
+      }
       if (id[0] != id[1] && id[1] != id[2] && id[0] != id[2])
         triples.insert(triples.end(), {id[0], id[1], id[2]});
     }
