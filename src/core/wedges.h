@@ -93,9 +93,14 @@ Wedges build_wedges(MeshView input, const std::vector<std::uint32_t>& internal, 
                     const SimplifyOptions& options);
 
 /// The wedge map of collapsing `removed` into `survivor`: each of the removed vertex's wedges to the
-/// survivor's wedge on the same side of the edge's faces. False if a wedge of the removed vertex is
-/// on no face of the edge (the collapse would move a seam or open it) or two wedges would merge into
-/// one (the collapse would close a seam). `map` gets (removed wedge, survivor wedge) pairs.
+/// survivor's wedge on the same side of the edge's faces. A wedge whose corners are all on the
+/// edge's faces is vacated (it dies with them unless a removed wedge comes to it): a removed one
+/// needs no partner, and a removed wedge that meets two of the survivor's goes to the one that is
+/// not vacated (a crease that ends one face away goes with that face). Two removed wedges may go
+/// into one on a manifold edge: their seam ends at the survivor and shortens along itself. False
+/// if a living wedge of the removed vertex is on no face of the edge (the collapse would move a
+/// seam or open it) or meets two living wedges of the survivor's (it would split one side).
+/// `map` gets (removed wedge, survivor wedge) pairs.
 /// Permissive (wedges.permissive, neither end protected): where those rules fail, each removed
 /// wedge goes to the survivor's wedge it meets on an edge face, else to the survivor's wedge of the
 /// same material nearest in weighted attribute values, and `crossed` (if given) is set; still
