@@ -15,6 +15,7 @@
 
 #include "qem/error.h"
 #include "qem/io.h"
+#include "qem/measure.h"
 #include "qem/simplify.h"
 #include "test_meshes.h"
 
@@ -575,6 +576,45 @@ TEST(Seams, ACreaseEndingOneFaceAwayDoesNotStopTheRun) {
     o.scheme = scheme;
     const SimplifyResult r = simplify(odd, o), reference = simplify(plain, o);
     EXPECT_EQ(r.mesh.face_count(), reference.mesh.face_count());
+    EXPECT_EQ(open_edges_welded(r.mesh, true), 0u);
+  }
+}
+
+TEST(Seams, ASurvivorThatStaysFitsItsNormalsToItsFaces) {
+  // At every interior vertex (i, j), i and j = 2 mod 4, of a wavy grid the faces left of the
+  // vertex carry a tilted normal at that corner: a crease that ends on both sides, so the vertex
+  // holds two wedges and stays where it is when its neighbours collapse into it. The tilted wedge
+  // then covers faces whose own normals are the surface's: its value is refitted to them
+  // (Hoppe's optimum at the kept position) instead of being kept, which held the tilt over the
+  // whole grown fan.
+  const int n = 16;
+  Mesh in = odd_corner_grid(n, false);
+  VertexAttribute& normal = in.attributes[0];
+  for (int j = 2; j < n; j += 4)
+    for (int i = 2; i < n; i += 4) {
+      const std::uint32_t v = std::uint32_t(j * (n + 1) + i), copy = std::uint32_t(in.vertex_count());
+      in.positions.insert(in.positions.end(), {in.positions[3 * v], in.positions[3 * v + 1], in.positions[3 * v + 2]});
+      normal.values.insert(normal.values.end(), {0.6, 0, 0.8});
+      for (std::size_t f = 0; f < in.face_count(); ++f) {
+        double cx = 0;
+        for (int k = 0; k < 3; ++k) cx += in.positions[3 * in.indices[3 * f + k]] / 3;
+        for (int k = 0; k < 3; ++k)
+          if (in.indices[3 * f + k] == v && cx < in.positions[3 * v]) in.indices[3 * f + k] = copy;
+      }
+    }
+  SimplifyOptions o;
+  o.target_ratio = 0.25;
+  MeasureOptions mo;
+  mo.samples = 100000;
+  for (Scheme scheme : {Scheme::Passes, Scheme::Greedy}) {
+    SCOPED_TRACE(to_string(scheme));
+    o.scheme = scheme;
+    const SimplifyResult r = simplify(in, o);
+    const MeasureResult m = measure(in, r.mesh, mo);
+    ASSERT_TRUE(m.normal_rms_deg.has_value());
+    // 3.40 degrees refitted; keeping the values gave 4.28 on the same 127 faces (5.9 against 7.4
+    // at 10 %).
+    EXPECT_LT(*m.normal_rms_deg, 3.8);
     EXPECT_EQ(open_edges_welded(r.mesh, true), 0u);
   }
 }

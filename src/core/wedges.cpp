@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <limits>
 #include <string>
 #include <unordered_map>
@@ -144,13 +143,17 @@ double Wedges::error_at(std::uint32_t w, const std::uint32_t* merged, std::size_
   return std::max(e, 0.0);
 }
 
-void Wedges::update_values(std::uint32_t w, const Vec3& p) {
+void Wedges::update_values(std::uint32_t w, const Vec3& p, bool keep_tex_coords) {
   const double* q = &quadric[std::size_t(w) * quadric_width];
   const double W = q[10];
   if (!(W > 0)) return;
   std::uint32_t j = 0;
   for (const Channel& ch : channels) {
     if (ch.weight == 0) continue;
+    if (keep_tex_coords && ch.kind == AttributeKind::TexCoord) {
+      j += ch.components;
+      continue;
+    }
     for (std::uint32_t c = 0; c < ch.components; ++c, ++j) {
       const double* gd = q + kHead + 4 * j;
       value[std::size_t(w) * width + ch.first + c] = (gd[0] * p.x + gd[1] * p.y + gd[2] * p.z + gd[3]) / W / ch.weight;
@@ -158,7 +161,7 @@ void Wedges::update_values(std::uint32_t w, const Vec3& p) {
   }
 }
 
-void Wedges::merge(std::uint32_t survivor, std::uint32_t removed, bool moved, const Vec3& p,
+void Wedges::merge(std::uint32_t survivor, std::uint32_t removed, bool moved, bool crossed, const Vec3& p,
                    const std::vector<std::pair<std::uint32_t, std::uint32_t>>& map, const WorkingMesh& m,
                    const std::vector<std::uint32_t>& faces) {
   for (const auto& [r, s] : map) {
@@ -168,7 +171,15 @@ void Wedges::merge(std::uint32_t survivor, std::uint32_t removed, bool moved, co
     merged_into[r] = s;
   }
   first[removed] = kNoVertex;
-  if (!moved) return;
+  if (!moved) {
+    // The survivor stays, and so do its texture coordinates (a seam's stay exactly on the chart's
+    // edge). Its other values take their optimum at its position for the faces it now has: the cost
+    // (place_with_wedges) was of that optimum, and a kept normal no longer fits a fan that grew. A
+    // crossing (permissive) was costed with the values kept, and keeps them.
+    if (!crossed)
+      for (const auto& [r, s] : map) update_values(s, p, true);
+    return;
+  }
   std::uint32_t w = first[survivor];
   do {
     update_values(w, p);

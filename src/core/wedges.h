@@ -59,14 +59,18 @@ struct Wedges {
   /// The attribute error of w with `merged` merged into it, at position p with w's values as they
   /// are (not at their optimum): what a collapse costs whose survivor keeps its values.
   double error_at(std::uint32_t w, const std::uint32_t* merged, std::size_t count, const Vec3& p) const;
-  /// Sets w's interpolated channels to their optimum at p (after the merge).
-  void update_values(std::uint32_t w, const Vec3& p);
+  /// Sets w's interpolated channels to their optimum at p (after the merge), texture coordinates
+  /// too unless `keep_tex_coords`.
+  void update_values(std::uint32_t w, const Vec3& p, bool keep_tex_coords = false);
   /// `removed` went into `survivor`, now at p: each removed wedge's quadric joins its partner's
   /// (map from map_wedges), and, if the survivor moved, its wedges take their optimal values at p,
   /// UVs within the box of the UVs of its neighbours on `faces` (the survivor's live faces, corners
   /// already mapped). A survivor that stays (a seam, a border, an endpoint placement) keeps its
-  /// values, as it keeps its position: a seam's UVs stay exactly on the chart's edge.
-  void merge(std::uint32_t survivor, std::uint32_t removed, bool moved, const Vec3& p,
+  /// texture coordinates, as it keeps its position (a seam's UVs stay exactly on the chart's edge);
+  /// its wedges that took a removed one's faces refit their other values (normals, colours) to
+  /// their optimum at p, the value the collapse's cost was of; unless the collapse `crossed` a
+  /// seam (permissive), whose cost was of the values kept.
+  void merge(std::uint32_t survivor, std::uint32_t removed, bool moved, bool crossed, const Vec3& p,
              const std::vector<std::pair<std::uint32_t, std::uint32_t>>& map, const WorkingMesh& m,
              const std::vector<std::uint32_t>& faces);
   /// A face corner moved from wedge `from` to wedge `to` (`to` == kNoVertex: the face died).
