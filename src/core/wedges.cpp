@@ -143,20 +143,42 @@ double Wedges::error_at(std::uint32_t w, const std::uint32_t* merged, std::size_
   return std::max(e, 0.0);
 }
 
-void Wedges::update_values(std::uint32_t w, const Vec3& p, bool keep_tex_coords) {
+void Wedges::update_values(std::uint32_t w, const Vec3& p) {
   const double* q = &quadric[std::size_t(w) * quadric_width];
   const double W = q[10];
   if (!(W > 0)) return;
   std::uint32_t j = 0;
   for (const Channel& ch : channels) {
     if (ch.weight == 0) continue;
-    if (keep_tex_coords && ch.kind == AttributeKind::TexCoord) {
+    for (std::uint32_t c = 0; c < ch.components; ++c, ++j) {
+      const double* gd = q + kHead + 4 * j;
+      value[std::size_t(w) * width + ch.first + c] = (gd[0] * p.x + gd[1] * p.y + gd[2] * p.z + gd[3]) / W / ch.weight;
+    }
+  }
+}
+
+void Wedges::refit_kept(std::uint32_t w, const Vec3& p) {
+  std::uint32_t sides[8], count = 0;
+  sides[count++] = w;
+  for (std::uint32_t x = next[w]; x != w && count < 8; x = next[x])
+    if (source[x] == source[w] && material[x] == material[w]) sides[count++] = x;
+  double W = 0;
+  for (std::uint32_t i = 0; i < count; ++i) W += quadric[std::size_t(sides[i]) * quadric_width + 10];
+  if (!(W > 0)) return;
+  std::uint32_t j = 0;
+  for (const Channel& ch : channels) {
+    if (ch.weight == 0) continue;
+    if (ch.kind == AttributeKind::TexCoord) {  // on the chart's edge: kept
       j += ch.components;
       continue;
     }
     for (std::uint32_t c = 0; c < ch.components; ++c, ++j) {
-      const double* gd = q + kHead + 4 * j;
-      value[std::size_t(w) * width + ch.first + c] = (gd[0] * p.x + gd[1] * p.y + gd[2] * p.z + gd[3]) / W / ch.weight;
+      double g = 0;
+      for (std::uint32_t i = 0; i < count; ++i) {
+        const double* gd = &quadric[std::size_t(sides[i]) * quadric_width + kHead + 4 * j];
+        g += gd[0] * p.x + gd[1] * p.y + gd[2] * p.z + gd[3];
+      }
+      for (std::uint32_t i = 0; i < count; ++i) value[std::size_t(sides[i]) * width + ch.first + c] = g / W / ch.weight;
     }
   }
 }
@@ -176,8 +198,11 @@ void Wedges::merge(std::uint32_t survivor, std::uint32_t removed, bool moved, bo
     // edge). Its other values take their optimum at its position for the faces it now has: the cost
     // (place_with_wedges) was of that optimum, and a kept normal no longer fits a fan that grew. A
     // crossing (permissive) was costed with the values kept, and keeps them.
+    // The two sides of a mirror line (wedges of one input vertex and material, equal values) take
+    // one optimum, over both sides' faces: they stay equal, one vertex in the output as in the
+    // input (build_wedge_output).
     if (!crossed)
-      for (const auto& [r, s] : map) update_values(s, p, true);
+      for (const auto& [r, s] : map) refit_kept(s, p);
     return;
   }
   std::uint32_t w = first[survivor];

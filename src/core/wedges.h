@@ -59,9 +59,12 @@ struct Wedges {
   /// The attribute error of w with `merged` merged into it, at position p with w's values as they
   /// are (not at their optimum): what a collapse costs whose survivor keeps its values.
   double error_at(std::uint32_t w, const std::uint32_t* merged, std::size_t count, const Vec3& p) const;
-  /// Sets w's interpolated channels to their optimum at p (after the merge), texture coordinates
-  /// too unless `keep_tex_coords`.
-  void update_values(std::uint32_t w, const Vec3& p, bool keep_tex_coords = false);
+  /// Sets w's interpolated channels to their optimum at p (after the merge).
+  void update_values(std::uint32_t w, const Vec3& p);
+  /// The same for a wedge whose vertex stays at p, texture coordinates excepted, over w and the
+  /// other sides of a mirror line at it (wedges of the same input vertex and material), which take
+  /// the same values.
+  void refit_kept(std::uint32_t w, const Vec3& p);
   /// `removed` went into `survivor`, now at p: each removed wedge's quadric joins its partner's
   /// (map from map_wedges), and, if the survivor moved, its wedges take their optimal values at p,
   /// UVs within the box of the UVs of its neighbours on `faces` (the survivor's live faces, corners
