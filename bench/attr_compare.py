@@ -320,17 +320,20 @@ def line(row, tools):
             f"{pair('color_rms')} | {fmt(q.get('seam_cracks'))} / {fmt(m.get('seam_cracks'))} / {fmt(g.get('seam_cracks'))} | {check} |")
 
 
+EXACT_E_REL = 1e-12
+
+
 def verdict(rows):
     """The issue's goal per row: E <= 0.9x meshopt's, attribute errors <= meshopt's, no cracks; judged at
     meshoptimizer's size where qem was re-run there."""
-    fails, uneq = [], []
+    fails, above = [], 0
     for row in rows:
         q, m = judged(row), row.get('meshopt', {})
-        if row.get('qem_eq_unequal'):
-            uneq.append(f"{row['asset']} {row['ratio']:g} ({fmt(q.get('approx_faces'))} vs {fmt(m.get('approx_faces'))})")
         why = []
         e = ratio_of(q.get('E'), m.get('E'))
-        if e is not None and e > 0.9:
+        # An output exact to rounding (E below 1e-12 of the diagonal: the 12-face cube of a subdivided
+        # cube, whose E is 1e-16 noise in either tool) cannot be bettered; the ratio of two noises says nothing.
+        if e is not None and e > 0.9 and not (q.get('E_rel') is not None and q['E_rel'] < EXACT_E_REL):
             why.append(f'E {e:.2f}x')
         for k in ('uv_rms', 'normal_rms_deg', 'color_rms'):
             if q.get(k) is not None and m.get(k) is not None and q[k] > m[k] + 1e-9:  # 1e-9: rounding noise
@@ -340,6 +343,7 @@ def verdict(rows):
         qf, mf = q.get('approx_faces'), m.get('approx_faces')
         if row.get('qem_eq_unequal') and qf is not None and mf is not None and qf > mf:
             why.append(f'stops at {qf} faces, above meshoptimizer\'s {mf}')  # a larger mesh's error proves nothing
+            above += 1
         if why:
             fails.append(f"{row['asset']} {row['ratio']:g}: " + ', '.join(why))
     er = [ratio_of(judged(r).get('E'), r.get('meshopt', {}).get('E')) for r in rows]
@@ -348,8 +352,7 @@ def verdict(rows):
     n_eq = sum('qem_eq' in r for r in rows)
     return (f'{len(rows) - len(fails)} of {len(rows)} rows meet the goal ({n_eq} judged with qem re-run at '
             f"meshoptimizer's size), geometric mean E q/m {gm:.3f}" +
-            ('; not met: ' + '; '.join(fails) if fails else '') +
-            ("; qem could not reach meshoptimizer's size: " + '; '.join(uneq) if uneq else ''))
+            (f"; not met ({above} of them stopping above meshoptimizer's size): " + '; '.join(fails) if fails else ''))
 
 
 if __name__ == '__main__':

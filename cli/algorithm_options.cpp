@@ -99,8 +99,8 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
                     "(--refit-rounds " +
                     std::to_string(kDefaultRefitRounds) + " --refit-sample " +
                     std::to_string(int(kDefaultRefitSample)) +
-                    ") when --placement is optimal and the mesh has no attributes (with attributes only when "
-                    "asked: it holds the seams; docs/attributes.md); see --no-refit");
+                    ") when --placement is optimal and the mesh has no texture coordinates or normals (with "
+                    "those only when asked; it holds the seams; docs/attributes.md); see --no-refit");
   sub->add_option("--refit-rounds", a.refit_rounds,
                   "Project-and-solve rounds of --refit (implies it; default " +
                       std::to_string(RefitOptions{}.rounds) + ")")
@@ -197,6 +197,11 @@ LoadOptions to_load_options(const AlgorithmArgs& a) {
   if (a.no_weld) load.weld = Weld::Off;
   if (!a.lock_property.empty()) load.keep_vertex_properties = true;
   return load;
+}
+
+unsigned attribute_refit_rounds(const AlgorithmArgs& a, const SimplifyOptions& options, const Mesh& mesh) {
+  const bool uv_or_normals = mesh.find_attribute(AttributeKind::TexCoord) || mesh.find_attribute(AttributeKind::Normal);
+  return a.refit_asked() || !uv_or_normals ? options.refit_rounds : 0;
 }
 
 unsigned attribute_refit_rounds(const AlgorithmArgs& a, const SimplifyOptions& options) {

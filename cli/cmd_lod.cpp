@@ -180,7 +180,7 @@ int run_lod_mesh(const LodArgs& a) {
     level.target_ratio = 0, level.target_faces = target, level.as_far_as_possible = target == 0;
     // Refitted in the run, which holds its seams (simplify.cpp): the chain's refit below sees no wedges.
     level.refit_rounds = refit.rounds, level.refit_points_per_vertex = refit.points_per_vertex;
-    level.refit_rounds = attribute_refit_rounds(a.algorithm, level);
+    level.refit_rounds = attribute_refit_rounds(a.algorithm, level, mesh);
     SimplifyResult r = simplify(mesh, level);
     r.mesh.material_names = mesh.material_names, r.mesh.material_library = mesh.material_library;
     levels.push_back({std::move(r.mesh), target, r.contractions, r.max_error});

@@ -190,7 +190,7 @@ int run_simplify(const SimplifyArgs& a) {
   Mesh mesh = load_input(a.input, load, &report);
   std::vector<std::uint8_t> lock;  // --lock-property: outlives the run, as vertex_lock must
   apply_lock_property(a.algorithm, a.input, mesh, lock, opt);
-  if (!mesh.attributes.empty()) opt.refit_rounds = attribute_refit_rounds(a.algorithm, opt);
+  if (!mesh.attributes.empty()) opt.refit_rounds = attribute_refit_rounds(a.algorithm, opt, mesh);
   const double load_s = t_load.seconds();
   if (!a.record.empty() && !mesh.attributes.empty())
     throw Error(a.input + ": --record keeps positions and faces only, and this mesh has attributes (" +

@@ -163,14 +163,15 @@ void contract(Context& c, Lists& lists, std::uint32_t p, const Quadric& q, const
   ++w.vertices_removed;
   m.aggregated[a] |= m.aggregated[b] | c.pairs.pairs[p].is_virtual;
 
-  if (c.wedges) map_wedges(m, *c.wedges, a, b, w.wedge_map);  // checked by place_pair
+  bool crossed = false;  // permissive: the collapse crosses a seam
+  if (c.wedges) map_wedges(m, *c.wedges, a, b, w.wedge_map, &crossed);  // checked by place_pair
   if (c.components) c.components->join(a, b);  // a threshold pair joins two parts into one
   const std::size_t killed_before = w.faces_killed;
   merge_faces(c, a, b, m.aggregated[a] || !c.settings.preserve_topology, w);
   if (c.components) c.components->faces_died(a, w.faces_killed - killed_before);
   merge_pairs(c, lists, p, a, b, w);
   if (c.wedges) {
-    c.wedges->merge(a, b, moves, target, w.wedge_map, m, w.faces);
+    c.wedges->merge(a, b, moves, crossed, target, w.wedge_map, m, w.faces);
     c.wedges->drop_unused(w.emptied_wedges);  // a seam whose faces on one side all died is gone
   }
   lists.contracted(a, b, w.faces, w.pairs);

@@ -31,7 +31,7 @@ inline double normalized_error(double q_error, double weight) {
 /// solve, through place()). A seam or material boundary stays where it is: when either end has
 /// more than one wedge, the survivor stays at its own position, and the removed end's wedges must
 /// each meet one of the survivor's on the edge's faces (the collapse runs along the seam, both
-/// sides together). False if neither direction is allowed.
+/// sides together; map_wedges, wedges.h). False if neither direction is allowed.
 bool place_with_wedges(const Context& c, std::uint32_t a, std::uint32_t b, const Quadric& q, Placed& placed);
 
 /// The quadric and placement of pair p. False if the pair cannot be placed now (both ends on a

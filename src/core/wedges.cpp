@@ -157,7 +157,33 @@ void Wedges::update_values(std::uint32_t w, const Vec3& p) {
   }
 }
 
-void Wedges::merge(std::uint32_t survivor, std::uint32_t removed, bool moved, const Vec3& p,
+void Wedges::refit_kept(std::uint32_t w, const Vec3& p) {
+  std::uint32_t sides[8], count = 0;
+  sides[count++] = w;
+  for (std::uint32_t x = next[w]; x != w && count < 8; x = next[x])
+    if (source[x] == source[w] && material[x] == material[w]) sides[count++] = x;
+  double W = 0;
+  for (std::uint32_t i = 0; i < count; ++i) W += quadric[std::size_t(sides[i]) * quadric_width + 10];
+  if (!(W > 0)) return;
+  std::uint32_t j = 0;
+  for (const Channel& ch : channels) {
+    if (ch.weight == 0) continue;
+    if (ch.kind == AttributeKind::TexCoord) {  // on the chart's edge: kept
+      j += ch.components;
+      continue;
+    }
+    for (std::uint32_t c = 0; c < ch.components; ++c, ++j) {
+      double g = 0;
+      for (std::uint32_t i = 0; i < count; ++i) {
+        const double* gd = &quadric[std::size_t(sides[i]) * quadric_width + kHead + 4 * j];
+        g += gd[0] * p.x + gd[1] * p.y + gd[2] * p.z + gd[3];
+      }
+      for (std::uint32_t i = 0; i < count; ++i) value[std::size_t(sides[i]) * width + ch.first + c] = g / W / ch.weight;
+    }
+  }
+}
+
+void Wedges::merge(std::uint32_t survivor, std::uint32_t removed, bool moved, bool crossed, const Vec3& p,
                    const std::vector<std::pair<std::uint32_t, std::uint32_t>>& map, const WorkingMesh& m,
                    const std::vector<std::uint32_t>& faces) {
   for (const auto& [r, s] : map) {
@@ -167,7 +193,18 @@ void Wedges::merge(std::uint32_t survivor, std::uint32_t removed, bool moved, co
     merged_into[r] = s;
   }
   first[removed] = kNoVertex;
-  if (!moved) return;
+  if (!moved) {
+    // The survivor stays, and so do its texture coordinates (a seam's stay exactly on the chart's
+    // edge). Its other values take their optimum at its position for the faces it now has: the cost
+    // (place_with_wedges) was of that optimum, and a kept normal no longer fits a fan that grew. A
+    // crossing (permissive) was costed with the values kept, and keeps them.
+    // The two sides of a mirror line (wedges of one input vertex and material, equal values) take
+    // one optimum, over both sides' faces: they stay equal, one vertex in the output as in the
+    // input (build_wedge_output).
+    if (!crossed)
+      for (const auto& [r, s] : map) refit_kept(s, p);
+    return;
+  }
   std::uint32_t w = first[survivor];
   do {
     update_values(w, p);
@@ -333,6 +370,9 @@ double value_distance(const Wedges& wg, std::uint32_t x, std::uint32_t y) {
   return d2;
 }
 
+// The faces of one edge map_wedges tells apart; more (a fan of sheets) leaves the strict rules.
+constexpr std::size_t kMaxEdgeFaces = 8;
+
 // The survivor's and the removed vertex's wedges at their corners of face f (a face of the edge).
 std::pair<std::uint32_t, std::uint32_t> edge_face_wedges(const WorkingMesh& m, std::uint32_t f, std::uint32_t survivor,
                                                          std::uint32_t removed) {
@@ -387,26 +427,58 @@ bool map_wedges(const WorkingMesh& m, const Wedges& wg, std::uint32_t survivor, 
                 std::vector<std::pair<std::uint32_t, std::uint32_t>>& map, bool* crossed) {
   if (crossed) *crossed = false;
   map.clear();
+  // The (survivor, removed) wedges of each face of the edge: these faces die with the collapse.
+  std::pair<std::uint32_t, std::uint32_t> edge[kMaxEdgeFaces];
+  std::size_t edge_faces = 0;
   bool strict = true;
   for (std::uint32_t f : m.vertex_faces[survivor]) {
     if (!m.face_alive[f] || !m.face_has(f, removed)) continue;
-    const auto [ws, wr] = edge_face_wedges(m, f, survivor, removed);
-    bool known = false;
-    for (const auto& [r, s] : map) {
-      if (r == wr && s == ws) known = true;
-      else if (r == wr || s == ws) strict = false;  // one wedge to two, or two into one
+    if (edge_faces == kMaxEdgeFaces) {  // a fan of sheets on one edge: no side is clear
+      strict = false;
+      break;
     }
-    if (!strict) break;
-    if (!known) map.push_back({wr, ws});
+    edge[edge_faces++] = edge_face_wedges(m, f, survivor, removed);
   }
-  if (strict) {
-    std::size_t removed_wedges = 0;
-    std::uint32_t w = wg.first[removed];
-    do ++removed_wedges, w = wg.next[w];
-    while (w != wg.first[removed]);
-    if (map.empty()) return false;  // not an edge: nothing tells the sides apart
-    if (map.size() == removed_wedges) return true;
-  }
+  if (edge_faces == 0) return false;  // not an edge: nothing tells the sides apart
+  // A wedge all of whose corners are on the edge's faces is vacated by the collapse: unless a
+  // removed wedge comes to it, it dies with those faces (drop_unused), and so does the seam it
+  // bounds (a crease that ends one face away, a flipped UV triangle).
+  const auto vacated = [&](std::uint32_t w, bool at_survivor) {
+    std::uint32_t on_edge = 0;
+    for (std::size_t i = 0; i < edge_faces; ++i) on_edge += (at_survivor ? edge[i].first : edge[i].second) == w;
+    return wg.corners[w] == on_edge;
+  };
+  std::uint32_t w = wg.first[removed];
+  if (strict) do {
+    // The survivor's wedges that w meets on the edge's faces: w's faces go on with the one it
+    // meets that lives on; meeting two that live on, it would be split (the seam would leave its
+    // edges). A vacated w needs no partner; it hands its quadric to the first it meets.
+    std::uint32_t to = kNoVertex, living = 0;
+    for (std::size_t i = 0; i < edge_faces; ++i) {
+      const std::uint32_t ws = edge[i].first;
+      if (edge[i].second != w || ws == to) continue;
+      if (to == kNoVertex) {
+        to = ws, living = !vacated(ws, true);
+      } else if (!vacated(ws, true)) {
+        if (living) strict = false;
+        to = ws, living = 1;
+      }
+    }
+    if (to == kNoVertex) {
+      if (!vacated(w, false)) strict = false;  // on no face of the edge: the collapse would move its seam
+    } else {
+      map.push_back({w, to});
+    }
+    w = wg.next[w];
+  } while (strict && w != wg.first[removed]);
+  // Two of the removed end's wedges into one of the survivor's: the seam between them ends at the
+  // survivor (a half seam) and shortens along itself, both sides together. Only on a manifold
+  // edge: with more faces, the sides are not told apart.
+  for (std::size_t i = 0; strict && edge_faces != 2 && i < map.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (map[i].second == map[j].second && !vacated(map[i].first, false) && !vacated(map[j].first, false))
+        strict = false;
+  if (strict) return true;
   const bool protect = !wg.protect.empty() && (wg.protect[survivor] || wg.protect[removed]);
   if (!wg.permissive || protect || !map_crossing(m, wg, survivor, removed, map)) return false;
   if (crossed) *crossed = true;

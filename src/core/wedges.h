@@ -61,12 +61,19 @@ struct Wedges {
   double error_at(std::uint32_t w, const std::uint32_t* merged, std::size_t count, const Vec3& p) const;
   /// Sets w's interpolated channels to their optimum at p (after the merge).
   void update_values(std::uint32_t w, const Vec3& p);
+  /// The same for a wedge whose vertex stays at p, texture coordinates excepted, over w and the
+  /// other sides of a mirror line at it (wedges of the same input vertex and material), which take
+  /// the same values.
+  void refit_kept(std::uint32_t w, const Vec3& p);
   /// `removed` went into `survivor`, now at p: each removed wedge's quadric joins its partner's
   /// (map from map_wedges), and, if the survivor moved, its wedges take their optimal values at p,
   /// UVs within the box of the UVs of its neighbours on `faces` (the survivor's live faces, corners
   /// already mapped). A survivor that stays (a seam, a border, an endpoint placement) keeps its
-  /// values, as it keeps its position: a seam's UVs stay exactly on the chart's edge.
-  void merge(std::uint32_t survivor, std::uint32_t removed, bool moved, const Vec3& p,
+  /// texture coordinates, as it keeps its position (a seam's UVs stay exactly on the chart's edge);
+  /// its wedges that took a removed one's faces refit their other values (normals, colours) to
+  /// their optimum at p, the value the collapse's cost was of; unless the collapse `crossed` a
+  /// seam (permissive), whose cost was of the values kept.
+  void merge(std::uint32_t survivor, std::uint32_t removed, bool moved, bool crossed, const Vec3& p,
              const std::vector<std::pair<std::uint32_t, std::uint32_t>>& map, const WorkingMesh& m,
              const std::vector<std::uint32_t>& faces);
   /// A face corner moved from wedge `from` to wedge `to` (`to` == kNoVertex: the face died).
@@ -93,9 +100,14 @@ Wedges build_wedges(MeshView input, const std::vector<std::uint32_t>& internal, 
                     const SimplifyOptions& options);
 
 /// The wedge map of collapsing `removed` into `survivor`: each of the removed vertex's wedges to the
-/// survivor's wedge on the same side of the edge's faces. False if a wedge of the removed vertex is
-/// on no face of the edge (the collapse would move a seam or open it) or two wedges would merge into
-/// one (the collapse would close a seam). `map` gets (removed wedge, survivor wedge) pairs.
+/// survivor's wedge on the same side of the edge's faces. A wedge whose corners are all on the
+/// edge's faces is vacated (it dies with them unless a removed wedge comes to it): a removed one
+/// needs no partner, and a removed wedge that meets two of the survivor's goes to the one that is
+/// not vacated (a crease that ends one face away goes with that face). Two removed wedges may go
+/// into one on a manifold edge: their seam ends at the survivor and shortens along itself. False
+/// if a living wedge of the removed vertex is on no face of the edge (the collapse would move a
+/// seam or open it) or meets two living wedges of the survivor's (it would split one side).
+/// `map` gets (removed wedge, survivor wedge) pairs.
 /// Permissive (wedges.permissive, neither end protected): where those rules fail, each removed
 /// wedge goes to the survivor's wedge it meets on an edge face, else to the survivor's wedge of the
 /// same material nearest in weighted attribute values, and `crossed` (if given) is set; still
