@@ -187,7 +187,7 @@ def option_names(option: str) -> list:
 # The library's names (src/option_names.cpp): one list, written once.
 _OPTION_NAMES = {option: tuple(_qem.option_names(option)) for option in ("weighting", "placement", "scheme", "inversion")}
 
-# The command line's default refit (cli/algorithm_options.h): one round, about 2 input vertices
+# The command line's default refit (cli/algorithm_options.h): two rounds, about 8 input vertices
 # per output vertex, made only with optimal placement. "full" is `--refit`: 3 rounds, every vertex.
 _REFIT = {"light": (2, 8.0), "full": (3, 0.0), "none": (0, 0.0)}
 
