@@ -99,7 +99,7 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
                     "(--refit-rounds " +
                     std::to_string(kDefaultRefitRounds) + " --refit-sample " +
                     std::to_string(int(kDefaultRefitSample)) +
-                    ") when --placement is optimal and the mesh has no texture coordinates or normals (with "
+                    ", fewer rounds or none where each output vertex stands for fewer than 6 or 3 input vertices) when --placement is optimal and the mesh has no texture coordinates or normals (with "
                     "those only when asked; it holds the seams; docs/attributes.md); see --no-refit");
   sub->add_option("--refit-rounds", a.refit_rounds,
                   "Project-and-solve rounds of --refit (implies it; default " +
@@ -187,6 +187,7 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
   } else if (!a.no_refit && opt.placement == Placement::Optimal) {
     opt.refit_rounds = kDefaultRefitRounds;
     opt.refit_points_per_vertex = kDefaultRefitSample;
+    opt.refit_by_reduction = true;
   }
   return opt;
 }

@@ -49,8 +49,9 @@ struct AlgorithmArgs {
 /// because the first round's projections are onto the unrefitted surface and the second corrects
 /// them; and more rounds on fewer points (2 per vertex) fit the sample, not the surface, and raise
 /// E (docs/benchmarks.md, "Refit variants"). Other placements keep their vertices where they put
-/// them (endpoints stay input vertices). The library's SimplifyOptions default stays GH97 as
-/// published (no refit).
+/// them (endpoints stay input vertices). It follows the reduction (SimplifyOptions::
+/// refit_by_reduction: less or no refit where each output vertex stands for few input vertices).
+/// The library's SimplifyOptions default stays GH97 as published (no refit).
 inline constexpr unsigned kDefaultRefitRounds = 2;
 inline constexpr double kDefaultRefitSample = 8;
 

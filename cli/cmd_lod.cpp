@@ -151,6 +151,7 @@ int run_lod_mesh(const LodArgs& a) {
   // A refit (the default's, or --refit's): each level is refitted below, as simplify refits its
   // output; the run itself only records the contractions.
   const RefitOptions refit = refit_options_for(opt);
+  const SimplifyOptions refit_as = opt;  // each level's refit follows its reduction (refit_levels)
   opt.refit_rounds = 0;
   ContractionRecorder recorder;
   if (!a.faces.empty())
@@ -185,11 +186,7 @@ int run_lod_mesh(const LodArgs& a) {
     r.mesh.material_names = mesh.material_names, r.mesh.material_library = mesh.material_library;
     levels.push_back({std::move(r.mesh), target, r.contractions, r.max_error});
   }
-  if (refit.rounds > 0 && !attributes) {
-    std::vector<Mesh*> meshes;
-    for (ReplayLevel& l : levels) meshes.push_back(&l.mesh);
-    qem::refit(mesh, meshes, refit);
-  }
+  if (refit.rounds > 0 && !attributes) refit_levels(mesh, levels, refit_as, result.input_vertices);
   const double replay_cpu = process_cpu_seconds() - cpu_replay0;
 
   namespace fs = std::filesystem;

@@ -34,6 +34,37 @@ RefitOptions refit_options_for(const SimplifyOptions& options) {
   return r;
 }
 
+RefitOptions refit_options_for(const SimplifyOptions& options, std::size_t input_vertices,
+                               std::size_t output_vertices) {
+  RefitOptions r = refit_options_for(options);
+  if (!options.refit_by_reduction || r.rounds == 0) return r;
+  // Input vertices per output vertex: at about 2 (half the faces) any refit raised E, at about 4
+  // one round on 2 points was the best, from about 6 two rounds on 8 (docs/benchmarks.md).
+  const double per_vertex = output_vertices > 0 ? double(input_vertices) / double(output_vertices) : 0;
+  if (per_vertex < 3) {
+    r.rounds = 0;
+  } else if (per_vertex < 6) {
+    r.rounds = 1;
+    r.points_per_vertex = 2;
+  }
+  return r;
+}
+
+void refit_levels(MeshView original, std::span<ReplayLevel> levels, const SimplifyOptions& options,
+                  std::size_t input_vertices) {
+  std::vector<std::pair<RefitOptions, std::vector<Mesh*>>> groups;
+  for (ReplayLevel& level : levels) {
+    const RefitOptions r = refit_options_for(options, input_vertices, level.mesh.vertex_count());
+    if (r.rounds == 0) continue;
+    auto same = std::find_if(groups.begin(), groups.end(), [&](const auto& g) {
+      return g.first.rounds == r.rounds && g.first.points_per_vertex == r.points_per_vertex;
+    });
+    if (same == groups.end()) same = groups.insert(groups.end(), {r, {}});
+    same->second.push_back(&level.mesh);
+  }
+  for (auto& [refit_options, meshes] : groups) qem::refit(original, meshes, refit_options);
+}
+
 void check_options(const SimplifyOptions& options) {
   core::validate(options);
   if (options.refit_rounds > 0) refit_detail::check_options(refit_options_for(options));
@@ -150,11 +181,12 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
   const Frame input_frame = bounded ? referenced_frame(input.positions, input_faces) : Frame{};
   double max_distance = options.max_distance;
   if (bounded && options.max_distance_is_relative) max_distance *= input_frame.scale;
-  if (refit && out.contractions > 0 && out.stop_reason != StopReason::Cancelled) {
+  const RefitOptions chosen = refit_options_for(options, out.input_vertices, out.mesh.vertex_count());
+  if (refit && chosen.rounds > 0 && out.contractions > 0 && out.stop_reason != StopReason::Cancelled) {
     if (!consumed_indices) weights = refit_detail::vertex_areas(input);
     const refit_detail::FitPoints points(input.positions, weights);
     const core::SurfaceDistance surface = refit_detail::surface_in_frame(input.positions, input_faces, points.frame());
-    RefitOptions refit_options = refit_options_for(options);
+    RefitOptions refit_options = chosen;
     refit_options.max_distance = max_distance;
     std::vector<std::uint8_t> fixed;  // the locked vertices stay
     if (!options.vertex_lock.empty()) {

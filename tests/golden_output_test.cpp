@@ -106,7 +106,7 @@ std::vector<Config> configs(std::size_t faces) {
         });
         add(base + "/light-refit", [&](SimplifyOptions& o) {
           common(o);
-          o.refit_rounds = 2, o.refit_points_per_vertex = 8;  // the command line's default
+          o.refit_rounds = 2, o.refit_points_per_vertex = 8;  // the default light refit's, every target
         });
       }
   // One of each other option, in the default order.

@@ -392,6 +392,38 @@ TEST(Refit, AFitToSampledPointsKeepsMostOfTheGain) {
 using test::slurp;
 int run(const std::string& args) { return test::run_qem_quietly(args); }
 
+TEST(Refit, CliDefaultRefitFollowsTheReduction) {
+  // The light refit raises E when each output vertex stands for only a few input vertices: none at
+  // half the faces, one round on 2 points at a quarter, two rounds on 8 from a sixth down; a lod
+  // chain refits each level as simplify does at that target.
+  const std::string dir = test::temp_dir() + "/refit_by_reduction";
+  std::filesystem::create_directories(dir);
+  const std::string in = dir + "/in.obj";
+  save_mesh(in, test::concatenated(test::icosphere(4),
+                                   test::transformed(test::height_field(20, waves), 1, 3, 0, 0)));
+  const std::size_t faces = load_mesh(in).face_count();
+  const auto made = [&](const std::string& name, std::size_t target, const std::string& options) {
+    EXPECT_EQ(run("simplify " + in + " " + dir + "/" + name + " --faces " + std::to_string(target) + " " + options), 0)
+        << options;
+    return slurp(dir + "/" + name);
+  };
+  const std::size_t half = faces / 2, quarter = faces / 4, tenth = faces / 10;
+  const std::string d_half = made("d_half.obj", half, ""), d_quarter = made("d_quarter.obj", quarter, ""),
+                    d_tenth = made("d_tenth.obj", tenth, "");
+  EXPECT_TRUE(d_half == made("n_half.obj", half, "--no-refit")) << "half the faces: no refit";
+  EXPECT_TRUE(d_quarter == made("o_quarter.obj", quarter, "--refit-rounds 1 --refit-sample 2"));
+  EXPECT_NE(d_quarter, made("n_quarter.obj", quarter, "--no-refit"));
+  EXPECT_TRUE(d_tenth == made("t_tenth.obj", tenth, "--refit-rounds 2 --refit-sample 8"));
+  // Asked for, the rounds are made whatever the reduction.
+  EXPECT_NE(made("a_half.obj", half, "--refit-rounds 2 --refit-sample 8"), d_half);
+  ASSERT_EQ(run("lod " + in + " " + dir + "/lod --faces " + std::to_string(half) + "," + std::to_string(quarter) +
+                "," + std::to_string(tenth) + " --format obj"),
+            0);
+  EXPECT_TRUE(slurp(dir + "/lod/in_lod0.obj") == d_half);
+  EXPECT_TRUE(slurp(dir + "/lod/in_lod1.obj") == d_quarter);
+  EXPECT_TRUE(slurp(dir + "/lod/in_lod2.obj") == d_tenth);
+}
+
 TEST(Refit, CliSimplifyRefitEqualsRefitCommandAndLodLevel) {
   const std::string dir = test::temp_dir() + "/refit_cli";
   std::filesystem::create_directories(dir);

@@ -188,11 +188,19 @@ struct SimplifyOptions {
   /// (docs/attributes.md, "Seams, locks and the refit"). An observer's contractions are those made
   /// before it: a replayed level is the unrefitted mesh (refit it with qem::refit to match). The
   /// command line's default is a light refit, refit_rounds = 2 with refit_points_per_vertex = 8
+  /// and refit_by_reduction
   /// (what it costs and gains: docs/benchmarks.md).
   unsigned refit_rounds = 0;
   /// The refit's input points per output vertex, 0 = every input vertex (RefitOptions::
   /// points_per_vertex): the time saved grows with the input's vertices per output vertex.
   double refit_points_per_vertex = 0;
+  /// The refit follows the reduction (the command line's light refit): none while each output
+  /// vertex stands for fewer than 3 input vertices, one round on about 2 points per output vertex
+  /// while it stands for fewer than 6, and refit_rounds on refit_points_per_vertex from there.
+  /// Fitting the faces to the input's vertices as points raises E when each output vertex stands
+  /// for only a few of them (at half the faces the refit raised E by 13-22 %; docs/benchmarks.md,
+  /// "Refit variants").
+  bool refit_by_reduction = false;
 
   /// With attributes (MeshView::attributes), their weights in the error.
   AttributeWeights attribute_weights;

@@ -188,7 +188,8 @@ def option_names(option: str) -> list:
 _OPTION_NAMES = {option: tuple(_qem.option_names(option)) for option in ("weighting", "placement", "scheme", "inversion")}
 
 # The command line's default refit (cli/algorithm_options.h): two rounds, about 8 input vertices
-# per output vertex, made only with optimal placement. "full" is `--refit`: 3 rounds, every vertex.
+# per output vertex, fewer at mild reductions (SimplifyOptions::refit_by_reduction), made only
+# with optimal placement. "full" is `--refit`: 3 rounds, every vertex.
 _REFIT = {"light": (2, 8.0), "full": (3, 0.0), "none": (0, 0.0)}
 
 _KIND_OF_NAME = [
@@ -330,6 +331,7 @@ def _options(*, target_faces, target_ratio, target_vertices, max_error, max_erro
         raise ValueError("refit: a record replays the contractions and the refit moves every vertex after them, "
                          "so record=True cannot be combined with a refit; use qem.lod, which refits each level")
     o.refit_rounds, o.refit_points_per_vertex = rounds, points
+    o.refit_by_reduction = refit == "light"  # as the command line's: it follows the reduction
     return o
 
 
@@ -378,8 +380,9 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
       allow_non_manifold: skip the link condition (edge collapses may make non-manifold edges).
       scheme: "passes" (fast) or "greedy" (GH97's heap: strictly cheapest first).
       refit: after the last contraction move the vertices to fit the input surface, faces fixed:
-        "light" (default, as the command line: 2 rounds on ~8 input vertices per output vertex, only
-        with optimal placement, without record and without attributes), "full" (3 rounds, every vertex), "none", or
+        "light" (default, as the command line: 2 rounds on ~8 input vertices per output vertex, fewer
+        or none at mild reductions, only with optimal placement, without record and without texture
+        coordinates or normals), "full" (3 rounds, every vertex), "none", or
         (rounds, points_per_vertex).
       threads: threads for the parallel parts (0 = all cores); the result is the same for any count.
       keep_components: every connected part keeps at least one face (a closed one four); False lets
@@ -425,10 +428,11 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
                        max_turn=max_turn, allow_non_manifold=allow_non_manifold, scheme=scheme, refit=refit,
                        threads=threads, record=record, keep_components=keep_components, prune=prune,
                        prune_relative=prune_relative, exact_border=exact_border)
-    # The light default follows the command line here too: not on a mesh with attributes, where it
-    # lowers E but raises the UV and normal errors a little (docs/attributes.md, "Seams, locks and
-    # the refit"); "full" or (rounds, points) still refits them, holding every seam position.
-    if refit == "light" and attributes:
+    # The light default follows the command line here too: not on a mesh with texture coordinates
+    # or normals, where it lowers E but raises their errors a little (docs/attributes.md, "Seams,
+    # locks and the refit"); colours alone keep it; "full" or (rounds, points) still refits them,
+    # holding every seam position.
+    if refit == "light" and any(kind in ("texcoord", "normal") for _, kind, _ in _attribute_list(attributes)):
         options.refit_rounds = 0
     options.map_input_vertices = bool(return_mapping)
     options.fit_attributes = bool(fit_attributes)

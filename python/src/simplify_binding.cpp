@@ -154,6 +154,7 @@ void bind_simplify(py::module_& m) {
       .def_readwrite("threads", &SimplifyOptions::threads)
       .def_readwrite("refit_rounds", &SimplifyOptions::refit_rounds)
       .def_readwrite("refit_points_per_vertex", &SimplifyOptions::refit_points_per_vertex)
+      .def_readwrite("refit_by_reduction", &SimplifyOptions::refit_by_reduction)
       .def_readwrite("fit_attributes", &SimplifyOptions::fit_attributes)
       .def_readwrite("map_input_vertices", &SimplifyOptions::map_input_vertices)
       .def_property(

@@ -138,6 +138,7 @@ py::list lod(py::handle vertices, py::handle faces, SimplifyOptions options, con
   Positions p = positions_from(vertices, "vertices");
   Indices f = indices_from(faces, "faces", p.data.size() / 3);
   const RefitOptions refit = refit_options_for(options);  // as simplify would refit
+  const SimplifyOptions refit_as = options;                // each level as its reduction says
   options.refit_rounds = 0;
   if (!faces_targets.empty())
     options.target_faces = *std::min_element(faces_targets.begin(), faces_targets.end());
@@ -151,18 +152,14 @@ py::list lod(py::handle vertices, py::handle faces, SimplifyOptions options, con
     py::gil_scoped_release nogil;
     const MeshView view(p.data, f.data);
     ContractionRecorder recorder;
-    qem::simplify(view, options, &recorder);
+    const SimplifyResult run = qem::simplify(view, options, &recorder);
     const Record record = make_record(view, recorder.log);
     std::vector<std::size_t> targets = faces_targets;
     for (double r : ratios) targets.push_back(std::size_t(std::floor(r * double(record.base.face_count()))));
     std::sort(targets.begin(), targets.end(), std::greater<>());
     targets.erase(std::unique(targets.begin(), targets.end()), targets.end());
     levels = replay_levels(record, targets);
-    if (refit.rounds > 0) {
-      std::vector<Mesh*> meshes;
-      for (ReplayLevel& l : levels) meshes.push_back(&l.mesh);
-      qem::refit(view, meshes, refit);
-    }
+    if (refit.rounds > 0) refit_levels(view, levels, refit_as, run.input_vertices);
   }
   py::list out;
   for (ReplayLevel& l : levels) {

@@ -203,11 +203,11 @@ SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options
   // The refit fits the result to the whole input, as simplify's own refit does, with the input's
   // surface: without it the refit has no Hausdorff guard and far points still pull, and it raised
   // the one-sided distance by a third on a bumpy sphere where simplify's refit keeps it.
-  if (options.refit_rounds > 0 && result.contractions > 0) {
+  RefitOptions refit_options = refit_options_for(options, referenced, result.mesh.vertex_count());
+  if (refit_options.rounds > 0 && result.contractions > 0) {
     const refit_detail::FitPoints points(input.positions, refit_detail::vertex_areas(input));
     const core::SurfaceDistance surface =
         refit_detail::surface_in_frame(input.positions, input.indices, points.frame());
-    RefitOptions refit_options = refit_options_for(options);
     std::vector<std::uint8_t> fixed;
     if (!options.vertex_lock.empty()) {
       fixed.assign(result.mesh.vertex_count(), 0);

@@ -2,6 +2,11 @@
 // takes the core's output and its map of where each input vertex went.
 #pragma once
 
+#include <cstddef>
+#include <span>
+
+#include "qem/mesh.h"
+#include "qem/progressive.h"
 #include "qem/refit.h"
 #include "qem/simplify.h"
 
@@ -12,5 +17,16 @@ namespace qem {
 /// refit slid along a curved border would leave the input's polyline); an absolute max_distance
 /// (simplify resolves a relative one). `qem lod` refits each level with them, as `simplify` would.
 RefitOptions refit_options_for(const SimplifyOptions& options);
+
+/// The same for a run whose output has `output_vertices` vertices for `input_vertices` referenced
+/// input vertices: with SimplifyOptions::refit_by_reduction the rounds (0: no refit) and points
+/// per vertex follow the reduction.
+RefitOptions refit_options_for(const SimplifyOptions& options, std::size_t input_vertices,
+                               std::size_t output_vertices);
+
+/// Refits the levels of a chain (`qem lod`, Python's lod) each as `simplify` would refit a run to
+/// that level: the levels that get the same refit are refitted together.
+void refit_levels(MeshView original, std::span<ReplayLevel> levels, const SimplifyOptions& options,
+                  std::size_t input_vertices);
 
 }  // namespace qem
