@@ -432,13 +432,14 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
     # or normals, where it lowers E but raises their errors a little (docs/attributes.md, "Seams,
     # locks and the refit"); colours alone keep it; "full" or (rounds, points) still refits them,
     # holding every seam position.
-    if refit == "light" and any(kind in ("texcoord", "normal") for _, kind, _ in _attribute_list(attributes)):
+    attribute_list = _attribute_list(attributes)
+    if refit == "light" and any(kind in ("texcoord", "normal") for _, kind, _ in attribute_list):
         options.refit_rounds = 0
     options.map_input_vertices = bool(return_mapping)
     options.fit_attributes = bool(fit_attributes)
     if attribute_weights is not None:
         options.attribute_weights = attribute_weights
-    d = _qem.simplify(vertices, faces, options, _attribute_list(attributes), bool(record), progress, vertex_lock)
+    d = _qem.simplify(vertices, faces, options, attribute_list, bool(record), progress, vertex_lock)
     result = _mesh_from_dict(d, SimplifyResult)
     for key in SimplifyResult.__slots__:
         if key in ("record",):

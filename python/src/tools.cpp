@@ -137,8 +137,7 @@ py::list lod(py::handle vertices, py::handle faces, SimplifyOptions options, con
     if (!(r >= 0 && r <= 1)) throw py::value_error("ratios: every ratio must be in [0, 1]");
   Positions p = positions_from(vertices, "vertices");
   Indices f = indices_from(faces, "faces", p.data.size() / 3);
-  const RefitOptions refit = refit_options_for(options);  // as simplify would refit
-  const SimplifyOptions refit_as = options;                // each level as its reduction says
+  const SimplifyOptions refit_as = options;  // each level refitted as simplify would at its target
   options.refit_rounds = 0;
   if (!faces_targets.empty())
     options.target_faces = *std::min_element(faces_targets.begin(), faces_targets.end());
@@ -159,7 +158,7 @@ py::list lod(py::handle vertices, py::handle faces, SimplifyOptions options, con
     std::sort(targets.begin(), targets.end(), std::greater<>());
     targets.erase(std::unique(targets.begin(), targets.end()), targets.end());
     levels = replay_levels(record, targets);
-    if (refit.rounds > 0) refit_levels(view, levels, refit_as, run.input_vertices);
+    refit_levels(view, levels, refit_as, run.input_vertices);  // nothing without a refit
   }
   py::list out;
   for (ReplayLevel& l : levels) {
