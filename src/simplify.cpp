@@ -9,6 +9,7 @@
 #include <span>
 
 #include "core/distance_bound.h"
+#include "core/parallel_chunks.h"
 #include "core/run.h"
 #include "core/settings.h"
 #include "geometry/box.h"
@@ -185,7 +186,8 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
   if (refit && chosen.rounds > 0 && out.contractions > 0 && out.stop_reason != StopReason::Cancelled) {
     if (!consumed_indices) weights = refit_detail::vertex_areas(input);
     const refit_detail::FitPoints points(input.positions, weights);
-    const core::SurfaceDistance surface = refit_detail::surface_in_frame(input.positions, input_faces, points.frame());
+    const core::SurfaceDistance surface = refit_detail::surface_in_frame(input.positions, input_faces, points.frame(),
+                                                                         core::resolve_threads(options.threads));
     RefitOptions refit_options = chosen;
     refit_options.max_distance = max_distance;
     std::vector<std::uint8_t> fixed;  // the locked vertices stay

@@ -79,6 +79,34 @@ TEST(Measure, BvhMatchesBruteForce) {
   }
 }
 
+// The build runs in fixed chunks on the threads (65,536 triangles a chunk): a tree built on one,
+// two or three threads over more than one chunk is the same tree, with the brute force's answers.
+TEST(Measure, BvhBuiltOnThreadsIsTheSameTree) {
+  const Mesh sphere = test::icosphere(6);  // 81,920 triangles: two chunks
+  const measure_detail::Surface s = measure_detail::make_surface(sphere, "sphere");
+  const measure_detail::TriangleBvh one(s.corners, 1), two(s.corners, 2), three(s.corners, 3);
+  ASSERT_EQ(two.node_count(), one.node_count());
+  ASSERT_EQ(three.node_count(), one.node_count());
+  measure_detail::Rng rng(11);
+  for (int i = 0; i < 40; ++i) {
+    const double p[3] = {3 * rng.uniform() - 1.5, 3 * rng.uniform() - 1.5, 3 * rng.uniform() - 1.5};
+    double best = INFINITY;
+    for (std::size_t t = 0; t < s.triangle_count(); ++t) {
+      const double* c = &s.corners[9 * t];
+      const Vec3 q = closest_point_on_triangle({p[0], p[1], p[2]}, {c[0], c[1], c[2]}, {c[3], c[4], c[5]},
+                                               {c[6], c[7], c[8]});
+      best = std::min(best, measure_detail::squared_distance({p[0], p[1], p[2]}, q));
+    }
+    const auto a = one.closest(p), b = two.closest(p), c = three.closest(p);
+    ASSERT_EQ(a.d2, best) << "query " << i;
+    ASSERT_EQ(b.triangle, a.triangle) << "query " << i;
+    ASSERT_EQ(c.triangle, a.triangle) << "query " << i;
+    ASSERT_TRUE(bit_equal(b.d2, a.d2) && bit_equal(c.d2, a.d2)) << "query " << i;
+    for (std::uint32_t t : {0u, 40000u, 81919u})  // the stored triangles, each where its index says
+      ASSERT_TRUE(std::equal(one.triangle(t), one.triangle(t) + 9, two.triangle(t)));
+  }
+}
+
 // The Morton-ordered build splits a range of equal codes in half: many triangles with one centre
 // (stacked copies), a dense cluster beside a far triangle, and exact ties all give the brute
 // force's answer, ties to the lowest index.

@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdint>
 #include <utility>
+#include <span>
 #include <vector>
 
 #include "core/working_mesh.h"
@@ -31,12 +32,13 @@ inline constexpr int kMaxDepth = 6;
 class SurfaceDistance {
  public:
   SurfaceDistance() = default;
-  /// `corners`: 9 doubles per triangle of the surface (a.xyz b.xyz c.xyz).
-  explicit SurfaceDistance(const std::vector<double>& corners) : tree_(corners) {}
+  /// `corners`: 9 doubles per triangle of the surface (a.xyz b.xyz c.xyz); its tree is built on up
+  /// to `threads` threads (the same tree on any number).
+  explicit SurfaceDistance(std::span<const double> corners, unsigned threads = 1) : tree_(corners, threads) {}
   /// With, for each vertex of the surface's mesh, one triangle that has it (UINT32_MAX: none): a
   /// start for searches from points known to lie near a vertex (face_at).
-  SurfaceDistance(const std::vector<double>& corners, std::vector<std::uint32_t> face_at_vertex)
-      : tree_(corners), face_at_vertex_(std::move(face_at_vertex)) {}
+  SurfaceDistance(std::span<const double> corners, std::vector<std::uint32_t> face_at_vertex, unsigned threads = 1)
+      : tree_(corners, threads), face_at_vertex_(std::move(face_at_vertex)) {}
   bool empty() const { return tree_.empty(); }
   /// A triangle that has vertex v, or UINT32_MAX (unknown).
   std::uint32_t face_at(std::uint32_t v) const {

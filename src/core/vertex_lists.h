@@ -12,31 +12,10 @@
 #include <utility>
 #include <vector>
 
+#include "core/default_init_allocator.h"
 #include "core/radix_sort.h"
 
 namespace qem::core {
-
-/// std::allocator whose resize() leaves new elements uninitialised: the arena below grows by
-/// stretches that are always written before they are read, and zero-filling them first was a
-/// measurable share of each pass.
-template <class T>
-struct DefaultInitAllocator : std::allocator<T> {
-  template <class U>
-  struct rebind {
-    using other = DefaultInitAllocator<U>;
-  };
-  DefaultInitAllocator() = default;
-  template <class U>
-  DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept {}
-  template <class U>
-  void construct(U* p) noexcept {
-    ::new (static_cast<void*>(p)) U;
-  }
-  template <class U, class... Args>
-  void construct(U* p, Args&&... args) {
-    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
-  }
-};
 
 class VertexLists {
  public:

@@ -10,7 +10,10 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <vector>
+
+#include "core/default_init_allocator.h"
 
 namespace qem::measure_detail {
 
@@ -26,8 +29,9 @@ class TriangleBvh {
   };
 
   TriangleBvh() = default;
-  /// `corners`: 9 doubles per triangle (a.xyz b.xyz c.xyz).
-  explicit TriangleBvh(const std::vector<double>& corners);
+  /// `corners`: 9 doubles per triangle (a.xyz b.xyz c.xyz). Built on up to `threads` threads; the
+  /// tree is the same on any number.
+  explicit TriangleBvh(std::span<const double> corners, unsigned threads = 1);
 
   /// The closest point of all triangles to `p` (of two as close, the one of lower index, so the
   /// answer does not depend on the tree's layout); none closer than sqrt(max_d2) -> Hit with d2 = inf.
@@ -66,9 +70,10 @@ class TriangleBvh {
   double slot_d2(const double p[3], std::uint32_t slot, double point[3]) const;
 
   std::vector<Node> nodes_;
-  std::vector<double> tris_;            ///< 9 per triangle, in leaf order
+  // Written whole by the build before any read: not zero-filled first.
+  std::vector<double, core::DefaultInitAllocator<double>> tris_;           ///< 9 per triangle, in leaf order
   std::vector<std::uint32_t> ids_;      ///< input index of each stored triangle
-  std::vector<std::uint32_t> slot_of_;  ///< stored position of each input triangle
+  std::vector<std::uint32_t, core::DefaultInitAllocator<std::uint32_t>> slot_of_;  ///< stored position of each input triangle
 };
 
 }  // namespace qem::measure_detail

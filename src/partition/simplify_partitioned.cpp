@@ -207,7 +207,7 @@ SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options
   if (refit_options.rounds > 0 && result.contractions > 0) {
     const refit_detail::FitPoints points(input.positions, refit_detail::vertex_areas(input));
     const core::SurfaceDistance surface =
-        refit_detail::surface_in_frame(input.positions, input.indices, points.frame());
+        refit_detail::surface_in_frame(input.positions, input.indices, points.frame(), core::resolve_threads(options.threads));
     std::vector<std::uint8_t> fixed;
     if (!options.vertex_lock.empty()) {
       fixed.assign(result.mesh.vertex_count(), 0);

@@ -718,16 +718,21 @@ void check_options(const RefitOptions& options) {
 }
 
 core::SurfaceDistance surface_in_frame(std::span<const double> positions, std::span<const std::uint32_t> indices,
-                                       const Frame& frame) {
-  std::vector<double> corners(3 * indices.size());
+                                       const Frame& frame, unsigned threads) {
+  // Filled on the threads, not zeroed first: on a large input these corners are otherwise a serial
+  // stretch of fresh pages.
+  std::vector<double, core::DefaultInitAllocator<double>> corners(3 * indices.size());
+  core::for_chunks(indices.size(), kChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
+    for (std::size_t c = begin; c < end; ++c) {
+      const double* p = &positions[3 * std::size_t(indices[c])];
+      const Vec3 q = frame.to_frame({p[0], p[1], p[2]});
+      corners[3 * c] = q.x, corners[3 * c + 1] = q.y, corners[3 * c + 2] = q.z;
+    }
+  });
   std::vector<std::uint32_t> face_at(positions.size() / 3, UINT32_MAX);
-  for (std::size_t c = 0; c < indices.size(); ++c) {
-    const double* p = &positions[3 * std::size_t(indices[c])];
-    const Vec3 q = frame.to_frame({p[0], p[1], p[2]});
-    corners[3 * c] = q.x, corners[3 * c + 1] = q.y, corners[3 * c + 2] = q.z;
+  for (std::size_t c = 0; c < indices.size(); ++c)
     if (face_at[indices[c]] == UINT32_MAX) face_at[indices[c]] = std::uint32_t(c / 3);
-  }
-  return core::SurfaceDistance(corners, std::move(face_at));
+  return core::SurfaceDistance(corners, std::move(face_at), threads);
 }
 
 RefitResult refit_to_points(const FitPoints& points, Mesh& approx, const RefitOptions& options,

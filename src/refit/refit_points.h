@@ -54,8 +54,9 @@ RefitResult refit_to_points(const FitPoints& points, Mesh& approx, const RefitOp
                             std::span<const std::uint32_t> near_vertex = {},
                             const core::SurfaceDistance* surface = nullptr);
 
-/// The surface of an original (positions, triangle indices) in `frame` (FitPoints::frame()).
+/// The surface of an original (positions, triangle indices) in `frame` (FitPoints::frame()), made
+/// on up to `threads` threads (the same surface on any number).
 core::SurfaceDistance surface_in_frame(std::span<const double> positions, std::span<const std::uint32_t> indices,
-                                       const Frame& frame);
+                                       const Frame& frame, unsigned threads = 1);
 
 }  // namespace qem::refit_detail
