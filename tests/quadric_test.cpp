@@ -1,6 +1,7 @@
 // GH97 §4-§5 quadric maths and §4 placement, against hand-computed values.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -87,6 +88,43 @@ TEST(Placement, NearlyParallelPlanesMeetAtTheirCornerUntilSingular) {
   }
   Vec3 v;
   EXPECT_FALSE(place_optimal(through_corner(1e-5), v));
+}
+
+// Below the determinant bound, place_optimal decides on bounds of the eigenvalue ratio from det
+// and the principal minors, and asks the eigen-decomposition only between them: its decision is
+// the eigen test's for every conditioning, across the threshold, and where it solves it finds the
+// corner (the closed form is the more accurate of the two; see the test above).
+TEST(Placement, RatioBoundsDecideAsTheEigenTest) {
+  const Vec3 corner{0.3, -2, 5};
+  int solved = 0, refused = 0, solved_by_bounds = 0;
+  for (int step = 0; step <= 120; ++step) {
+    const double theta = std::pow(10.0, -1.0 - 5.0 * step / 120);  // 1e-1 down to 1e-6
+    for (double stretch : {1.0, 0.1, 0.01}) {  // the two small eigenvalues alike, or apart
+      Quadric q;
+      for (const Vec3& n : {Vec3{0, 0, 1}, Vec3{std::sin(theta), 0, std::cos(theta)},
+                            Vec3{0, std::sin(stretch * theta), std::cos(stretch * theta)}})
+        q += Quadric::plane(n, -dot(n, corner), 1);
+      Vec3 fast, eigen;
+      const bool by_bounds = place_optimal(q, fast), by_eigen = place_optimal_near_singular(q, eigen);
+      ASSERT_EQ(by_bounds, by_eigen) << "theta " << theta << " stretch " << stretch;
+      if (!by_bounds) {
+        ++refused;
+        continue;
+      }
+      ++solved;
+      if (fast.x == eigen.x && fast.y == eigen.y && fast.z == eigen.z) continue;  // the band: the eigen solve
+      ++solved_by_bounds;
+      // At the corner, to the rounding over the eigenvalue ratio (~theta^2); the eigen solve
+      // is off by up to ~100 times more here.
+      const double tolerance = std::max(1e-12, 1e-14 / (stretch * stretch * theta * theta));
+      EXPECT_NEAR(fast.x, corner.x, tolerance) << theta;
+      EXPECT_NEAR(fast.y, corner.y, tolerance) << theta;
+      EXPECT_NEAR(fast.z, corner.z, tolerance) << theta;
+    }
+  }
+  EXPECT_GT(solved, 50);  // both sides of the threshold were reached
+  EXPECT_GT(refused, 50);
+  EXPECT_GT(solved_by_bounds, 50);
 }
 
 TEST(Placement, FallsBackToSegmentWhenSingular) {

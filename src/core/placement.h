@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cmath>
+#include <limits>
 
 #include "core/border_chains.h"
 #include "core/quadric.h"
@@ -51,15 +52,27 @@ inline bool place_optimal(const Quadric& q, Vec3& out) {
   if (!(trace > 0)) return false;
   const double det = q.a00 * (q.a11 * q.a22 - q.a12 * q.a12) - q.a01 * (q.a01 * q.a22 - q.a12 * q.a02) +
                      q.a02 * (q.a01 * q.a12 - q.a11 * q.a02);
-  const double t3 = trace / 3;
-  if (!(det > kFastRatio * t3 * t3 * t3)) return place_optimal_near_singular(q, out);
-  // Cofactor inverse of the symmetric A, applied to -b.
+  // Cofactors of the symmetric A: its inverse times det, and on the diagonal the principal 2x2
+  // minors, whose sum c1 = l0 l1 + l0 l2 + l1 l2 bounds the ratio below.
   const double i00 = q.a11 * q.a22 - q.a12 * q.a12;
   const double i01 = q.a02 * q.a12 - q.a01 * q.a22;
   const double i02 = q.a01 * q.a12 - q.a02 * q.a11;
   const double i11 = q.a00 * q.a22 - q.a02 * q.a02;
   const double i12 = q.a01 * q.a02 - q.a00 * q.a12;
   const double i22 = q.a00 * q.a11 - q.a01 * q.a01;
+  const double t3 = trace / 3;
+  if (!(det > kFastRatio * t3 * t3 * t3)) {
+    // A fine smooth surface gives two small eigenvalues, below the bound above but far above
+    // kMinEigenRatio. With l0 <= l1 <= l2 >= 0: l1 l2 <= c1 <= 3 l1 l2 and t/3 <= l2 <= t, so
+    // det / (c1 t) <= l0 / l2 <= 9 det / (c1 t). Where these bounds, widened by the rounding of det
+    // and c1 (a few ulps of t^3 and t^2), decide the eigen test, it is skipped; only the band
+    // between them asks the eigen-decomposition.
+    const double c1 = i00 + i11 + i22;
+    const double det_error = 32 * std::numeric_limits<double>::epsilon() * trace * trace * trace;
+    const double c1_error = 8 * std::numeric_limits<double>::epsilon() * trace * trace;
+    if (9 * (det + det_error) < kMinEigenRatio * (c1 - c1_error) * trace) return false;  // l0 / l2 surely below
+    if (!(det - det_error > kMinEigenRatio * (c1 + c1_error) * trace)) return place_optimal_near_singular(q, out);
+  }
   const double inv = -1.0 / det;
   out = {(i00 * q.b0 + i01 * q.b1 + i02 * q.b2) * inv, (i01 * q.b0 + i11 * q.b1 + i12 * q.b2) * inv,
          (i02 * q.b0 + i12 * q.b1 + i22 * q.b2) * inv};
