@@ -83,7 +83,9 @@ bool fits_in_memory(const std::string& path, std::uint64_t memory_limit);
 
 /// Simplifies the mesh file `path` in the two phases, whatever its size, under the options'
 /// budget. `options` are those of qem::simplify and apply to phase 2 (its quadrics are recomputed
-/// from the clustered faces); target_ratio counts the input's faces; vertex_lock is refused; the
+/// from the clustered faces); with refit_by_reduction, where phase 2 starts from fewer than 6
+/// clustered faces an output face, the refit fits the output to the input's points instead
+/// (one round, a fourth phase "refitting"; docs/out-of-core.md); target_ratio counts the input's faces; vertex_lock is refused; the
 /// result does not depend on options.threads. Throws
 /// qem::Error on a malformed input, an unwritable or full temporary folder, or a cancel; temporary files are
 /// removed in every case (and on SIGINT/SIGTERM).
