@@ -259,6 +259,7 @@ class Refitter {
       ring_slot_[c] = fill[tri_[c]]++;
       ring_faces_[ring_slot_[c]] = std::uint32_t(c / 3);
     }
+    make_around();
     // A start for each vertex's search of the original: of the faces at the input vertices
     // contracted into it (one each), the nearest.
     if (surface_ && !near_vertex_.empty()) {
@@ -412,19 +413,33 @@ class Refitter {
       reach = std::sqrt(d2);
     };
     test(f);
-    const std::uint32_t* corners = &tri_[3 * std::size_t(f)];
-    for (int corner = 0; corner < 3; ++corner) {
-      const std::uint32_t v = corners[corner];
-      for (std::uint32_t i = ring_start_[v]; i < ring_start_[v + 1]; ++i) {
-        const std::uint32_t g = ring_faces_[i];
-        const std::uint32_t* t = &tri_[3 * std::size_t(g)];
-        // A face around an earlier corner too was tested there.
-        const auto has = [t](std::uint32_t u) { return t[0] == u || t[1] == u || t[2] == u; };
-        if (g == f || (corner > 0 && has(corners[0])) || (corner > 1 && has(corners[1]))) continue;
-        test(g);
-      }
-    }
+    for (std::uint32_t i = around_start_[f]; i < around_start_[f + 1]; ++i) test(around_faces_[i]);
     return hit;
+  }
+
+  // Per face f, the other faces around its corners, each once, in the order of the corners' rings
+  // (CSR in around_start_, around_faces_): what closest_around tests after f. The faces do not
+  // change between rounds, so the lists are made once, not for every query.
+  void make_around() {
+    const std::size_t nf = tri_.size() / 3;
+    around_start_.assign(nf + 1, 0);
+    around_faces_.clear();
+    around_faces_.reserve(12 * nf);
+    for (std::size_t f = 0; f < nf; ++f) {
+      const std::uint32_t* corners = &tri_[3 * f];
+      for (int corner = 0; corner < 3; ++corner) {
+        const std::uint32_t v = corners[corner];
+        for (std::uint32_t i = ring_start_[v]; i < ring_start_[v + 1]; ++i) {
+          const std::uint32_t g = ring_faces_[i];
+          const std::uint32_t* t = &tri_[3 * std::size_t(g)];
+          // A face around an earlier corner too is listed there.
+          const auto has = [t](std::uint32_t u) { return t[0] == u || t[1] == u || t[2] == u; };
+          if (g == f || (corner > 0 && has(corners[0])) || (corner > 1 && has(corners[1]))) continue;
+          around_faces_.push_back(g);
+        }
+      }
+      around_start_[f + 1] = std::uint32_t(around_faces_.size());
+    }
   }
 
   // The vertex given near point j, if it has a face; else UINT32_MAX.
@@ -689,6 +704,7 @@ class Refitter {
   std::vector<std::uint8_t> fixed_;
   std::vector<std::uint32_t> ring_start_, ring_faces_;  // faces around each vertex
   std::vector<std::uint32_t> ring_slot_;  // per corner of a face: its place in its vertex's ring
+  std::vector<std::uint32_t> around_start_, around_faces_;  // per face: the faces around its corners
   bool ready_ = false;
 };
 
