@@ -79,6 +79,8 @@ constexpr double kFarHausdorff = 2;
 /// The refit may raise the sampled one-sided Hausdorff distance (approximation to original, over
 /// vertices and face centroids) by at most this fraction of its value before the refit.
 constexpr double kHausdorffMargin = 0.02;
+/// Doubles per face in Refitter::bounding_spheres: centre, radius, unit normal, padding.
+constexpr std::size_t kSphere = 8;
 
 Vec3 at(const std::vector<double>& x, std::uint32_t v) { return {x[3 * v], x[3 * v + 1], x[3 * v + 2]}; }
 
@@ -259,6 +261,7 @@ class Refitter {
       ring_slot_[c] = fill[tri_[c]]++;
       ring_faces_[ring_slot_[c]] = std::uint32_t(c / 3);
     }
+    make_around();
     // A start for each vertex's search of the original: of the faces at the input vertices
     // contracted into it (one each), the nearest.
     if (surface_ && !near_vertex_.empty()) {
@@ -375,17 +378,23 @@ class Refitter {
   // Per face of the approximation with vertices x, a sphere that holds it: centre = the corners'
   // mean, radius = the farthest corner's distance plus 1e-12 (of the diagonal: the frame is
   // normalised), far above the rounding of the distances (~1e-16), so a face the bound skips could
-  // never have been the closest.
+  // never have been the closest; and the face's unit normal (kSphere doubles a face).
   std::vector<double> bounding_spheres(const std::vector<double>& x) const {
-    std::vector<double> out(tri_.size() / 3 * 4);
+    std::vector<double> out(tri_.size() / 3 * kSphere);
     for (std::size_t f = 0; f < tri_.size() / 3; ++f) {
       const std::uint32_t* t = &tri_[3 * f];
       const Vec3 a = at(x, t[0]), b = at(x, t[1]), c = at(x, t[2]);
       const Vec3 m = (1.0 / 3) * (a + b + c);
       using measure_detail::squared_distance;
       const double r2 = std::max({squared_distance(a, m), squared_distance(b, m), squared_distance(c, m)});
-      out[4 * f] = m.x, out[4 * f + 1] = m.y, out[4 * f + 2] = m.z;
-      out[4 * f + 3] = std::sqrt(r2) + 1e-12;
+      double* o = &out[kSphere * f];
+      o[0] = m.x, o[1] = m.y, o[2] = m.z, o[3] = std::sqrt(r2) + 1e-12;
+      // The unit normal, where its direction is known to ~1e-10 (the sine of the face's sharpest
+      // angle at least 1e-6); else zero, and closest_around uses the sphere alone.
+      const Vec3 e1 = b - a, e2 = c - a, n = cross(e1, e2);
+      const double nn = dot(n, n), ee = dot(e1, e1) * dot(e2, e2);
+      const double scale = nn > 1e-12 * ee && nn > 0 ? 1 / std::sqrt(nn) : 0.0;
+      o[4] = n.x * scale, o[5] = n.y * scale, o[6] = n.z * scale;
     }
     return out;
   }
@@ -401,9 +410,21 @@ class Refitter {
     double reach = HUGE_VAL;  // sqrt(hit.d2)
     const Vec3 point{q[0], q[1], q[2]};
     const auto test = [&](std::uint32_t g) {
-      const double* s = &spheres[4 * std::size_t(g)];
+      const double* s = &spheres[kSphere * std::size_t(g)];
       const double gap = reach + s[3];
-      if (measure_detail::squared_distance(point, {s[0], s[1], s[2]}) > gap * gap) return;
+      const Vec3 qc = point - Vec3{s[0], s[1], s[2]};
+      const double qc2 = dot(qc, qc);
+      if (qc2 > gap * gap) return;
+      // Tighter: the face lies in its plane, within s[3] of the centre, so its distance is at least
+      // sqrt(h^2 + max(0, l - s[3])^2), h the height over the plane and l the distance along it.
+      // Skipped only when that exceeds the closest so far by more than the rounding of h and l
+      // (the normal's direction to 1e-10, the frame's coordinates of order 1): never a face that
+      // could be as close.
+      const double h = qc.x * s[4] + qc.y * s[5] + qc.z * s[6];
+      const Vec3 along = qc - h * Vec3{s[4], s[5], s[6]};
+      const double l = std::sqrt(dot(along, along)), lateral = l > s[3] ? l - s[3] : 0.0;
+      const double bound = reach + 1e-12 + 1e-9 * std::sqrt(qc2);
+      if (h * h + lateral * lateral > bound * bound) return;
       const std::uint32_t* t = &tri_[3 * std::size_t(g)];
       const Vec3 c = measure_detail::closest_point_on_triangle(point, at(x, t[0]), at(x, t[1]), at(x, t[2]));
       const double d2 = measure_detail::squared_distance(point, c);
@@ -412,19 +433,33 @@ class Refitter {
       reach = std::sqrt(d2);
     };
     test(f);
-    const std::uint32_t* corners = &tri_[3 * std::size_t(f)];
-    for (int corner = 0; corner < 3; ++corner) {
-      const std::uint32_t v = corners[corner];
-      for (std::uint32_t i = ring_start_[v]; i < ring_start_[v + 1]; ++i) {
-        const std::uint32_t g = ring_faces_[i];
-        const std::uint32_t* t = &tri_[3 * std::size_t(g)];
-        // A face around an earlier corner too was tested there.
-        const auto has = [t](std::uint32_t u) { return t[0] == u || t[1] == u || t[2] == u; };
-        if (g == f || (corner > 0 && has(corners[0])) || (corner > 1 && has(corners[1]))) continue;
-        test(g);
-      }
-    }
+    for (std::uint32_t i = around_start_[f]; i < around_start_[f + 1]; ++i) test(around_faces_[i]);
     return hit;
+  }
+
+  // Per face f, the other faces around its corners, each once, in the order of the corners' rings
+  // (CSR in around_start_, around_faces_): what closest_around tests after f. The faces do not
+  // change between rounds, so the lists are made once, not for every query.
+  void make_around() {
+    const std::size_t nf = tri_.size() / 3;
+    around_start_.assign(nf + 1, 0);
+    around_faces_.clear();
+    around_faces_.reserve(12 * nf);
+    for (std::size_t f = 0; f < nf; ++f) {
+      const std::uint32_t* corners = &tri_[3 * f];
+      for (int corner = 0; corner < 3; ++corner) {
+        const std::uint32_t v = corners[corner];
+        for (std::uint32_t i = ring_start_[v]; i < ring_start_[v + 1]; ++i) {
+          const std::uint32_t g = ring_faces_[i];
+          const std::uint32_t* t = &tri_[3 * std::size_t(g)];
+          // A face around an earlier corner too is listed there.
+          const auto has = [t](std::uint32_t u) { return t[0] == u || t[1] == u || t[2] == u; };
+          if (g == f || (corner > 0 && has(corners[0])) || (corner > 1 && has(corners[1]))) continue;
+          around_faces_.push_back(g);
+        }
+      }
+      around_start_[f + 1] = std::uint32_t(around_faces_.size());
+    }
   }
 
   // The vertex given near point j, if it has a face; else UINT32_MAX.
@@ -449,7 +484,7 @@ class Refitter {
     double nearest = HUGE_VAL;
     for (std::uint32_t i = ring_start_[v]; i < ring_start_[v + 1]; ++i) {
       const std::uint32_t g = ring_faces_[i];
-      const double* s = &spheres[4 * std::size_t(g)];
+      const double* s = &spheres[kSphere * std::size_t(g)];
       const double d2 = measure_detail::squared_distance({q[0], q[1], q[2]}, {s[0], s[1], s[2]});
       if (d2 < nearest) nearest = d2, f = g;
     }
@@ -689,6 +724,7 @@ class Refitter {
   std::vector<std::uint8_t> fixed_;
   std::vector<std::uint32_t> ring_start_, ring_faces_;  // faces around each vertex
   std::vector<std::uint32_t> ring_slot_;  // per corner of a face: its place in its vertex's ring
+  std::vector<std::uint32_t> around_start_, around_faces_;  // per face: the faces around its corners
   bool ready_ = false;
 };
 
