@@ -232,9 +232,10 @@ Mesh star_hole_annulus() {
 // A border edge of the output is a chord across the input border between its ends: the input
 // border vertices it replaces lie at most the run's error from it (core/border_placement.h,
 // chord_error). GH97's boundary planes alone priced only how far the new vertex left the planes
-// of the removed border edges: rim vertices of the star's concave lobes lay up to 2.3 times the
-// run's largest contraction error (r.max_error) from the output border, the faces on those chords
-// covering part of the hole (the bunny's base at 1 %: Hausdorff 1.31x meshoptimizer's).
+// of the removed border edges: rim vertices of the star's lobes lay 2.1 (10 %) and 4.4 (3 %)
+// times the run's largest contraction error (r.max_error) from the output border, the faces on
+// those chords covering part of the hole (the bunny's base at 1 %: Hausdorff 1.31x
+// meshoptimizer's). Now the bound holds and is what limits: the farthest comes within 1 % of it.
 TEST(Borders, InputBorderLiesWithinTheErrorOfItsChords) {
   const Mesh in = star_hole_annulus();
   std::vector<Point> in_border;
@@ -252,7 +253,7 @@ TEST(Borders, InputBorderLiesWithinTheErrorOfItsChords) {
     for (const Point& p : in_border) farthest = std::max(farthest, distance_to_edges(p, out_border));
     // 1e-9 of the diagonal (about 2) for rounding: sqrt of a quadric error is not exact.
     EXPECT_LE(farthest, r.max_error + 2e-9) << "ratio " << ratio;
-    EXPECT_GT(farthest, 0.2 * r.max_error) << "ratio " << ratio;  // the chords do cut the border
+    EXPECT_GT(farthest, 0.5 * r.max_error) << "ratio " << ratio;  // the chords do cut the border
   }
 }
 
