@@ -141,9 +141,9 @@ double param_on(const BorderSpot& v, std::uint32_t x, std::uint32_t y) {
 // toward y. False if a corner (unless `through_corners`), a polyline's end or kMaxBorderWalk
 // edges come first.
 bool walk(const BorderChains& ch, std::uint32_t x, std::uint32_t y, double lo, const BorderSpot& v,
-          std::vector<Piece>& out, bool through_corners) {
+          std::vector<Piece>& out, bool through_corners, std::size_t max_steps) {
   out.clear();
-  for (std::size_t steps = 0; steps < kMaxBorderWalk && y != kNoSlot; ++steps) {
+  for (std::size_t steps = 0; steps < max_steps && y != kNoSlot; ++steps) {
     const double tv = param_on(v, x, y);
     if (tv > lo) {
       out.push_back({x, y, lo, tv});
@@ -165,7 +165,9 @@ std::vector<Piece> border_between(const BorderChains& ch, const BorderSpot& u, c
                                   bool through_corners = false) {
   std::vector<Piece> best, way;
   const auto consider = [&](std::uint32_t x, std::uint32_t y, double lo) {
-    if (y == kNoSlot || !walk(ch, x, y, lo, v, way, through_corners)) return;
+    // The second way need not be walked further than the first found (around a loop, through
+    // corners, the wrong way goes all the way round).
+    if (y == kNoSlot || !walk(ch, x, y, lo, v, way, through_corners, best.empty() ? kMaxBorderWalk : best.size() - 1)) return;
     if (best.empty() || way.size() < best.size()) best = way;
   };
   if (u.to == kNoSlot) {
