@@ -429,7 +429,9 @@ TEST(Seams, CommandLinePermissiveReachesTheTarget) {
   EXPECT_EQ(strict.out.find("\"out_faces\":160"), std::string::npos) << strict.out;
   CliRun permissive = run_cli("simplify " + obj + " " + out + " --faces 160 --seams permissive --json --quiet --force");
   ASSERT_EQ(permissive.exit_code, 0) << permissive.out;
-  EXPECT_EQ(load_mesh(out).face_count(), 160u);
+  // Reached: an interior contraction removes two faces, so the run may stop one below the target.
+  EXPECT_LE(load_mesh(out).face_count(), 160u);
+  EXPECT_GE(load_mesh(out).face_count(), 159u);
   CliRun bad = run_cli("simplify " + obj + " " + out + " --faces 160 --seams sometimes --quiet --force");
   EXPECT_NE(bad.exit_code, 0);
 }
