@@ -138,11 +138,12 @@ double param_on(const BorderSpot& v, std::uint32_t x, std::uint32_t y) {
 }
 
 // The input border from u to v along one direction: starting on edge x-y at parameter lo,
-// toward y. False if a corner, a polyline's end or kMaxBorderWalk edges come first.
+// toward y. False if a corner (unless `through_corners`), a polyline's end or kMaxBorderWalk
+// edges come first.
 bool walk(const BorderChains& ch, std::uint32_t x, std::uint32_t y, double lo, const BorderSpot& v,
-          std::vector<Piece>& out) {
+          std::vector<Piece>& out, bool through_corners, std::size_t max_steps) {
   out.clear();
-  for (std::size_t steps = 0; steps < kMaxBorderWalk && y != kNoSlot; ++steps) {
+  for (std::size_t steps = 0; steps < max_steps && y != kNoSlot; ++steps) {
     const double tv = param_on(v, x, y);
     if (tv > lo) {
       out.push_back({x, y, lo, tv});
@@ -150,7 +151,7 @@ bool walk(const BorderChains& ch, std::uint32_t x, std::uint32_t y, double lo, c
     }
     out.push_back({x, y, lo, 1});
     if (v.to == kNoSlot && v.from == y) return true;
-    if (ch.corner[y]) return false;  // a live vertex: v is not beyond it
+    if (ch.corner[y] && !through_corners) return false;  // a live vertex: v is not beyond it
     const std::uint32_t* nb = &ch.neighbour[2 * std::size_t(y)];
     const std::uint32_t next = nb[0] == x ? nb[1] : nb[0];
     x = y, y = next, lo = 0;
@@ -158,11 +159,15 @@ bool walk(const BorderChains& ch, std::uint32_t x, std::uint32_t y, double lo, c
   return false;
 }
 
-// The shorter of the two ways from u to v along the input border (empty: neither found).
-std::vector<Piece> border_between(const BorderChains& ch, const BorderSpot& u, const BorderSpot& v) {
+// The shorter of the two ways from u to v along the input border (empty: neither found). A
+// corner ends the way unless `through_corners` (a soft corner the run removed still has its slot).
+std::vector<Piece> border_between(const BorderChains& ch, const BorderSpot& u, const BorderSpot& v,
+                                  bool through_corners = false) {
   std::vector<Piece> best, way;
   const auto consider = [&](std::uint32_t x, std::uint32_t y, double lo) {
-    if (y == kNoSlot || !walk(ch, x, y, lo, v, way)) return;
+    // The second way need not be walked further than the first found (around a loop, through
+    // corners, the wrong way goes all the way round).
+    if (y == kNoSlot || !walk(ch, x, y, lo, v, way, through_corners, best.empty() ? kMaxBorderWalk : best.size() - 1)) return;
     if (best.empty() || way.size() < best.size()) best = way;
   };
   if (u.to == kNoSlot) {
@@ -200,6 +205,51 @@ double corner_error(const Context& c_, std::uint32_t a, std::uint32_t b, const V
       size = std::max(size, m.chains.corner_size[m.border_spot[e].from]);
   }
   return (weight > 0 ? weight : 1) * size * size;
+}
+
+namespace {
+// Up to two neighbours of v along the current border other than `not_this`; kNoVertex for none.
+void border_neighbours(const WorkingMesh& m, std::uint32_t v, std::uint32_t not_this, std::uint32_t out[2]) {
+  out[0] = out[1] = kNoVertex;
+  for (std::uint32_t f : m.vertex_faces[v]) {
+    if (!m.face_alive[f]) continue;
+    const std::uint32_t* t = m.face(f);
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t n = t[k];
+      if (n == v || n == not_this || n == out[0] || n == out[1] || !border_detail::is_border_edge(m, v, n)) continue;
+      if (out[0] == kNoVertex) out[0] = n;
+      else out[1] = n;
+      if (out[1] != kNoVertex) return;
+    }
+  }
+}
+}  // namespace
+
+double chord_error(const Context& c_, std::uint32_t a, std::uint32_t b, const Vec3& x, const BorderSpot& xs, double weight) {
+  const WorkingMesh& m = c_.mesh;
+  if (!c_.settings.exact_border || m.corner.empty() || xs.from == kNoSlot || !(m.boundary[a] || m.boundary[b])) return 0;
+  const auto same = [](const Vec3& p, const Vec3& q) { return p.x == q.x && p.y == q.y && p.z == q.z; };
+  std::uint32_t nbr[2][2];
+  border_neighbours(m, a, b, nbr[0]);
+  border_neighbours(m, b, a, nbr[1]);
+  // A hole down to three vertices: the contraction closes it (hole_error), no border edge is left.
+  if (nbr[0][0] != kNoVertex && (nbr[0][0] == nbr[1][0] || nbr[0][0] == nbr[1][1])) return 0;
+  double d2 = 0;
+  for (int end = 0; end < 2; ++end) {
+    const std::uint32_t e = end == 0 ? a : b;
+    if (!m.boundary[e] || same(x, m.pos[e])) continue;  // e stays: its border edges are as they were
+    for (std::uint32_t n : nbr[end]) {
+      if (n == kNoVertex || m.border_spot[n].from == kNoSlot) continue;
+      const Vec3& s = m.pos[n];
+      // Through corners: a soft corner between n and x is gone if the way reaches x (a live one
+      // would be a vertex of the current border between them, which n and x are neighbours on).
+      for (const Piece& p : border_between(m.chains, m.border_spot[n], xs, true)) {
+        const Vec3 o = m.chains.pos[p.x], d = m.chains.pos[p.y] - o;
+        d2 = std::max({d2, squared_distance_to_segment(o + d * p.lo, s, x), squared_distance_to_segment(o + d * p.hi, s, x)});
+      }
+    }
+  }
+  return (weight > 0 ? weight : 1) * d2;
 }
 
 std::uint32_t hole_closed_by(const WorkingMesh& m, std::uint32_t a, std::uint32_t b) {
@@ -290,6 +340,7 @@ void place_along_border(const Context& c, std::uint32_t a, std::uint32_t b, cons
   const BorderSpot& u = m.border_spot[a];
   const BorderSpot& v = m.border_spot[b];
   if (u.from != kNoSlot && v.from != kNoSlot) add_piece_minima(m.chains, border_between(m.chains, u, v), q, error_at, cand);
+  for (Placed& k : cand) k.error = std::max(k.error, chord_error(c, a, b, k.position, k.spot, q.weight));
   choose(c, a, b, cand, placed);
 }
 
@@ -314,6 +365,8 @@ void place_on_own_border(const Context& c, std::uint32_t a, std::uint32_t b, con
     for (std::uint32_t n : {n0, n1})
       if (n != kNoVertex && m.border_spot[n].from != kNoSlot)
         add_piece_minima(m.chains, border_between(m.chains, u, m.border_spot[n]), q, error_at, cand);
+    // A slide moves a's two border edges (a's own place, cand[0], moves none).
+    for (Placed& k : cand) k.error = std::max(k.error, chord_error(c, a, b, k.position, k.spot, q.weight));
   }
   choose(c, a, b, cand, placed);
 }

@@ -228,8 +228,9 @@ bool try_contract(Context& c, Lists& lists, std::uint32_t p, Worker& w) {
   }
   // Exact borders: a border pair's cost depends on more than its two ends. Its placement is the
   // cheapest point that flips no face, so a neighbour's contraction can push it to a dearer one
-  // (one that removes a corner, corner_error), and a hole comes down to three vertices by a
-  // contraction elsewhere on its loop (hole_error). Neither re-costs this pair, so when its cost
+  // (one that removes a corner, corner_error), a hole comes down to three vertices by a
+  // contraction elsewhere on its loop (hole_error), and a border neighbour's slide or removal
+  // moves the far end of the chords it would make (chord_error). None re-costs this pair, so when its cost
   // now exceeds the ranked one it is ranked again instead of being made out of order.
   if (c.settings.exact_border && (c.mesh.boundary[a] || c.mesh.boundary[b]) &&
       round_key(placed.error) > double(ps.cost[p])) {

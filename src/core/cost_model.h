@@ -59,7 +59,8 @@ inline bool place_pair(const Context& c, std::uint32_t p, Quadric& q, Placed& pl
       if (border_detail::role(c, keep) == border_detail::Role::Border && !m.boundary[other])
         place_on_own_border(c, keep, other, q, placed);  // keep slides along its border
       else
-        placed = {m.pos[keep], std::max(q.evaluate(m.pos[keep]), corner_error(c, a, b, m.pos[keep], q.weight))};
+        placed = {m.pos[keep], std::max({q.evaluate(m.pos[keep]), corner_error(c, a, b, m.pos[keep], q.weight),
+                                         chord_error(c, a, b, m.pos[keep], m.border_spot[keep], q.weight)})};
       return true;
     }
     case BorderTarget::AtEither:

@@ -36,8 +36,10 @@ bool place_with_wedges(const Context& c, std::uint32_t a, std::uint32_t b, const
     } while (w != wg.first[survivor]);
     const Placed candidate =
         free ? place(total, m.pos[a], m.pos[b], c.settings.placement)
-             : Placed{m.pos[survivor], std::max(total.evaluate(m.pos[survivor]) + crossing_error,
-                                                corner_error(c, a, b, m.pos[survivor], q.weight))};
+             : Placed{m.pos[survivor],
+                      std::max({total.evaluate(m.pos[survivor]) + crossing_error, corner_error(c, a, b, m.pos[survivor], q.weight),
+                                chord_error(c, a, b, m.pos[survivor], m.border_spot.empty() ? BorderSpot{} : m.border_spot[survivor],
+                                            q.weight)})};
     if (!found || candidate.error < placed.error) placed = candidate;
     found = true;
     if (free) break;  // both directions place the same way
