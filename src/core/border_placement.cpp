@@ -229,6 +229,8 @@ double chord_error(const Context& c_, std::uint32_t a, std::uint32_t b, const Ve
   const WorkingMesh& m = c_.mesh;
   if (!c_.settings.exact_border || m.corner.empty() || xs.from == kNoSlot || !(m.boundary[a] || m.boundary[b])) return 0;
   const auto same = [](const Vec3& p, const Vec3& q) { return p.x == q.x && p.y == q.y && p.z == q.z; };
+  // No border end moves (a held or locked end, such as a part's cut): no border edge changes.
+  if (!(m.boundary[a] && !same(x, m.pos[a])) && !(m.boundary[b] && !same(x, m.pos[b]))) return 0;
   std::uint32_t nbr[2][2];
   border_neighbours(m, a, b, nbr[0]);
   border_neighbours(m, b, a, nbr[1]);
