@@ -137,47 +137,62 @@ double param_on(const BorderSpot& v, std::uint32_t x, std::uint32_t y) {
   return -1;
 }
 
-// The input border from u to v along one direction: starting on edge x-y at parameter lo,
-// toward y. False if a corner (unless `through_corners`), a polyline's end or kMaxBorderWalk
-// edges come first.
-bool walk(const BorderChains& ch, std::uint32_t x, std::uint32_t y, double lo, const BorderSpot& v,
-          std::vector<Piece>& out, bool through_corners, std::size_t max_steps) {
-  out.clear();
-  for (std::size_t steps = 0; steps < max_steps && y != kNoSlot; ++steps) {
+// One way along the input border toward v, a step (an input edge) at a time: starting on edge x-y
+// at parameter lo, toward y. It ends found, or dead at a corner (unless `through_corners`) or a
+// polyline's end.
+struct BorderWalk {
+  std::uint32_t x, y;
+  double lo;
+  std::vector<Piece> pieces;
+  enum { Going, Found, Dead } state = Going;
+
+  BorderWalk(std::uint32_t from, std::uint32_t to, double at) : x(from), y(to), lo(at) {
+    if (y == kNoSlot) state = Dead;
+  }
+  void step(const BorderChains& ch, const BorderSpot& v, bool through_corners) {
     const double tv = param_on(v, x, y);
     if (tv > lo) {
-      out.push_back({x, y, lo, tv});
-      return true;
+      pieces.push_back({x, y, lo, tv});
+      state = Found;
+      return;
     }
-    out.push_back({x, y, lo, 1});
-    if (v.to == kNoSlot && v.from == y) return true;
-    if (ch.corner[y] && !through_corners) return false;  // a live vertex: v is not beyond it
+    pieces.push_back({x, y, lo, 1});
+    if (v.to == kNoSlot && v.from == y) {
+      state = Found;
+      return;
+    }
+    if (ch.corner[y] && !through_corners) {  // a live vertex: v is not beyond it
+      state = Dead;
+      return;
+    }
     const std::uint32_t* nb = &ch.neighbour[2 * std::size_t(y)];
     const std::uint32_t next = nb[0] == x ? nb[1] : nb[0];
     x = y, y = next, lo = 0;
+    if (y == kNoSlot) state = Dead;
   }
-  return false;
-}
+};
 
-// The shorter of the two ways from u to v along the input border (empty: neither found). A
-// corner ends the way unless `through_corners` (a soft corner the run removed still has its slot).
+// The shorter of the two ways from u to v along the input border (empty: neither found within
+// kMaxBorderWalk edges; of two as short, the first). A corner ends a way unless `through_corners`
+// (a soft corner the run removed still has its slot). The two ways are walked in step, so a
+// contraction near one end of a long border (a terrain's side) never walks the wrong way round.
 std::vector<Piece> border_between(const BorderChains& ch, const BorderSpot& u, const BorderSpot& v,
                                   bool through_corners = false) {
-  std::vector<Piece> best, way;
-  const auto consider = [&](std::uint32_t x, std::uint32_t y, double lo) {
-    // The second way need not be walked further than the first found (around a loop, through
-    // corners, the wrong way goes all the way round).
-    if (y == kNoSlot || !walk(ch, x, y, lo, v, way, through_corners, best.empty() ? kMaxBorderWalk : best.size() - 1)) return;
-    if (best.empty() || way.size() < best.size()) best = way;
-  };
-  if (u.to == kNoSlot) {
-    consider(u.from, ch.neighbour[2 * std::size_t(u.from)], 0);
-    consider(u.from, ch.neighbour[2 * std::size_t(u.from) + 1], 0);
-  } else {
-    consider(u.from, u.to, u.t);
-    consider(u.to, u.from, 1 - u.t);
+  BorderWalk ways[2] = {u.to == kNoSlot ? BorderWalk(u.from, ch.neighbour[2 * std::size_t(u.from)], 0)
+                                        : BorderWalk(u.from, u.to, u.t),
+                        u.to == kNoSlot ? BorderWalk(u.from, ch.neighbour[2 * std::size_t(u.from) + 1], 0)
+                                        : BorderWalk(u.to, u.from, 1 - u.t)};
+  for (std::size_t steps = 0; steps < kMaxBorderWalk; ++steps) {
+    bool going = false;
+    for (BorderWalk& w : ways) {
+      if (w.state != BorderWalk::Going) continue;
+      w.step(ch, v, through_corners);
+      if (w.state == BorderWalk::Found) return std::move(w.pieces);
+      going |= w.state == BorderWalk::Going;
+    }
+    if (!going) break;
   }
-  return best;
+  return {};
 }
 
 // v's neighbour along the current border other than `not_this` (kNoVertex if none).
