@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "core/distance_bound.h"
 #include "measure/bvh.h"
@@ -57,6 +58,18 @@ TEST(Measure, PointTriangleRegions) {
   EXPECT_EQ(q.y, 0);
 }
 
+// The squared distance from p to the closest of the triangles (9 doubles each), testing them all.
+double brute_force_d2(const std::vector<double>& corners, const double p[3]) {
+  double best = INFINITY;
+  for (std::size_t t = 0; t < corners.size() / 9; ++t) {
+    const double* c = &corners[9 * t];
+    const Vec3 q =
+        closest_point_on_triangle({p[0], p[1], p[2]}, {c[0], c[1], c[2]}, {c[3], c[4], c[5]}, {c[6], c[7], c[8]});
+    best = std::min(best, measure_detail::squared_distance({p[0], p[1], p[2]}, q));
+  }
+  return best;
+}
+
 TEST(Measure, BvhMatchesBruteForce) {
   const Mesh sphere = test::icosphere(3);
   const measure_detail::Surface s = measure_detail::make_surface(sphere, "sphere");
@@ -65,13 +78,7 @@ TEST(Measure, BvhMatchesBruteForce) {
   measure_detail::Rng rng(7);
   for (int i = 0; i < 2000; ++i) {
     const double p[3] = {3 * rng.uniform() - 1.5, 3 * rng.uniform() - 1.5, 3 * rng.uniform() - 1.5};
-    double best = INFINITY;
-    for (std::size_t t = 0; t < s.triangle_count(); ++t) {
-      const double* c = &s.corners[9 * t];
-      const Vec3 q = closest_point_on_triangle({p[0], p[1], p[2]}, {c[0], c[1], c[2]}, {c[3], c[4], c[5]},
-                                               {c[6], c[7], c[8]});
-      best = std::min(best, measure_detail::squared_distance({p[0], p[1], p[2]}, q));
-    }
+    const double best = brute_force_d2(s.corners, p);
     const auto hit = bvh.closest(p);
     ASSERT_EQ(hit.d2, best) << "query " << i;  // same primitive test: the minimum is bit-identical
     const double dx = hit.point[0] - p[0], dy = hit.point[1] - p[1], dz = hit.point[2] - p[2];
@@ -90,13 +97,7 @@ TEST(Measure, BvhBuiltOnThreadsIsTheSameTree) {
   measure_detail::Rng rng(11);
   for (int i = 0; i < 40; ++i) {
     const double p[3] = {3 * rng.uniform() - 1.5, 3 * rng.uniform() - 1.5, 3 * rng.uniform() - 1.5};
-    double best = INFINITY;
-    for (std::size_t t = 0; t < s.triangle_count(); ++t) {
-      const double* c = &s.corners[9 * t];
-      const Vec3 q = closest_point_on_triangle({p[0], p[1], p[2]}, {c[0], c[1], c[2]}, {c[3], c[4], c[5]},
-                                               {c[6], c[7], c[8]});
-      best = std::min(best, measure_detail::squared_distance({p[0], p[1], p[2]}, q));
-    }
+    const double best = brute_force_d2(s.corners, p);
     const auto a = one.closest(p), b = two.closest(p), c = three.closest(p);
     ASSERT_EQ(a.d2, best) << "query " << i;
     ASSERT_EQ(b.triangle, a.triangle) << "query " << i;
