@@ -43,6 +43,14 @@ inline bool place_pair(const Context& c, std::uint32_t p, Quadric& q, Placed& pl
   const std::uint32_t a = c.pairs.pairs[p].v[0], b = c.pairs.pairs[p].v[1];
   const WorkingMesh& m = c.mesh;
   q = c.quadric[a] + c.quadric[b];
+  // Most pairs: neither end on a border, a corner or locked, no attributes. Every rule below then
+  // comes to the plain placement; deciding it from the flags at once saves the roles' lookups on
+  // every pair cost.
+  if (!c.wedges && !m.boundary[a] && !m.boundary[b] && (m.corner.empty() || (m.corner[a] | m.corner[b]) == 0) &&
+      (m.locked.empty() || (m.locked[a] | m.locked[b]) == 0)) {
+    placed = place(q, m.pos[a], m.pos[b], c.settings.placement);
+    return true;
+  }
   const BorderTarget border = border_target(c, a, b);
   if (c.wedges) {
     if (!place_with_wedges(c, a, b, q, placed)) return false;

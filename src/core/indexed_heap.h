@@ -20,6 +20,7 @@ class IndexedHeap {
 
   void reset(std::size_t id_count) {
     heap_.clear();
+    heap_.reserve(id_count);  // every id at most once: no reallocation copies while filling
     slot_.assign(id_count, kAbsent);
   }
   bool empty() const { return heap_.empty(); }

@@ -11,6 +11,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/default_init_allocator.h"
+#include "core/parallel_chunks.h"
 #include "core/quadric.h"
 #include "core/radix_sort.h"
 
@@ -29,21 +31,38 @@ inline std::uint64_t spread_bits_3d(std::uint64_t x) {
 }
 
 /// Indices 0..n-1 sorted by the Morton code of point_of(i) (a Vec3) over the points' bounding
-/// box, ties by index: the order is fully determined by the input.
+/// box, ties by index: the order is fully determined by the input. The box and the codes are made
+/// in fixed chunks on up to `threads` threads (per-chunk bounds merged in chunk order: min and max
+/// are exact), the sort on the calling thread: the same order on any number of threads.
 template <class PointOf>
-std::vector<std::uint32_t> morton_order(std::size_t n, PointOf point_of) {
+std::vector<std::uint32_t> morton_order(std::size_t n, PointOf point_of, unsigned threads = 1) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
-  Vec3 lo{kInf, kInf, kInf}, hi{-kInf, -kInf, -kInf};
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 p = point_of(i);
-    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
-    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
-  }
+  constexpr std::size_t kChunk = std::size_t(1) << 16;
+  struct Bounds {
+    Vec3 lo{kInf, kInf, kInf}, hi{-kInf, -kInf, -kInf};
+    void grow(const Vec3& p) {
+      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+    }
+    void merge(const Bounds& b) {
+      lo = {std::min(lo.x, b.lo.x), std::min(lo.y, b.lo.y), std::min(lo.z, b.lo.z)};
+      hi = {std::max(hi.x, b.hi.x), std::max(hi.y, b.hi.y), std::max(hi.z, b.hi.z)};
+    }
+  };
+  std::vector<Bounds> chunk_bounds((n + kChunk - 1) / kChunk);
+  for_chunks(n, kChunk, threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) chunk_bounds[c].grow(point_of(i));
+  });
+  Bounds all;
+  for (const Bounds& b : chunk_bounds) all.merge(b);
+  const Vec3 lo = all.lo, hi = all.hi;
   // One scale for all axes keeps the cells cubic.
   const double extent = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
   const double scale = extent > 0 ? double((1 << 21) - 1) / extent : 0;
-  std::vector<std::uint64_t> code(n);
-  for (std::size_t i = 0; i < n; ++i) {
+  std::vector<std::uint64_t, DefaultInitAllocator<std::uint64_t>> code(n);
+  std::vector<std::uint32_t> order(n), scratch;
+  for_chunks(n, kChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
+   for (std::size_t i = begin; i < end; ++i) {
     const Vec3 p = point_of(i);
     // Clamped before the conversion (NaN, inf and out-of-range doubles must never reach the cast:
     // undefined behaviour, found by fuzz_simplify with coordinates near 1e308).
@@ -53,13 +72,13 @@ std::vector<std::uint32_t> morton_order(std::size_t n, PointOf point_of) {
     };
     code[i] = spread_bits_3d(cell(p.x, lo.x)) | spread_bits_3d(cell(p.y, lo.y)) << 1 |
               spread_bits_3d(cell(p.z, lo.z)) << 2;
-  }
+    order[i] = std::uint32_t(i);
+   }
+  });
   // Sorted by (code, index): a stable radix sort on the code's top 32 of 63 bits, then each run of
   // equal top bits, almost always a single point, by its full code. Linear time, so cheaper on
   // large meshes than the comparison sort of (code, index) it replaces (docs/benchmarks.md,
   // "Measurements behind the code").
-  std::vector<std::uint32_t> order(n), scratch;
-  for (std::size_t i = 0; i < n; ++i) order[i] = std::uint32_t(i);
   radix_sort_by_key(order, scratch, [&](std::uint32_t i) { return std::uint32_t(code[i] >> 31); });
   for (std::size_t begin = 0, end; begin < n; begin = end) {
     end = begin + 1;

@@ -43,6 +43,7 @@ std::vector<std::uint32_t> referenced_vertices(MeshView in, std::size_t& degener
     referenced[t[0]] = referenced[t[1]] = referenced[t[2]] = 1;
   }
   std::vector<std::uint32_t> used;
+  used.reserve(referenced.size());  // no reallocation copies (valid_pairs.cpp, unique_edges)
   for (std::uint32_t v = 0; v < referenced.size(); ++v)
     if (referenced[v]) used.push_back(v);
   return used;

@@ -28,6 +28,12 @@ class BoxOfPoints {
   void add_all(std::span<const double> xyz) {
     for (std::size_t i = 0; i + 2 < xyz.size(); i += 3) add(&xyz[i]);
   }
+  /// Adds the points another box was grown from: the same box as adding them here one by one
+  /// after those added so far (min and max are exact; of equal bounds the earlier stays).
+  void add(const BoxOfPoints& other) {
+    for (int k = 0; k < 3; ++k) lo_[k] = std::min(lo_[k], other.lo_[k]), hi_[k] = std::max(hi_[k], other.hi_[k]);
+    any_ = any_ || other.any_;
+  }
   /// No point added yet.
   bool empty() const { return !any_; }
   /// The box of the points added; the zero box (as bounding_box gives for no vertex) if none was.

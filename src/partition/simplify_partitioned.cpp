@@ -205,9 +205,10 @@ SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options
   // the one-sided distance by a third on a bumpy sphere where simplify's refit keeps it.
   RefitOptions refit_options = refit_options_for(options, referenced, result.mesh.vertex_count());
   if (refit_options.rounds > 0 && result.contractions > 0) {
-    const refit_detail::FitPoints points(input.positions, refit_detail::vertex_areas(input));
+    const unsigned threads = core::resolve_threads(options.threads);
+    const refit_detail::FitPoints points(input.positions, refit_detail::vertex_areas(input, threads), threads);
     const core::SurfaceDistance surface =
-        refit_detail::surface_in_frame(input.positions, input.indices, points.frame(), core::resolve_threads(options.threads));
+        refit_detail::surface_in_frame(input.positions, input.indices, points.frame(), threads);
     std::vector<std::uint8_t> fixed;
     if (!options.vertex_lock.empty()) {
       fixed.assign(result.mesh.vertex_count(), 0);

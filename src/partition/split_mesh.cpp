@@ -181,6 +181,15 @@ std::vector<MeshPart> split_mesh(MeshView input, const SimplifyOptions& options,
     const std::size_t begin = part_begin[p], end = part_begin[p + 1];
     part.mesh.indices.reserve(3 * (end - begin));
     part.input_face.reserve(end - begin);
+    // Room for the vertices of a closed manifold part (half as many as its faces) and a cut of a
+    // sixteenth more, so that the arrays are not grown by copying into fresh pages as they fill:
+    // without it, those copies and their page faults were about half the page faults of a 10M-face
+    // run (perf record -e page-faults), on the threads and on the calling thread alike. A part
+    // with more vertices still grows its arrays, from there.
+    const std::size_t vertices_guess = (end - begin) / 2 + (end - begin) / 16 + 64;
+    part.mesh.positions.reserve(3 * vertices_guess);
+    part.input_vertex.reserve(vertices_guess);
+    part.locked.reserve(vertices_guess);
     std::size_t locked_count = 0;
     for (std::size_t i = begin; i < end; ++i) {
       const std::uint32_t f = faces[i];

@@ -16,15 +16,17 @@ namespace qem::refit_detail {
 
 /// A third of the area of each face around each vertex: the vertex's share of the surface, so
 /// that sums over vertices approximate integrals over the surface (HG99 §2's area weighting).
-/// The mesh must have passed check_mesh (simplify and qem::refit check it first).
-std::vector<double> vertex_areas(MeshView mesh);
+/// The mesh must have passed check_mesh (simplify and qem::refit check it first). On up to
+/// `threads` threads, the same result on any number.
+std::vector<double> vertex_areas(MeshView mesh, unsigned threads = 1);
 
 /// The points an approximation is fitted to, in the refit's normalised frame: made once for any
 /// number of approximations of the same original.
 struct FitPoints {
   FitPoints() = default;
-  /// Points of 3 doubles each, with the given weights; the points of weight 0 are left out.
-  FitPoints(std::span<const double> points, std::span<const double> weights);
+  /// Points of 3 doubles each, with the given weights; the points of weight 0 are left out. Made
+  /// on up to `threads` threads, the same on any number.
+  FitPoints(std::span<const double> points, std::span<const double> weights, unsigned threads = 1);
   /// One point for each run of `group` consecutive points in Morton order: the run's middle
   /// point, carrying the run's summed weight (RefitOptions::points_per_vertex). Same frame.
   FitPoints thinned(std::size_t group) const;
