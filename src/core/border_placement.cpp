@@ -302,11 +302,15 @@ double chord_error(const Context& c_, std::uint32_t a, std::uint32_t b, const Ve
       const Vec3& s = m.pos[n];
       // Through corners: a soft corner between n and x is gone if the way reaches x (a live one
       // would be a vertex of the current border between them, which n and x are neighbours on).
-      // The way toward e, not the one past n's other neighbour (border_avoiding).
-      const std::uint32_t beyond = other_border_neighbour(m, n, e);
-      const std::vector<Piece> way = beyond != kNoVertex && m.border_spot[beyond].from != kNoSlot
-                                         ? border_avoiding(m.chains, m.border_spot[n], m.border_spot[beyond], xs)
-                                         : border_between(m.chains, m.border_spot[n], xs, true);
+      // The way toward e, not the one past n's other neighbour (border_avoiding), where n is on a
+      // simple chain: one other border neighbour, no hard corner (where borders meet, the shorter
+      // way as before).
+      std::uint32_t beyond[2];
+      border_neighbours(m, n, e, beyond);
+      const bool simple = m.corner[n] != kHardCorner && beyond[0] != kNoVertex && beyond[1] == kNoVertex &&
+                          m.border_spot[beyond[0]].from != kNoSlot;
+      const std::vector<Piece> way = simple ? border_avoiding(m.chains, m.border_spot[n], m.border_spot[beyond[0]], xs)
+                                            : border_between(m.chains, m.border_spot[n], xs, true);
       for (const Piece& p : way) {
         const Vec3 o = m.chains.pos[p.x], d = m.chains.pos[p.y] - o;
         d2 = std::max({d2, squared_distance_to_segment(o + d * p.lo, s, x), squared_distance_to_segment(o + d * p.hi, s, x)});
