@@ -257,6 +257,70 @@ TEST(Borders, InputBorderLiesWithinTheErrorOfItsChords) {
   }
 }
 
+// The bumpy unit square (bumps) as a 24 x 24 grid with an L-shaped zero-width slit cut along grid
+// lines: from tip (4, 12) to the bend (12, 12) and on to tip (12, 4). The slit's vertices but the
+// tips are two vertices at one position, the faces inside the L on the second: one border loop of
+// 32 edges whose two sides coincide (the Stanford dragon has 407 such loops, issue 21).
+Mesh square_with_slit() {
+  Mesh in;
+  const int n = 24;
+  const auto id = [&](int i, int j) { return std::uint32_t(j * (n + 1) + i); };
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      const double x = double(i) / n, y = double(j) / n;
+      in.positions.insert(in.positions.end(), {x, y, bumps(x, y)});
+    }
+  // The second vertex of each slit vertex but the tips.
+  std::map<std::uint32_t, std::uint32_t> twin;
+  const auto add_twin = [&](int i, int j) {
+    twin[id(i, j)] = std::uint32_t(in.positions.size() / 3);
+    const Point p = vertex(in, id(i, j));
+    in.positions.insert(in.positions.end(), p.begin(), p.end());
+  };
+  for (int i = 5; i <= 12; ++i) add_twin(i, 12);
+  for (int j = 5; j < 12; ++j) add_twin(12, j);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const bool inside = i < 12 && j < 12;  // the cell is inside the L: its slit vertices are twins
+      const auto v = [&](int a, int b) {
+        const auto t = twin.find(id(a, b));
+        return inside && t != twin.end() ? t->second : id(a, b);
+      };
+      in.indices.insert(in.indices.end(), {v(i, j), v(i + 1, j), v(i + 1, j + 1)});
+      in.indices.insert(in.indices.end(), {v(i, j), v(i + 1, j + 1), v(i, j + 1)});
+    }
+  return in;
+}
+
+// The chord bound holds on a zero-width slit (core/border_placement.cpp, border_avoiding): every
+// input border vertex, the slit's tips and bend included, lies within the run's error of the
+// output border. On the dragon, where few vertices of a slit's loop were left, chord_error measured
+// the input border a contraction removed the shorter way round the loop, through the side it kept,
+// so a slit's bend went at almost no cost (10 %: 1.8e-4 from the output, Hausdorff 1.62x CGAL's
+// GH-plane). This small slit does not reach that state (it holds before the fix too): it guards
+// the bound on slits, two sides at one position, with the way now chosen by direction.
+TEST(Borders, SlitTipsAndBendStayWithinTheError) {
+  const Mesh in = square_with_slit();
+  ASSERT_EQ(border_vertices(in).size(), 96u + 32u);
+  std::vector<Point> in_border;
+  for (std::uint32_t v : border_vertices(in)) in_border.push_back(vertex(in, v));
+  for (double ratio : {0.2, 0.1, 0.05}) {
+    SimplifyOptions o;  // exact borders, the default
+    o.target_ratio = ratio;
+    o.refit_rounds = 0;  // the border as the contractions left it
+    const SimplifyResult r = simplify(in, o);
+    ASSERT_LE(r.mesh.face_count(), std::size_t(ratio * double(in.face_count())));
+    const std::vector<std::pair<Point, Point>> out_border = border_edges(r.mesh);
+    ASSERT_LT(out_border.size(), 96u + 32u);  // the borders lost vertices
+    double farthest = 0;
+    for (const Point& p : in_border) farthest = std::max(farthest, distance_to_edges(p, out_border));
+    // 1e-9 of the diagonal (about 1.4) for rounding: sqrt of a quadric error is not exact.
+    EXPECT_LE(farthest, r.max_error + 2e-9) << "ratio " << ratio;
+    for (const Point& tip : {vertex(in, 12 * 25 + 4), vertex(in, 4 * 25 + 12), vertex(in, 12 * 25 + 12)})
+      EXPECT_LE(distance_to_edges(tip, out_border), r.max_error + 2e-9) << "ratio " << ratio;
+  }
+}
+
 // A border vertex contracted with an interior vertex may slide along its own polyline
 // (border_placement.h, place_on_own_border), not only stay. Every other border vertex of the half
 // disc is locked (a hard corner), so no border vertex can slide along a border edge: an unlocked
