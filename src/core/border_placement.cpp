@@ -172,12 +172,28 @@ struct BorderWalk {
   }
 };
 
+// Whether piece p reaches spot v past its start (a way starts at u, not at v).
+bool piece_reaches(const Piece& p, const BorderSpot& v) {
+  if (v.to == kNoSlot) return v.from == p.y && p.hi == 1;
+  const double tv = param_on(v, p.x, p.y);
+  return tv > p.lo && tv <= p.hi;
+}
+
 // The shorter of the two ways from u to v along the input border (empty: neither found within
 // kMaxBorderWalk edges; of two as short, the first). A corner ends a way unless `through_corners`
 // (a soft corner the run removed still has its slot). The two ways are walked in step, so a
 // contraction near one end of a long border (a terrain's side) never walks the wrong way round.
+//
+// With `avoid`, only a way that does not pass that spot before v (at v's own place either way is
+// as good), for chord_error: u is a current border neighbour of a moving end, v that end's new
+// place, and `avoid` u's other current border neighbour's place, which the way u leaves toward v
+// does not pass. The shorter way is not always that one: where the current border has few
+// vertices left (a zero-width slit, whose removed side is many input edges long while the way
+// back round the loop is few), the shorter way runs through the part of the border that stays
+// and misses the part the contraction removes (the dragon at 10 %: a slit's bend 1.8e-4 from the
+// output).
 std::vector<Piece> border_between(const BorderChains& ch, const BorderSpot& u, const BorderSpot& v,
-                                  bool through_corners = false) {
+                                  bool through_corners = false, const BorderSpot* avoid = nullptr) {
   BorderWalk ways[2] = {u.to == kNoSlot ? BorderWalk(u.from, ch.neighbour[2 * std::size_t(u.from)], 0)
                                         : BorderWalk(u.from, u.to, u.t),
                         u.to == kNoSlot ? BorderWalk(u.from, ch.neighbour[2 * std::size_t(u.from) + 1], 0)
@@ -187,43 +203,9 @@ std::vector<Piece> border_between(const BorderChains& ch, const BorderSpot& u, c
     for (BorderWalk& w : ways) {
       if (w.state != BorderWalk::Going) continue;
       w.step(ch, v, through_corners);
-      if (w.state == BorderWalk::Found) return std::move(w.pieces);
-      going |= w.state == BorderWalk::Going;
-    }
-    if (!going) break;
-  }
-  return {};
-}
-
-// Whether piece p reaches spot v past its start (a way starts at u, not at v).
-bool piece_reaches(const Piece& p, const BorderSpot& v) {
-  if (v.to == kNoSlot) return v.from == p.y && p.hi == 1;
-  const double tv = param_on(v, p.x, p.y);
-  return tv > p.lo && tv <= p.hi;
-}
-
-// The way from u to v along the input border (through corners) that does not pass spot `stop`,
-// for chord_error: u is a current border neighbour of a moving end, v that end's new place, and
-// `stop` u's other current border neighbour's place, which the way u leaves toward v does not
-// pass. The shorter way (border_between) is not always that one: where the current border has
-// few vertices left (a zero-width slit, whose removed side is many input edges long while the way
-// back round the loop is few), the shorter way runs through the part of the border that stays
-// and misses the part the contraction removes (the dragon at 10 %: a slit's bend 1.8e-4 from the
-// output). Both ways are walked in step; empty when neither is found within kMaxBorderWalk edges.
-std::vector<Piece> border_avoiding(const BorderChains& ch, const BorderSpot& u, const BorderSpot& stop, const BorderSpot& v) {
-  BorderWalk ways[2] = {u.to == kNoSlot ? BorderWalk(u.from, ch.neighbour[2 * std::size_t(u.from)], 0)
-                                        : BorderWalk(u.from, u.to, u.t),
-                        u.to == kNoSlot ? BorderWalk(u.from, ch.neighbour[2 * std::size_t(u.from) + 1], 0)
-                                        : BorderWalk(u.to, u.from, 1 - u.t)};
-  for (std::size_t steps = 0; steps < kMaxBorderWalk; ++steps) {
-    bool going = false;
-    for (BorderWalk& w : ways) {
-      if (w.state != BorderWalk::Going) continue;
-      w.step(ch, v, true);
-      const Piece& last = w.pieces.back();
-      // `stop` on this step before v (or at v's own place: then either way is as good).
-      if (piece_reaches(last, stop)) {
-        const double ts = stop.to == kNoSlot ? 1 : param_on(stop, last.x, last.y);
+      if (avoid && piece_reaches(w.pieces.back(), *avoid)) {
+        const Piece& last = w.pieces.back();
+        const double ts = avoid->to == kNoSlot ? 1 : param_on(*avoid, last.x, last.y);
         if (ts < last.hi || w.state != BorderWalk::Found) {
           w.state = BorderWalk::Dead;
           continue;
@@ -302,15 +284,15 @@ double chord_error(const Context& c_, std::uint32_t a, std::uint32_t b, const Ve
       const Vec3& s = m.pos[n];
       // Through corners: a soft corner between n and x is gone if the way reaches x (a live one
       // would be a vertex of the current border between them, which n and x are neighbours on).
-      // The way toward e, not the one past n's other neighbour (border_avoiding), where n is on a
-      // simple chain: one other border neighbour, no hard corner (where borders meet, the shorter
-      // way as before).
+      // The way toward e, not the one past n's other neighbour (border_between's `avoid`), where
+      // n is on a simple chain: one other border neighbour, no hard corner (where borders meet,
+      // the shorter way as before).
       std::uint32_t beyond[2];
       border_neighbours(m, n, e, beyond);
       const bool simple = m.corner[n] != kHardCorner && beyond[0] != kNoVertex && beyond[1] == kNoVertex &&
                           m.border_spot[beyond[0]].from != kNoSlot;
-      const std::vector<Piece> way = simple ? border_avoiding(m.chains, m.border_spot[n], m.border_spot[beyond[0]], xs)
-                                            : border_between(m.chains, m.border_spot[n], xs, true);
+      const std::vector<Piece> way =
+          border_between(m.chains, m.border_spot[n], xs, true, simple ? &m.border_spot[beyond[0]] : nullptr);
       for (const Piece& p : way) {
         const Vec3 o = m.chains.pos[p.x], d = m.chains.pos[p.y] - o;
         d2 = std::max({d2, squared_distance_to_segment(o + d * p.lo, s, x), squared_distance_to_segment(o + d * p.hi, s, x)});
