@@ -229,6 +229,29 @@ Mesh star_hole_annulus() {
   return in;
 }
 
+// The border vertices of m, as points.
+std::vector<Point> border_points(const Mesh& m) {
+  std::vector<Point> out;
+  for (std::uint32_t v : border_vertices(m)) out.push_back(vertex(m, v));
+  return out;
+}
+
+// `in` simplified to `ratio` with default (exact) borders and no refit: the border as the
+// contractions left it.
+SimplifyResult contracted_only(const Mesh& in, double ratio) {
+  SimplifyOptions o;
+  o.target_ratio = ratio;
+  o.refit_rounds = 0;
+  return simplify(in, o);
+}
+
+// The farthest of `points` from the nearest of `edges`.
+double farthest_from_edges(const std::vector<Point>& points, const std::vector<std::pair<Point, Point>>& edges) {
+  double farthest = 0;
+  for (const Point& p : points) farthest = std::max(farthest, distance_to_edges(p, edges));
+  return farthest;
+}
+
 // A border edge of the output is a chord across the input border between its ends: the input
 // border vertices it replaces lie at most the run's error from it (core/border_placement.h,
 // chord_error). GH97's boundary planes alone priced only how far the new vertex left the planes
@@ -238,19 +261,14 @@ Mesh star_hole_annulus() {
 // meshoptimizer's). Now the bound holds and is what limits: the farthest comes within 1 % of it.
 TEST(Borders, InputBorderLiesWithinTheErrorOfItsChords) {
   const Mesh in = star_hole_annulus();
-  std::vector<Point> in_border;
-  for (std::uint32_t v : border_vertices(in)) in_border.push_back(vertex(in, v));
+  const std::vector<Point> in_border = border_points(in);
   ASSERT_EQ(in_border.size(), 320u);
   for (double ratio : {0.1, 0.03}) {
-    SimplifyOptions o;  // exact borders, the default
-    o.target_ratio = ratio;
-    o.refit_rounds = 0;  // the border as the contractions left it
-    const SimplifyResult r = simplify(in, o);
+    const SimplifyResult r = contracted_only(in, ratio);
     ASSERT_LE(r.mesh.face_count(), std::size_t(ratio * double(in.face_count())));
     const std::vector<std::pair<Point, Point>> out_border = border_edges(r.mesh);
     ASSERT_LT(out_border.size(), 160u);  // the borders lost vertices
-    double farthest = 0;
-    for (const Point& p : in_border) farthest = std::max(farthest, distance_to_edges(p, out_border));
+    const double farthest = farthest_from_edges(in_border, out_border);
     // 1e-9 of the diagonal (about 2) for rounding: sqrt of a quadric error is not exact.
     EXPECT_LE(farthest, r.max_error + 2e-9) << "ratio " << ratio;
     EXPECT_GT(farthest, 0.5 * r.max_error) << "ratio " << ratio;  // the chords do cut the border
@@ -292,7 +310,7 @@ Mesh square_with_slit() {
   return in;
 }
 
-// The chord bound holds on a zero-width slit (core/border_placement.cpp, border_avoiding): every
+// The chord bound holds on a zero-width slit (core/border_placement.cpp, border_between's `avoid`): every
 // input border vertex, the slit's tips and bend included, lies within the run's error of the
 // output border. On the dragon, where few vertices of a slit's loop were left, chord_error measured
 // the input border a contraction removed the shorter way round the loop, through the side it kept,
@@ -301,19 +319,14 @@ Mesh square_with_slit() {
 // the bound on slits, two sides at one position, with the way now chosen by direction.
 TEST(Borders, SlitTipsAndBendStayWithinTheError) {
   const Mesh in = square_with_slit();
-  ASSERT_EQ(border_vertices(in).size(), 96u + 32u);
-  std::vector<Point> in_border;
-  for (std::uint32_t v : border_vertices(in)) in_border.push_back(vertex(in, v));
+  const std::vector<Point> in_border = border_points(in);
+  ASSERT_EQ(in_border.size(), 96u + 32u);
   for (double ratio : {0.2, 0.1, 0.05}) {
-    SimplifyOptions o;  // exact borders, the default
-    o.target_ratio = ratio;
-    o.refit_rounds = 0;  // the border as the contractions left it
-    const SimplifyResult r = simplify(in, o);
+    const SimplifyResult r = contracted_only(in, ratio);
     ASSERT_LE(r.mesh.face_count(), std::size_t(ratio * double(in.face_count())));
     const std::vector<std::pair<Point, Point>> out_border = border_edges(r.mesh);
     ASSERT_LT(out_border.size(), 96u + 32u);  // the borders lost vertices
-    double farthest = 0;
-    for (const Point& p : in_border) farthest = std::max(farthest, distance_to_edges(p, out_border));
+    const double farthest = farthest_from_edges(in_border, out_border);
     // 1e-9 of the diagonal (about 1.4) for rounding: sqrt of a quadric error is not exact.
     EXPECT_LE(farthest, r.max_error + 2e-9) << "ratio " << ratio;
     for (const Point& tip : {vertex(in, 12 * 25 + 4), vertex(in, 4 * 25 + 12), vertex(in, 12 * 25 + 12)})

@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <limits>
 #include <utility>
 #include <vector>
 
@@ -15,6 +14,7 @@
 #include "core/parallel_chunks.h"
 #include "core/quadric.h"
 #include "core/radix_sort.h"
+#include "geometry/box.h"
 
 namespace qem::core {
 
@@ -32,48 +32,41 @@ inline std::uint64_t spread_bits_3d(std::uint64_t x) {
 
 /// Indices 0..n-1 sorted by the Morton code of point_of(i) (a Vec3) over the points' bounding
 /// box, ties by index: the order is fully determined by the input. The box and the codes are made
-/// in fixed chunks on up to `threads` threads (per-chunk bounds merged in chunk order: min and max
+/// in fixed chunks on up to `threads` threads (per-chunk boxes merged in chunk order: min and max
 /// are exact), the sort on the calling thread: the same order on any number of threads.
 template <class PointOf>
 std::vector<std::uint32_t> morton_order(std::size_t n, PointOf point_of, unsigned threads = 1) {
-  constexpr double kInf = std::numeric_limits<double>::infinity();
   constexpr std::size_t kChunk = std::size_t(1) << 16;
-  struct Bounds {
-    Vec3 lo{kInf, kInf, kInf}, hi{-kInf, -kInf, -kInf};
-    void grow(const Vec3& p) {
-      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
-      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
-    }
-    void merge(const Bounds& b) {
-      lo = {std::min(lo.x, b.lo.x), std::min(lo.y, b.lo.y), std::min(lo.z, b.lo.z)};
-      hi = {std::max(hi.x, b.hi.x), std::max(hi.y, b.hi.y), std::max(hi.z, b.hi.z)};
-    }
-  };
-  std::vector<Bounds> chunk_bounds((n + kChunk - 1) / kChunk);
+  std::vector<BoxOfPoints> chunk_boxes((n + kChunk - 1) / kChunk);
   for_chunks(n, kChunk, threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) chunk_bounds[c].grow(point_of(i));
+    for (std::size_t i = begin; i < end; ++i) {
+      const Vec3 p = point_of(i);
+      const double xyz[3] = {p.x, p.y, p.z};
+      chunk_boxes[c].add(xyz);
+    }
   });
-  Bounds all;
-  for (const Bounds& b : chunk_bounds) all.merge(b);
-  const Vec3 lo = all.lo, hi = all.hi;
+  BoxOfPoints all;
+  for (const BoxOfPoints& b : chunk_boxes) all.add(b);
+  const Box box = all.box();
+  const Vec3 lo{box.lo[0], box.lo[1], box.lo[2]}, hi{box.hi[0], box.hi[1], box.hi[2]};
   // One scale for all axes keeps the cells cubic.
   const double extent = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
   const double scale = extent > 0 ? double((1 << 21) - 1) / extent : 0;
   std::vector<std::uint64_t, DefaultInitAllocator<std::uint64_t>> code(n);
   std::vector<std::uint32_t> order(n), scratch;
   for_chunks(n, kChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
-   for (std::size_t i = begin; i < end; ++i) {
-    const Vec3 p = point_of(i);
-    // Clamped before the conversion (NaN, inf and out-of-range doubles must never reach the cast:
-    // undefined behaviour, found by fuzz_simplify with coordinates near 1e308).
-    const auto cell = [&](double x, double l) {
-      const double c = (x - l) * scale;
-      return c >= 0 ? std::uint64_t(std::min(c, double((1 << 21) - 1))) : std::uint64_t(0);
-    };
-    code[i] = spread_bits_3d(cell(p.x, lo.x)) | spread_bits_3d(cell(p.y, lo.y)) << 1 |
-              spread_bits_3d(cell(p.z, lo.z)) << 2;
-    order[i] = std::uint32_t(i);
-   }
+    for (std::size_t i = begin; i < end; ++i) {
+      const Vec3 p = point_of(i);
+      // Clamped before the conversion (NaN, inf and out-of-range doubles must never reach the
+      // cast: undefined behaviour, found by fuzz_simplify with coordinates near 1e308).
+      const auto cell = [&](double x, double l) {
+        const double c = (x - l) * scale;
+        return c >= 0 ? std::uint64_t(std::min(c, double((1 << 21) - 1))) : std::uint64_t(0);
+      };
+      code[i] = spread_bits_3d(cell(p.x, lo.x)) | spread_bits_3d(cell(p.y, lo.y)) << 1 |
+                spread_bits_3d(cell(p.z, lo.z)) << 2;
+      order[i] = std::uint32_t(i);
+    }
   });
   // Sorted by (code, index): a stable radix sort on the code's top 32 of 63 bits, then each run of
   // equal top bits, almost always a single point, by its full code. Linear time, so cheaper on

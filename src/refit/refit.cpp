@@ -300,9 +300,9 @@ class Refitter {
                        });
       std::vector<double> nearest(approx.vertex_count(), HUGE_VAL);
       for (std::size_t i = 0; i < near_vertex_.size(); ++i) {
-        const std::uint32_t v = near_vertex_[i];
-        if (v >= original_face_near_.size() || surface_->face_at(std::uint32_t(i)) == UINT32_MAX) continue;
-        if (distance[i] < nearest[v]) nearest[v] = distance[i], original_face_near_[v] = surface_->face_at(std::uint32_t(i));
+        const std::uint32_t v = near_vertex_[i];  // no face or no vertex: HUGE_VAL, never nearer
+        if (v < original_face_near_.size() && distance[i] < nearest[v])
+          nearest[v] = distance[i], original_face_near_[v] = surface_->face_at(std::uint32_t(i));
       }
     }
     ready_ = true;
