@@ -112,6 +112,11 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
       ->check(CLI::Range(0.0, 1e6));
   sub->add_flag("--no-refit", a.no_refit,
                 "No refit, not even the default's light one: every vertex stays where GH97 placed it");
+  sub->add_flag("--flip-edges", a.flip_edges,
+                "After the run (and the refit), flip the edges where the flip lowers the local Hausdorff "
+                "distance to the input without raising the local error: no vertex moves; borders, seams and "
+                "locked vertices keep their edges (docs/benchmarks.md, \"Edge flips\": lower E and Hausdorff "
+                "at 100 faces, more CPU time on large outputs)");
   sub->add_flag("--attribute-fit", a.attribute_fit,
                 "With attributes, after the run fit each vertex's values (off the seams) by least squares to "
                 "the input's attributes at the output's points closest to the input's faces, instead of "
@@ -189,6 +194,7 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
     opt.refit_points_per_vertex = kDefaultRefitSample;
     opt.refit_by_reduction = true;
   }
+  opt.flip_edges = a.flip_edges;
   return opt;
 }
 

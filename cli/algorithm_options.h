@@ -34,6 +34,7 @@ struct AlgorithmArgs {
   double refit_sample = 0;    // --refit-sample (implies --refit); 0 = every input vertex
   bool no_refit = false;      // --no-refit: not even the light refit of the default
   bool attribute_fit = false;  // --attribute-fit: values fitted to the input after the run
+  bool flip_edges = false;  // --flip-edges: flip far edges after the run (SimplifyOptions::flip_edges)
   std::vector<std::string> attribute_weights;  // --attribute-weight KIND=W, ...
   std::string seams = "strict";                // --seams strict|permissive
   std::vector<std::string> lock;               // --lock seams,borders

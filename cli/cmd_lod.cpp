@@ -153,6 +153,7 @@ int run_lod_mesh(const LodArgs& a) {
   const RefitOptions refit = refit_options_for(opt);
   const SimplifyOptions refit_as = opt;  // each level's refit follows its reduction (refit_levels)
   opt.refit_rounds = 0;
+  opt.flip_edges = false;  // the levels are the recorded contractions'
   ContractionRecorder recorder;
   if (!a.faces.empty())
     opt.target_faces = *std::min_element(a.faces.begin(), a.faces.end());

@@ -9,6 +9,7 @@
 #include <span>
 
 #include "core/distance_bound.h"
+#include "core/edge_flips.h"
 #include "core/parallel_chunks.h"
 #include "core/run.h"
 #include "core/settings.h"
@@ -168,11 +169,12 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
   hooks.consumed_indices = consumed_indices;
   hooks.consumed_attributes = consumed_attributes;
   hooks.map_input_vertices = refit || fit_values;
-  core::WedgeRefitData wedge_refit;  // with attributes, for the refit and the attribute fit
-  if ((refit || fit_values) && !input.attributes.empty()) hooks.wedge_refit = &wedge_refit;
-  if (refit || bounded || fit_values)
+  core::WedgeRefitData wedge_refit;  // with attributes, for the refit, the attribute fit and the flips
+  const bool flip = options.flip_edges;
+  if ((refit || fit_values || flip) && !input.attributes.empty()) hooks.wedge_refit = &wedge_refit;
+  if (refit || bounded || fit_values || flip)
     hooks.before_release = [&](MeshView in) {
-      if (refit) weights = refit_detail::vertex_areas(in);
+      if (refit || flip) weights = refit_detail::vertex_areas(in);
       kept_indices.assign(in.indices.begin(), in.indices.end());
     };
   SimplifyResult out = core::run(input, options, hooks);
@@ -183,19 +185,27 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
   double max_distance = options.max_distance;
   if (bounded && options.max_distance_is_relative) max_distance *= input_frame.scale;
   const RefitOptions chosen = refit_options_for(options, out.input_vertices, out.mesh.vertex_count());
-  if (refit && chosen.rounds > 0 && out.contractions > 0 && out.stop_reason != StopReason::Cancelled) {
+  const bool finished = out.contractions > 0 && out.stop_reason != StopReason::Cancelled;
+  const bool refitted = refit && chosen.rounds > 0 && finished;
+  // The refit and the flips measure against the input's vertices (as points weighted by their
+  // share of the area) and faces, in the points' frame.
+  refit_detail::FitPoints points;
+  core::SurfaceDistance surface;
+  if (refitted || (flip && finished)) {
     if (!consumed_indices) weights = refit_detail::vertex_areas(input);
-    const refit_detail::FitPoints points(input.positions, weights);
-    const core::SurfaceDistance surface = refit_detail::surface_in_frame(input.positions, input_faces, points.frame(),
-                                                                         core::resolve_threads(options.threads));
+    points = refit_detail::FitPoints(input.positions, weights);
+    surface = refit_detail::surface_in_frame(input.positions, input_faces, points.frame(),
+                                             core::resolve_threads(options.threads));
+  }
+  std::vector<std::uint8_t> fixed;  // the locked vertices stay
+  if (!options.vertex_lock.empty()) {
+    fixed.assign(out.mesh.vertex_count(), 0);
+    for (std::size_t v = 0; v < out.vertex_source.size(); ++v) fixed[v] = options.vertex_lock[out.vertex_source[v]];
+  }
+  if (refitted) {
     RefitOptions refit_options = chosen;
     refit_options.max_distance = max_distance;
-    std::vector<std::uint8_t> fixed;  // the locked vertices stay
-    if (!options.vertex_lock.empty()) {
-      fixed.assign(out.mesh.vertex_count(), 0);
-      for (std::size_t v = 0; v < out.vertex_source.size(); ++v) fixed[v] = options.vertex_lock[out.vertex_source[v]];
-      refit_options.fixed_vertices = fixed;
-    }
+    refit_options.fixed_vertices = fixed;
     // Its first search for each input vertex's closest face starts at the vertex it went into.
     const RefitResult fit =
         out.mesh.attributes.empty()
@@ -204,6 +214,19 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
     out.refit_rms_before = fit.rms_before;
     out.refit_rms_after = fit.rms_after;
     out.refit_rounds = fit.rounds;
+  }
+  if (flip && finished) {
+    // Seam wedges and locked vertices keep their edges.
+    std::vector<std::uint8_t> held = wedge_refit.on_seam;
+    held.resize(out.mesh.vertex_count(), 0);
+    for (std::size_t v = 0; v < fixed.size(); ++v) held[v] |= fixed[v];
+    core::EdgeFlipOptions flip_options;
+    flip_options.held = held;
+    flip_options.max_normal_turn_degrees = options.max_normal_turn_degrees;
+    flip_options.threads = core::resolve_threads(options.threads);
+    const core::EdgeFlipResult flipped =
+        core::flip_far_edges(out.mesh, points.frame(), surface, points.position, points.weight, flip_options);
+    out.edge_flips = flipped.flips;
   }
   if (fit_values && out.contractions > 0 && out.stop_reason != StopReason::Cancelled) {
     // After the refit: the values fit the final positions. Seam and locked vertices keep theirs.

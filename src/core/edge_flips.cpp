@@ -1,0 +1,305 @@
+#include "core/edge_flips.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "core/parallel_chunks.h"
+#include "measure/bvh.h"
+#include "measure/point_triangle.h"
+
+namespace qem::core {
+
+namespace {
+
+// Queries per work item (fixed: the results never depend on the threads).
+constexpr std::size_t kChunk = 1024;
+// The sample grid on a face: barycentric, kGrid subdivisions per edge (15 points at 4), which puts
+// points at the middle of each edge, where an edge across a groove is farthest from it.
+constexpr int kGrid = 4;
+
+// What a face contributes: its samples' largest and summed squared distances to the input (the
+// sum times the face's area over the sample count: its side of GH97 §6.1's E).
+struct FaceScore {
+  double most = 0;    // largest sample distance
+  double energy = 0;  // area * mean squared sample distance
+};
+
+class Flipper {
+ public:
+  Flipper(Mesh& approx, const Frame& frame, const SurfaceDistance& surface, std::span<const double> points,
+          std::span<const double> weights, const EdgeFlipOptions& options)
+      : mesh_(approx), surface_(surface), points_(points), weights_(weights), opt_(options),
+        cos_turn_(std::cos(options.max_normal_turn_degrees * std::numbers::pi / 180)),
+        weight_scale_(1 / (frame.scale * frame.scale)) {
+    const std::size_t n = approx.vertex_count();
+    x_.resize(n);
+    for (std::size_t v = 0; v < n; ++v) {
+      const double* p = &approx.positions[3 * v];
+      x_[v] = frame.to_frame({p[0], p[1], p[2]});
+    }
+    tri_ = approx.indices;
+    // Vertices at one position (wedges of a seam, or vertices the input never welded) are held:
+    // an edge added at one could duplicate an edge of its twin.
+    held_.assign(n, 0);
+    for (std::size_t v = 0; v < n && v < options.held.size(); ++v) held_[v] = options.held[v];
+    std::vector<std::uint32_t> order(n);
+    for (std::uint32_t v = 0; v < n; ++v) order[v] = v;
+    const auto key = [&](std::uint32_t v) { return std::array<double, 3>{x_[v].x, x_[v].y, x_[v].z}; };
+    std::sort(order.begin(), order.end(), [&](std::uint32_t u, std::uint32_t v) { return key(u) < key(v); });
+    for (std::size_t i = 1; i < n; ++i)
+      if (key(order[i]) == key(order[i - 1])) held_[order[i]] = held_[order[i - 1]] = 1;
+    faces_at_.assign(n, {});
+    for (std::uint32_t f = 0; f < face_count(); ++f)
+      for (int k = 0; k < 3; ++k) faces_at_[tri_[3 * f + k]].push_back(f);
+    score_faces();
+    assign_points();
+  }
+
+  EdgeFlipResult run() {
+    EdgeFlipResult r;
+    r.largest_before = largest();
+    for (unsigned sweep = 0; sweep < opt_.sweeps; ++sweep) {
+      const std::size_t flips = this->sweep(opt_.from_fraction * largest());
+      r.flips += flips;
+      if (flips == 0) break;
+    }
+    r.largest_after = largest();
+    mesh_.indices = tri_;
+    return r;
+  }
+
+ private:
+  std::uint32_t face_count() const { return std::uint32_t(tri_.size() / 3); }
+  Vec3 point(std::uint32_t p) const { return {points_[3 * p], points_[3 * p + 1], points_[3 * p + 2]}; }
+
+  FaceScore score(const Vec3& a, const Vec3& b, const Vec3& c) const {
+    FaceScore s;
+    std::uint32_t hint = UINT32_MAX;
+    int count = 0;
+    for (int i = 0; i <= kGrid; ++i)
+      for (int j = 0; i + j <= kGrid; ++j) {
+        const Vec3 q = a + (b - a) * (double(i) / kGrid) + (c - a) * (double(j) / kGrid);
+        const double d = surface_.distance(q, &hint);
+        s.most = std::max(s.most, d);
+        s.energy += d * d;
+        ++count;
+      }
+    s.energy *= 0.5 * length(cross(b - a, c - a)) / count;
+    return s;
+  }
+
+  void score_faces() {
+    score_.resize(face_count());
+    for_chunks(face_count(), kChunk, resolve_threads(opt_.threads), [&](std::size_t, std::size_t begin, std::size_t end) {
+      for (std::size_t f = begin; f < end; ++f) {
+        const std::uint32_t* t = &tri_[3 * f];
+        score_[f] = score(x_[t[0]], x_[t[1]], x_[t[2]]);
+      }
+    });
+  }
+
+  // Each input point goes to its closest output face (of two as close, the lower index): only the
+  // points of a flip's two faces can come farther from the output by it.
+  void assign_points() {
+    std::vector<double> corners(9 * std::size_t(face_count()));
+    for (std::size_t f = 0; f < face_count(); ++f)
+      for (int k = 0; k < 3; ++k) {
+        const Vec3& p = x_[tri_[3 * f + k]];
+        corners[9 * f + 3 * k] = p.x, corners[9 * f + 3 * k + 1] = p.y, corners[9 * f + 3 * k + 2] = p.z;
+      }
+    const measure_detail::TriangleBvh tree(corners, resolve_threads(opt_.threads));
+    const std::size_t count = weights_.size();
+    std::vector<std::uint32_t> face_of(count);
+    d2_.resize(count);
+    for_chunks(count, kChunk, resolve_threads(opt_.threads), [&](std::size_t, std::size_t begin, std::size_t end) {
+      std::uint32_t hint = UINT32_MAX;
+      for (std::size_t p = begin; p < end; ++p) {
+        const auto hit = tree.closest(&points_[3 * p], &hint);
+        face_of[p] = hit.triangle, d2_[p] = hit.d2;
+      }
+    });
+    points_of_.assign(face_count(), {});
+    for (std::uint32_t p = 0; p < count; ++p)
+      if (face_of[p] != UINT32_MAX) points_of_[face_of[p]].push_back(p);
+    near_most_.assign(face_count(), 0);
+    for (std::uint32_t f = 0; f < face_count(); ++f) near_most_[f] = nearest_most(f);
+  }
+
+  double nearest_most(std::uint32_t f) const {
+    double most = 0;
+    for (std::uint32_t p : points_of_[f]) most = std::max(most, d2_[p]);
+    return std::sqrt(most);
+  }
+  double local(std::uint32_t f) const { return std::max(score_[f].most, near_most_[f]); }
+  double largest() const {
+    double most = 0;
+    for (std::uint32_t f = 0; f < face_count(); ++f) most = std::max(most, local(f));
+    return most;
+  }
+
+  // The face other than f that has the edge from a to b the other way round, or UINT32_MAX when
+  // there is none or more than one (a border or a non-manifold edge), or when a face has it the
+  // same way round.
+  std::uint32_t across(std::uint32_t f, std::uint32_t a, std::uint32_t b) const {
+    std::uint32_t found = UINT32_MAX;
+    for (std::uint32_t g : faces_at_[a]) {
+      if (g == f) continue;
+      const std::uint32_t* t = &tri_[3 * g];
+      for (int k = 0; k < 3; ++k) {
+        if (t[k] != a) continue;
+        if (t[(k + 1) % 3] == b) return UINT32_MAX;  // same way round: not orientable here
+        if (t[(k + 2) % 3] == b) {
+          if (found != UINT32_MAX) return UINT32_MAX;
+          found = g;
+        }
+      }
+    }
+    return found;
+  }
+  bool has_edge(std::uint32_t a, std::uint32_t b) const {
+    for (std::uint32_t g : faces_at_[a]) {
+      const std::uint32_t* t = &tri_[3 * g];
+      if (t[0] == b || t[1] == b || t[2] == b) return true;
+    }
+    return false;
+  }
+  bool held(std::uint32_t v) const { return held_[v] != 0; }
+  Vec3 normal(std::uint32_t a, std::uint32_t b, std::uint32_t c) const {
+    return cross(x_[b] - x_[a], x_[c] - x_[a]);
+  }
+  // The unit normal of the face across edge ab from f (UINT32_MAX: none, then a zero vector).
+  Vec3 across_normal(std::uint32_t f, std::uint32_t a, std::uint32_t b) const {
+    const std::uint32_t g = across(f, a, b);
+    if (g == UINT32_MAX) return {0, 0, 0};
+    const std::uint32_t* t = &tri_[3 * g];
+    return normalized(normal(t[0], t[1], t[2]));
+  }
+  // Whether the crease between unit normals n and m is allowed where it replaces the crease
+  // between o and m (a zero m: no neighbour, nothing to check).
+  bool crease_ok(const Vec3& n, const Vec3& o, const Vec3& m) const {
+    if (dot(m, m) == 0) return true;
+    return dot(n, m) >= std::min(cos_turn_, dot(o, m));
+  }
+
+  // The largest and the area-weighted squared distances of the input points `pts` to the nearer of
+  // faces g1, g2 (corners given).
+  void near_points(const std::vector<std::uint32_t>& pts, const Vec3* g1, const Vec3* g2,
+                   std::vector<double>& d2, double& most, double& energy) const {
+    using measure_detail::closest_point_on_triangle;
+    using measure_detail::squared_distance;
+    d2.resize(pts.size());
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      const Vec3 p = point(pts[i]);
+      const double one = squared_distance(p, closest_point_on_triangle(p, g1[0], g1[1], g1[2]));
+      const double two = squared_distance(p, closest_point_on_triangle(p, g2[0], g2[1], g2[2]));
+      d2[i] = std::min(one, two);
+      most = std::max(most, d2[i]);
+      energy += weights_[pts[i]] * weight_scale_ * d2[i];
+    }
+  }
+
+  // Tries the flip of edge k of face f1; returns whether it was made.
+  bool try_flip(std::uint32_t f1, int k) {
+    const std::uint32_t* t1 = &tri_[3 * f1];
+    const std::uint32_t a = t1[k], b = t1[(k + 1) % 3], c = t1[(k + 2) % 3];
+    const std::uint32_t f2 = across(f1, a, b);
+    if (f2 == UINT32_MAX) return false;
+    if (!mesh_.face_materials.empty() && mesh_.face_materials[f1] != mesh_.face_materials[f2]) return false;
+    const std::uint32_t* t2 = &tri_[3 * f2];
+    std::uint32_t d = UINT32_MAX;
+    for (int i = 0; i < 3; ++i)
+      if (t2[i] != a && t2[i] != b) d = t2[i];
+    if (d == UINT32_MAX || d == c || held(a) || held(b) || held(c) || held(d) || has_edge(c, d)) return false;
+    // Orientation and folds: the new faces (a,d,c), (b,c,d) turn the same way as the old ones
+    // (each within 90 degrees of both), and no crease round them gets sharper than allowed.
+    const Vec3 n1 = normalized(normal(a, b, c)), n2 = normalized(normal(b, a, d));
+    const Vec3 m1 = normalized(normal(a, d, c)), m2 = normalized(normal(b, c, d));
+    if (dot(m1, m1) == 0 || dot(m2, m2) == 0 || dot(n1, n1) == 0 || dot(n2, n2) == 0) return false;
+    if (dot(m1, n1) <= 0 || dot(m1, n2) <= 0 || dot(m2, n1) <= 0 || dot(m2, n2) <= 0) return false;
+    if (dot(m1, m2) < std::min(cos_turn_, dot(n1, n2))) return false;
+    // The outer edges: c-a was f1's (now g1's), a-d f2's (now g1's), d-b f2's (now g2's), b-c f1's.
+    if (!crease_ok(m1, n1, across_normal(f1, c, a)) || !crease_ok(m1, n2, across_normal(f2, a, d)) ||
+        !crease_ok(m2, n2, across_normal(f2, d, b)) || !crease_ok(m2, n1, across_normal(f1, b, c)))
+      return false;
+
+    // The local Hausdorff distance and share of E, before and after.
+    const Vec3 g1[3] = {x_[a], x_[d], x_[c]}, g2[3] = {x_[b], x_[c], x_[d]};
+    const FaceScore s1 = score(g1[0], g1[1], g1[2]), s2 = score(g2[0], g2[1], g2[2]);
+    const double old_most = std::max(local(f1), local(f2));
+    double old_energy = score_[f1].energy + score_[f2].energy;
+    for (std::uint32_t f : {f1, f2})
+      for (std::uint32_t p : points_of_[f]) old_energy += weights_[p] * weight_scale_ * d2_[p];
+    if (std::max(s1.most, s2.most) >= old_most) return false;
+    std::vector<std::uint32_t>& pts = scratch_points_;
+    pts.assign(points_of_[f1].begin(), points_of_[f1].end());
+    pts.insert(pts.end(), points_of_[f2].begin(), points_of_[f2].end());
+    double most2 = 0, energy = s1.energy + s2.energy;
+    near_points(pts, g1, g2, scratch_d2_, most2, energy);
+    if (std::max({s1.most, s2.most, std::sqrt(most2)}) >= old_most) return false;
+    if (energy > old_energy * (1 + opt_.error_margin)) return false;
+
+    // Made: f1 becomes (a,d,c), f2 (b,c,d); b leaves f1 and d joins it, a leaves f2 and c joins it.
+    tri_[3 * f1] = a, tri_[3 * f1 + 1] = d, tri_[3 * f1 + 2] = c;
+    tri_[3 * f2] = b, tri_[3 * f2 + 1] = c, tri_[3 * f2 + 2] = d;
+    std::erase(faces_at_[b], f1), faces_at_[d].push_back(f1);
+    std::erase(faces_at_[a], f2), faces_at_[c].push_back(f2);
+    score_[f1] = s1, score_[f2] = s2;
+    points_of_[f1].clear(), points_of_[f2].clear();
+    using measure_detail::closest_point_on_triangle;
+    using measure_detail::squared_distance;
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      const Vec3 p = point(pts[i]);
+      const double one = squared_distance(p, closest_point_on_triangle(p, g1[0], g1[1], g1[2]));
+      d2_[pts[i]] = scratch_d2_[i];
+      points_of_[one <= scratch_d2_[i] ? f1 : f2].push_back(pts[i]);
+    }
+    near_most_[f1] = nearest_most(f1), near_most_[f2] = nearest_most(f2);
+    return true;
+  }
+
+  // One sweep over the edges of the faces at least `from` from the input (locally), in face order.
+  std::size_t sweep(double from) {
+    std::vector<std::uint32_t> far;
+    for (std::uint32_t f = 0; f < face_count(); ++f)
+      if (local(f) >= from) far.push_back(f);
+    std::size_t flips = 0;
+    for (std::uint32_t f : far)
+      for (int k = 0; k < 3; ++k)
+        if (try_flip(f, k)) {
+          ++flips;
+          break;  // f is another face now
+        }
+    return flips;
+  }
+
+  Mesh& mesh_;
+  const SurfaceDistance& surface_;
+  std::span<const double> points_, weights_;
+  const EdgeFlipOptions& opt_;
+  const double cos_turn_;
+  const double weight_scale_;  // model area to the frame's
+  std::vector<Vec3> x_;                              // output positions in the frame
+  std::vector<std::uint8_t> held_;                   // per vertex: its edges stay
+  std::vector<std::uint32_t> tri_;                   // output faces (3 per face), flipped in place
+  std::vector<std::vector<std::uint32_t>> faces_at_;  // per vertex, the faces that have it
+  std::vector<FaceScore> score_;                     // per face
+  std::vector<std::vector<std::uint32_t>> points_of_;  // per face, the input points closest to it
+  std::vector<double> near_most_;                    // per face, the largest of those points' distances
+  std::vector<double> d2_;                           // per point, its squared distance to its face
+  std::vector<std::uint32_t> scratch_points_;
+  std::vector<double> scratch_d2_;
+};
+
+}  // namespace
+
+EdgeFlipResult flip_far_edges(Mesh& approx, const Frame& frame, const SurfaceDistance& surface,
+                              std::span<const double> points, std::span<const double> weights,
+                              const EdgeFlipOptions& options) {
+  if (approx.face_count() < 2 || surface.empty()) return {};
+  return Flipper(approx, frame, surface, points, weights, options).run();
+}
+
+}  // namespace qem::core

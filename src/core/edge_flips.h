@@ -1,0 +1,63 @@
+// After the last contraction (and the refit): flips of output edges that lower the local
+// Hausdorff distance between the output and the input, with no vertex moved.
+//
+// GH97's contraction order and placement leave some output edges across a groove or a ridge of
+// the input: the edge's two faces span it, the vertices lie on it, and the far points are near the
+// middle of the edge (docs/benchmarks.md, "Hausdorff"). Of the two diagonals of the quadrilateral
+// those two faces form, the other may follow the groove. A flip (Hoppe et al. 1993 §4, the "edge
+// swap" of their mesh optimisation, here scored by the largest distance instead of the energy)
+// replaces faces (a,b,c), (b,a,d) by (a,d,c), (b,c,d) when that lowers the larger of
+//   - the largest distance from the two faces' sample points to the input surface, and
+//   - the largest distance from the input points nearest to those two faces to them,
+// without raising their share of the mean squared error E (GH97 §6.1) by more than a margin.
+//
+// A flip is refused where it would change the mesh's topology or fold it: the edge must be
+// interior and manifold, the new edge must not exist, no new crease may be sharper than
+// `max_normal_turn_degrees` unless it replaces one at least as sharp, and none of the four
+// vertices may be held (locked, or on a seam). Borders and faces of different materials stay as
+// they are. Deterministic: flips are tried one at a time in a fixed order.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+#include "core/distance_bound.h"
+#include "geometry/frame.h"
+#include "qem/mesh.h"
+
+namespace qem::core {
+
+struct EdgeFlipOptions {
+  /// Per output vertex: 1 = no flip may add or remove an edge at it (locked vertices, seam
+  /// wedges). Empty: none held.
+  std::span<const std::uint8_t> held;
+  /// Only edges of faces whose local largest distance is at least this fraction of the output's
+  /// largest are tried (the Hausdorff distance is a maximum: the far places are where it is won).
+  double from_fraction = 0.5;
+  /// Sweeps over those edges; a sweep that flips nothing ends the pass.
+  unsigned sweeps = 4;
+  /// A flip may raise its faces' share of E (both sides' squared distances over their area) by at
+  /// most this fraction.
+  double error_margin = 0;
+  /// No new crease sharper than this (the angle between the normals of two faces of an edge),
+  /// unless the crease it replaces is at least as sharp (SimplifyOptions::max_normal_turn_degrees).
+  double max_normal_turn_degrees = 75;
+  unsigned threads = 1;
+};
+
+struct EdgeFlipResult {
+  std::size_t flips = 0;
+  /// The largest sampled distance (both ways, in the surface's frame) before and after.
+  double largest_before = 0, largest_after = 0;
+};
+
+/// Flips edges of `approx` (positions in model units; `frame` maps them to the surface's frame).
+/// `surface`: the input's triangles in that frame. `points` (3 per point, in the frame) and `weights`
+/// (each one's share of the input's area, in model units): the input's vertices
+/// (refit_detail::FitPoints). Only approx.indices change.
+EdgeFlipResult flip_far_edges(Mesh& approx, const Frame& frame, const SurfaceDistance& surface,
+                              std::span<const double> points, std::span<const double> weights,
+                              const EdgeFlipOptions& options);
+
+}  // namespace qem::core
