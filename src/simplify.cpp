@@ -174,7 +174,7 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
   if ((refit || fit_values || flip) && !input.attributes.empty()) hooks.wedge_refit = &wedge_refit;
   if (refit || bounded || fit_values || flip)
     hooks.before_release = [&](MeshView in) {
-      if (refit || flip) weights = refit_detail::vertex_areas(in);
+      if (refit || flip) weights = refit_detail::vertex_areas(in, core::resolve_threads(options.threads));
       kept_indices.assign(in.indices.begin(), in.indices.end());
     };
   SimplifyResult out = core::run(input, options, hooks);
@@ -192,10 +192,10 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
   refit_detail::FitPoints points;
   core::SurfaceDistance surface;
   if (refitted || (flip && finished)) {
-    if (!consumed_indices) weights = refit_detail::vertex_areas(input);
-    points = refit_detail::FitPoints(input.positions, weights);
-    surface = refit_detail::surface_in_frame(input.positions, input_faces, points.frame(),
-                                             core::resolve_threads(options.threads));
+    const unsigned threads = core::resolve_threads(options.threads);
+    if (!consumed_indices) weights = refit_detail::vertex_areas(input, threads);
+    points = refit_detail::FitPoints(input.positions, weights, threads);
+    surface = refit_detail::surface_in_frame(input.positions, input_faces, points.frame(), threads);
   }
   std::vector<std::uint8_t> fixed;  // the locked vertices stay
   if (!options.vertex_lock.empty()) {
