@@ -113,10 +113,11 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
   sub->add_flag("--no-refit", a.no_refit,
                 "No refit, not even the default's light one: every vertex stays where GH97 placed it");
   sub->add_flag("--flip-edges", a.flip_edges,
-                "After the run (and the refit), flip the edges where the flip lowers the local Hausdorff "
+                "After the run and the refit, flip the edges where the flip lowers the local Hausdorff "
                 "distance to the input without raising the local error: no vertex moves; borders, seams and "
-                "locked vertices keep their edges (docs/benchmarks.md, \"Edge flips\": lower E and Hausdorff "
-                "at 100 faces, more CPU time on large outputs)");
+                "locked vertices keep their edges (docs/benchmarks.md, \"Edge flips\"). On by default with "
+                "the refit; this turns them on without it");
+  sub->add_flag("--no-flip-edges", a.no_flip_edges, "No edge flips after the run (see --flip-edges)");
   sub->add_flag("--attribute-fit", a.attribute_fit,
                 "With attributes, after the run fit each vertex's values (off the seams) by least squares to "
                 "the input's attributes at the output's points closest to the input's faces, instead of "
@@ -194,7 +195,8 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
     opt.refit_points_per_vertex = kDefaultRefitSample;
     opt.refit_by_reduction = true;
   }
-  opt.flip_edges = a.flip_edges;
+  if (a.flip_edges && a.no_flip_edges) throw Error("--flip-edges cannot be combined with --no-flip-edges");
+  opt.flip_edges = flips_wanted(a, opt);
   return opt;
 }
 
@@ -204,6 +206,13 @@ LoadOptions to_load_options(const AlgorithmArgs& a) {
   if (a.no_weld) load.weld = Weld::Off;
   if (!a.lock_property.empty()) load.keep_vertex_properties = true;
   return load;
+}
+
+// The flips finish the refit's work (the far places its moves cannot take away): on with it
+// unless asked otherwise, and not where the refit is left out (meshes with attributes, whose
+// values the flips would interpolate anew, unmeasured).
+bool flips_wanted(const AlgorithmArgs& a, const SimplifyOptions& options) {
+  return a.flip_edges || (options.refit_rounds > 0 && !a.no_flip_edges);
 }
 
 unsigned attribute_refit_rounds(const AlgorithmArgs& a, const SimplifyOptions& options, const Mesh& mesh) {

@@ -172,7 +172,10 @@ int run_simplify(const SimplifyArgs& a) {
   check_options(opt);  // before the input is read: a slip in the options is said at once
   // A document's primitives carry attributes (NORMAL, TEXCOORD_n...) as a rule: the default's light
   // refit is left out for them as for any mesh with attributes; --refit asks for it.
-  if (gltf_document) opt.refit_rounds = attribute_refit_rounds(a.algorithm, opt);
+  if (gltf_document) {
+    opt.refit_rounds = attribute_refit_rounds(a.algorithm, opt);
+    opt.flip_edges = flips_wanted(a.algorithm, opt);
+  }
   if (gltf_document) return run_simplify_gltf(a, opt);
   // An input too large for memory goes the out-of-core way (qem/out_of_core.h); others as before.
   if (a.record.empty() && wants_out_of_core(a.input, a.out_of_core)) {
@@ -191,7 +194,10 @@ int run_simplify(const SimplifyArgs& a) {
   Mesh mesh = load_input(a.input, load, &report);
   std::vector<std::uint8_t> lock;  // --lock-property: outlives the run, as vertex_lock must
   apply_lock_property(a.algorithm, a.input, mesh, lock, opt);
-  if (!mesh.attributes.empty()) opt.refit_rounds = attribute_refit_rounds(a.algorithm, opt, mesh);
+  if (!mesh.attributes.empty()) {
+    opt.refit_rounds = attribute_refit_rounds(a.algorithm, opt, mesh);
+    opt.flip_edges = flips_wanted(a.algorithm, opt);
+  }
   const double load_s = t_load.seconds();
   if (!a.record.empty() && !mesh.attributes.empty())
     throw Error(a.input + ": --record keeps positions and faces only, and this mesh has attributes (" +

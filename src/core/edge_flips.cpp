@@ -19,12 +19,32 @@ constexpr std::size_t kChunk = 1024;
 // The sample grid on a face: barycentric, kGrid subdivisions per edge (15 points at 4), which puts
 // points at the middle of each edge, where an edge across a groove is farthest from it.
 constexpr int kGrid = 4;
+constexpr int kSamples = (kGrid + 1) * (kGrid + 2) / 2;
+
+// The grid's points as weights (u, v) of b - a and c - a, those of edge bc first, its middle
+// first: a flip's new faces have the new edge there, where they are farthest from the input if
+// anywhere, so a flip that would not help is usually refused after one sample.
+struct SampleAt {
+  double u, v;
+};
+constexpr std::array<SampleAt, kSamples> sample_order() {
+  std::array<SampleAt, kSamples> order{};
+  int n = 0;
+  const int edge[] = {kGrid / 2, kGrid / 2 - 1, kGrid / 2 + 1, 0, kGrid};  // i along bc, middle out
+  for (int i : edge) order[n++] = {double(i) / kGrid, double(kGrid - i) / kGrid};
+  for (int i = 0; i <= kGrid; ++i)
+    for (int j = 0; i + j < kGrid; ++j) order[n++] = {double(i) / kGrid, double(j) / kGrid};
+  return order;
+}
+constexpr std::array<SampleAt, kSamples> kOrder = sample_order();
+static_assert(kGrid == 4, "the edge's points in sample_order are written out for 4 subdivisions");
 
 // What a face contributes: its samples' largest and summed squared distances to the input (the
 // sum times the face's area over the sample count: its side of GH97 §6.1's E).
 struct FaceScore {
   double most = 0;    // largest sample distance
-  double energy = 0;  // area * mean squared sample distance
+  double energy = 0;  // area * mean squared sample distance (complete only when all were taken)
+  std::uint32_t hint = UINT32_MAX;  // a face of the input near the face, where searches start
 };
 
 class Flipper {
@@ -54,19 +74,21 @@ class Flipper {
     faces_at_.assign(n, {});
     for (std::uint32_t f = 0; f < face_count(); ++f)
       for (int k = 0; k < 3; ++k) faces_at_[tri_[3 * f + k]].push_back(f);
-    score_faces();
     assign_points();
+    scan_faces();
   }
 
   EdgeFlipResult run() {
     EdgeFlipResult r;
-    r.largest_before = largest();
+    r.largest_before = largest_;
+    // The first sweep tries every far face; each later one only the faces a flip of the sweep
+    // before changed or bordered (elsewhere nothing changed, so no other flip became possible).
+    std::vector<std::uint8_t> dirty(face_count(), 1);
     for (unsigned sweep = 0; sweep < opt_.sweeps; ++sweep) {
-      const std::size_t flips = this->sweep(opt_.from_fraction * largest());
+      const std::size_t flips = this->sweep(opt_.from_fraction * largest_, dirty);
       r.flips += flips;
       if (flips == 0) break;
     }
-    r.largest_after = largest();
     mesh_.indices = tri_;
     return r;
   }
@@ -75,30 +97,55 @@ class Flipper {
   std::uint32_t face_count() const { return std::uint32_t(tri_.size() / 3); }
   Vec3 point(std::uint32_t p) const { return {points_[3 * p], points_[3 * p + 1], points_[3 * p + 2]}; }
 
-  FaceScore score(const Vec3& a, const Vec3& b, const Vec3& c) const {
+  // The samples of face abc, searched from input face `hint`; stops at the first sample at least
+  // `limit` from the input (then `energy` is incomplete and `most` at least limit).
+  FaceScore score(const Vec3& a, const Vec3& b, const Vec3& c, std::uint32_t hint,
+                  double limit = HUGE_VAL) const {
     FaceScore s;
-    std::uint32_t hint = UINT32_MAX;
-    int count = 0;
-    for (int i = 0; i <= kGrid; ++i)
-      for (int j = 0; i + j <= kGrid; ++j) {
-        const Vec3 q = a + (b - a) * (double(i) / kGrid) + (c - a) * (double(j) / kGrid);
-        const double d = surface_.distance(q, &hint);
-        s.most = std::max(s.most, d);
-        s.energy += d * d;
-        ++count;
-      }
-    s.energy *= 0.5 * length(cross(b - a, c - a)) / count;
+    for (const SampleAt& at : kOrder) {
+      const double d = surface_.distance(a + (b - a) * at.u + (c - a) * at.v, &hint);
+      s.most = std::max(s.most, d);
+      s.energy += d * d;
+      if (d >= limit) break;
+    }
+    s.energy *= 0.5 * length(cross(b - a, c - a)) / kSamples;
+    s.hint = hint;
     return s;
   }
+  FaceScore score(std::uint32_t f, double limit = HUGE_VAL) const {
+    const std::uint32_t* t = &tri_[3 * f];
+    return score(x_[t[0]], x_[t[1]], x_[t[2]], hint_[f], limit);
+  }
+  void ensure_scored(std::uint32_t f) {
+    if (scored_[f]) return;
+    score_[f] = score(f);
+    scored_[f] = 1;
+  }
 
-  void score_faces() {
-    score_.resize(face_count());
-    for_chunks(face_count(), kChunk, resolve_threads(opt_.threads), [&](std::size_t, std::size_t begin, std::size_t end) {
+  // Where the far faces are, for a fraction of the samples' searches: per face, the largest
+  // distance of its centroid and edge midpoints (the middle of an edge across a groove is where
+  // it is farthest from it) to the input (near_), and the largest of those and of the input
+  // points' distances (largest_). The exact samples of a face are taken when a flip needs them.
+  void scan_faces() {
+    const std::size_t nf = face_count();
+    near_.assign(nf, 0);
+    hint_.assign(nf, UINT32_MAX);
+    scored_.assign(nf, 0);
+    score_.assign(nf, {});
+    for_chunks(nf, kChunk, resolve_threads(opt_.threads), [&](std::size_t, std::size_t begin, std::size_t end) {
+      std::uint32_t hint = UINT32_MAX;
       for (std::size_t f = begin; f < end; ++f) {
         const std::uint32_t* t = &tri_[3 * f];
-        score_[f] = score(x_[t[0]], x_[t[1]], x_[t[2]]);
+        const Vec3 &a = x_[t[0]], &b = x_[t[1]], &c = x_[t[2]];
+        const Vec3 at[4] = {(1.0 / 3) * (a + b + c), 0.5 * (a + b), 0.5 * (b + c), 0.5 * (c + a)};
+        double most = 0;
+        for (const Vec3& q : at) most = std::max(most, surface_.distance(q, &hint));
+        near_[f] = most;
+        hint_[f] = hint;
       }
     });
+    largest_ = 0;
+    for (std::uint32_t f = 0; f < nf; ++f) largest_ = std::max(largest_, local(f));
   }
 
   // Each input point goes to its closest output face (of two as close, the lower index): only the
@@ -133,12 +180,9 @@ class Flipper {
     for (std::uint32_t p : points_of_[f]) most = std::max(most, d2_[p]);
     return std::sqrt(most);
   }
-  double local(std::uint32_t f) const { return std::max(score_[f].most, near_most_[f]); }
-  double largest() const {
-    double most = 0;
-    for (std::uint32_t f = 0; f < face_count(); ++f) most = std::max(most, local(f));
-    return most;
-  }
+  // The face's largest distance (both ways): exact once scored, else that of its centroid and
+  // edge midpoints.
+  double local(std::uint32_t f) const { return std::max(scored_[f] ? score_[f].most : near_[f], near_most_[f]); }
 
   // The face other than f that has the edge from a to b the other way round, or UINT32_MAX when
   // there is none or more than one (a border or a non-manifold edge), or when a face has it the
@@ -201,45 +245,50 @@ class Flipper {
     }
   }
 
-  // Tries the flip of edge k of face f1; returns whether it was made.
-  bool try_flip(std::uint32_t f1, int k) {
+  // Tries the flip of edge k of face f1; returns the other face of the flip, or UINT32_MAX when
+  // it was not made.
+  std::uint32_t try_flip(std::uint32_t f1, int k) {
     const std::uint32_t* t1 = &tri_[3 * f1];
     const std::uint32_t a = t1[k], b = t1[(k + 1) % 3], c = t1[(k + 2) % 3];
     const std::uint32_t f2 = across(f1, a, b);
-    if (f2 == UINT32_MAX) return false;
-    if (!mesh_.face_materials.empty() && mesh_.face_materials[f1] != mesh_.face_materials[f2]) return false;
+    if (f2 == UINT32_MAX) return UINT32_MAX;
+    if (!mesh_.face_materials.empty() && mesh_.face_materials[f1] != mesh_.face_materials[f2]) return UINT32_MAX;
     const std::uint32_t* t2 = &tri_[3 * f2];
     std::uint32_t d = UINT32_MAX;
     for (int i = 0; i < 3; ++i)
       if (t2[i] != a && t2[i] != b) d = t2[i];
-    if (d == UINT32_MAX || d == c || held(a) || held(b) || held(c) || held(d) || has_edge(c, d)) return false;
+    if (d == UINT32_MAX || d == c || held(a) || held(b) || held(c) || held(d) || has_edge(c, d)) return UINT32_MAX;
     // Orientation and folds: the new faces (a,d,c), (b,c,d) turn the same way as the old ones
     // (each within 90 degrees of both), and no crease round them gets sharper than allowed.
     const Vec3 n1 = normalized(normal(a, b, c)), n2 = normalized(normal(b, a, d));
     const Vec3 m1 = normalized(normal(a, d, c)), m2 = normalized(normal(b, c, d));
-    if (dot(m1, m1) == 0 || dot(m2, m2) == 0 || dot(n1, n1) == 0 || dot(n2, n2) == 0) return false;
-    if (dot(m1, n1) <= 0 || dot(m1, n2) <= 0 || dot(m2, n1) <= 0 || dot(m2, n2) <= 0) return false;
-    if (dot(m1, m2) < std::min(cos_turn_, dot(n1, n2))) return false;
+    if (dot(m1, m1) == 0 || dot(m2, m2) == 0 || dot(n1, n1) == 0 || dot(n2, n2) == 0) return UINT32_MAX;
+    if (dot(m1, n1) <= 0 || dot(m1, n2) <= 0 || dot(m2, n1) <= 0 || dot(m2, n2) <= 0) return UINT32_MAX;
+    if (dot(m1, m2) < std::min(cos_turn_, dot(n1, n2))) return UINT32_MAX;
     // The outer edges: c-a was f1's (now g1's), a-d f2's (now g1's), d-b f2's (now g2's), b-c f1's.
     if (!crease_ok(m1, n1, across_normal(f1, c, a)) || !crease_ok(m1, n2, across_normal(f2, a, d)) ||
         !crease_ok(m2, n2, across_normal(f2, d, b)) || !crease_ok(m2, n1, across_normal(f1, b, c)))
-      return false;
+      return UINT32_MAX;
 
     // The local Hausdorff distance and share of E, before and after.
-    const Vec3 g1[3] = {x_[a], x_[d], x_[c]}, g2[3] = {x_[b], x_[c], x_[d]};
-    const FaceScore s1 = score(g1[0], g1[1], g1[2]), s2 = score(g2[0], g2[1], g2[2]);
+    // (Corners d, c of g1 and c, d of g2 second and third: the new edge's samples go first.)
+    ensure_scored(f1), ensure_scored(f2);
     const double old_most = std::max(local(f1), local(f2));
+    const Vec3 g1[3] = {x_[a], x_[d], x_[c]}, g2[3] = {x_[b], x_[c], x_[d]};
+    const FaceScore s1 = score(g1[0], g1[1], g1[2], score_[f1].hint, old_most);
+    if (s1.most >= old_most) return UINT32_MAX;
+    const FaceScore s2 = score(g2[0], g2[1], g2[2], score_[f2].hint, old_most);
+    if (s2.most >= old_most) return UINT32_MAX;
     double old_energy = score_[f1].energy + score_[f2].energy;
     for (std::uint32_t f : {f1, f2})
       for (std::uint32_t p : points_of_[f]) old_energy += weights_[p] * weight_scale_ * d2_[p];
-    if (std::max(s1.most, s2.most) >= old_most) return false;
     std::vector<std::uint32_t>& pts = scratch_points_;
     pts.assign(points_of_[f1].begin(), points_of_[f1].end());
     pts.insert(pts.end(), points_of_[f2].begin(), points_of_[f2].end());
     double most2 = 0, energy = s1.energy + s2.energy;
     near_points(pts, g1, g2, scratch_d2_, most2, energy);
-    if (std::max({s1.most, s2.most, std::sqrt(most2)}) >= old_most) return false;
-    if (energy > old_energy * (1 + opt_.error_margin)) return false;
+    if (std::max({s1.most, s2.most, std::sqrt(most2)}) >= old_most) return UINT32_MAX;
+    if (energy > old_energy * (1 + opt_.error_margin)) return UINT32_MAX;
 
     // Made: f1 becomes (a,d,c), f2 (b,c,d); b leaves f1 and d joins it, a leaves f2 and c joins it.
     tri_[3 * f1] = a, tri_[3 * f1 + 1] = d, tri_[3 * f1 + 2] = c;
@@ -247,6 +296,7 @@ class Flipper {
     std::erase(faces_at_[b], f1), faces_at_[d].push_back(f1);
     std::erase(faces_at_[a], f2), faces_at_[c].push_back(f2);
     score_[f1] = s1, score_[f2] = s2;
+    scored_[f1] = scored_[f2] = 1;
     points_of_[f1].clear(), points_of_[f2].clear();
     using measure_detail::closest_point_on_triangle;
     using measure_detail::squared_distance;
@@ -257,21 +307,35 @@ class Flipper {
       points_of_[one <= scratch_d2_[i] ? f1 : f2].push_back(pts[i]);
     }
     near_most_[f1] = nearest_most(f1), near_most_[f2] = nearest_most(f2);
-    return true;
+    return f2;
   }
 
-  // One sweep over the edges of the faces at least `from` from the input (locally), in face order.
-  std::size_t sweep(double from) {
+  // One sweep over the edges of the faces marked in `dirty` that are at least `from` from the
+  // input (locally), in face order. Leaves in `dirty` the faces of this sweep's flips and their
+  // neighbours.
+  std::size_t sweep(double from, std::vector<std::uint8_t>& dirty) {
     std::vector<std::uint32_t> far;
-    for (std::uint32_t f = 0; f < face_count(); ++f)
+    for (std::uint32_t f = 0; f < face_count(); ++f) {
+      if (!dirty[f] || local(f) < from) continue;
+      ensure_scored(f);
       if (local(f) >= from) far.push_back(f);
+    }
+    std::fill(dirty.begin(), dirty.end(), 0);
     std::size_t flips = 0;
     for (std::uint32_t f : far)
-      for (int k = 0; k < 3; ++k)
-        if (try_flip(f, k)) {
-          ++flips;
-          break;  // f is another face now
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t g = try_flip(f, k);
+        if (g == UINT32_MAX) continue;
+        ++flips;
+        for (std::uint32_t h : {f, g}) {
+          dirty[h] = 1;
+          for (int e = 0; e < 3; ++e) {
+            const std::uint32_t next = across(h, tri_[3 * h + e], tri_[3 * h + (e + 1) % 3]);
+            if (next != UINT32_MAX) dirty[next] = 1;
+          }
         }
+        break;  // f is another face now
+      }
     return flips;
   }
 
@@ -285,7 +349,11 @@ class Flipper {
   std::vector<std::uint8_t> held_;                   // per vertex: its edges stay
   std::vector<std::uint32_t> tri_;                   // output faces (3 per face), flipped in place
   std::vector<std::vector<std::uint32_t>> faces_at_;  // per vertex, the faces that have it
-  std::vector<FaceScore> score_;                     // per face
+  std::vector<FaceScore> score_;                     // per face, its samples (where scored_)
+  std::vector<std::uint8_t> scored_;                 // per face: score_ is exact
+  std::vector<double> near_;                         // per face, its centroid's and edge midpoints' largest
+  std::vector<std::uint32_t> hint_;                  // per face, a face of the input near it
+  double largest_ = 0;                               // the largest distance both ways, at the start (scanned)
   std::vector<std::vector<std::uint32_t>> points_of_;  // per face, the input points closest to it
   std::vector<double> near_most_;                    // per face, the largest of those points' distances
   std::vector<double> d2_;                           // per point, its squared distance to its face
