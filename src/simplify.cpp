@@ -65,6 +65,30 @@ void refit_levels(MeshView original, std::span<ReplayLevel> levels, const Simpli
     same->second.push_back(&level.mesh);
   }
   for (auto& [refit_options, meshes] : groups) qem::refit(original, meshes, refit_options);
+  if (!options.flip_edges || groups.empty()) return;
+  // Then the flips, as simplify makes them after its refit (the refitted levels only).
+  const unsigned threads = core::resolve_threads(options.threads);
+  const std::vector<double> weights = refit_detail::vertex_areas(original, threads);
+  const refit_detail::FitPoints points(original.positions, weights, threads);
+  const core::SurfaceDistance surface =
+      refit_detail::surface_in_frame(original.positions, original.indices, points.frame(), threads);
+  // A locked vertex never moves: a level's vertex at a locked input vertex's position is held.
+  std::vector<std::array<double, 3>> locked;
+  for (std::size_t v = 0; v < options.vertex_lock.size(); ++v)
+    if (options.vertex_lock[v]) locked.push_back({original.positions[3 * v], original.positions[3 * v + 1], original.positions[3 * v + 2]});
+  std::sort(locked.begin(), locked.end());
+  core::EdgeFlipOptions flip_options;
+  flip_options.max_normal_turn_degrees = options.max_normal_turn_degrees;
+  flip_options.threads = threads;
+  for (auto& [refit_options, meshes] : groups)
+    for (Mesh* mesh : meshes) {
+      std::vector<std::uint8_t> held(locked.empty() ? 0 : mesh->vertex_count(), 0);
+      for (std::size_t v = 0; v < held.size(); ++v)
+        held[v] = std::binary_search(locked.begin(), locked.end(),
+                                     std::array<double, 3>{mesh->positions[3 * v], mesh->positions[3 * v + 1], mesh->positions[3 * v + 2]});
+      flip_options.held = held;
+      core::flip_far_edges(*mesh, points.frame(), surface, points.position, points.weight, flip_options);
+    }
 }
 
 void check_options(const SimplifyOptions& options) {
@@ -187,11 +211,14 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
   const RefitOptions chosen = refit_options_for(options, out.input_vertices, out.mesh.vertex_count());
   const bool finished = out.contractions > 0 && out.stop_reason != StopReason::Cancelled;
   const bool refitted = refit && chosen.rounds > 0 && finished;
+  // The flips finish the refit's work: not where the refit was asked for and the reduction left it
+  // out (refit_by_reduction), so that such a run stays GH97's; alone (no refit asked), they run.
+  const bool flipped = flip && finished && (refitted || !refit);
   // The refit and the flips measure against the input's vertices (as points weighted by their
   // share of the area) and faces, in the points' frame.
   refit_detail::FitPoints points;
   core::SurfaceDistance surface;
-  if (refitted || (flip && finished)) {
+  if (refitted || flipped) {
     const unsigned threads = core::resolve_threads(options.threads);
     if (!consumed_indices) weights = refit_detail::vertex_areas(input, threads);
     points = refit_detail::FitPoints(input.positions, weights, threads);
@@ -215,7 +242,7 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
     out.refit_rms_after = fit.rms_after;
     out.refit_rounds = fit.rounds;
   }
-  if (flip && finished) {
+  if (flipped) {
     // Seam wedges and locked vertices keep their edges.
     std::vector<std::uint8_t> held = wedge_refit.on_seam;
     held.resize(out.mesh.vertex_count(), 0);

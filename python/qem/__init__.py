@@ -332,6 +332,7 @@ def _options(*, target_faces, target_ratio, target_vertices, max_error, max_erro
                          "so record=True cannot be combined with a refit; use qem.lod, which refits each level")
     o.refit_rounds, o.refit_points_per_vertex = rounds, points
     o.refit_by_reduction = refit == "light"  # as the command line's: it follows the reduction
+    o.flip_edges = rounds > 0  # as the command line's: the edge flips finish the refit
     return o
 
 
