@@ -112,12 +112,13 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
       ->check(CLI::Range(0.0, 1e6));
   sub->add_flag("--no-refit", a.no_refit,
                 "No refit, not even the default's light one: every vertex stays where GH97 placed it");
-  sub->add_flag("--flip-edges", a.flip_edges,
-                "After the run and the refit, flip the edges where the flip lowers the local Hausdorff "
-                "distance to the input without raising the local error: no vertex moves; borders, seams and "
-                "locked vertices keep their edges (docs/benchmarks.md, \"Edge flips\"). On by default with "
-                "the refit; this turns them on without it");
-  sub->add_flag("--no-flip-edges", a.no_flip_edges, "No edge flips after the run (see --flip-edges)");
+  sub->add_flag("--far-repair", a.far_repair,
+                "After the run and the refit, repair the places farthest from the input: flip an edge, or "
+                "move an interior vertex toward the input points far from it, where that lowers the local "
+                "Hausdorff distance without raising the local error; borders, seams and locked vertices "
+                "stay (docs/benchmarks.md, \"Far places\"). On by default with the refit; this turns it "
+                "on without it");
+  sub->add_flag("--no-far-repair", a.no_far_repair, "No repair of the far places after the run (see --far-repair)");
   sub->add_flag("--attribute-fit", a.attribute_fit,
                 "With attributes, after the run fit each vertex's values (off the seams) by least squares to "
                 "the input's attributes at the output's points closest to the input's faces, instead of "
@@ -195,8 +196,8 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
     opt.refit_points_per_vertex = kDefaultRefitSample;
     opt.refit_by_reduction = true;
   }
-  if (a.flip_edges && a.no_flip_edges) throw Error("--flip-edges cannot be combined with --no-flip-edges");
-  opt.flip_edges = flips_wanted(a, opt);
+  if (a.far_repair && a.no_far_repair) throw Error("--far-repair cannot be combined with --no-far-repair");
+  opt.far_repair = far_repair_wanted(a, opt);
   return opt;
 }
 
@@ -208,11 +209,11 @@ LoadOptions to_load_options(const AlgorithmArgs& a) {
   return load;
 }
 
-// The flips finish the refit's work (the far places its moves cannot take away): on with it
+// The repair finishes the refit's work (the far places its least-squares moves leave): on with it
 // unless asked otherwise, and not where the refit is left out (meshes with attributes, whose
-// values the flips would interpolate anew, unmeasured).
-bool flips_wanted(const AlgorithmArgs& a, const SimplifyOptions& options) {
-  return a.flip_edges || (options.refit_rounds > 0 && !a.no_flip_edges);
+// values a flip would interpolate anew: unmeasured).
+bool far_repair_wanted(const AlgorithmArgs& a, const SimplifyOptions& options) {
+  return a.far_repair || (options.refit_rounds > 0 && !a.no_far_repair);
 }
 
 unsigned attribute_refit_rounds(const AlgorithmArgs& a, const SimplifyOptions& options, const Mesh& mesh) {

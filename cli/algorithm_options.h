@@ -34,8 +34,8 @@ struct AlgorithmArgs {
   double refit_sample = 0;    // --refit-sample (implies --refit); 0 = every input vertex
   bool no_refit = false;      // --no-refit: not even the light refit of the default
   bool attribute_fit = false;  // --attribute-fit: values fitted to the input after the run
-  bool flip_edges = false;     // --flip-edges: flips even without the refit
-  bool no_flip_edges = false;  // --no-flip-edges: no flips, not even with the refit
+  bool far_repair = false;     // --far-repair: the far places repaired even without the refit
+  bool no_far_repair = false;  // --no-far-repair: not even with the refit
   std::vector<std::string> attribute_weights;  // --attribute-weight KIND=W, ...
   std::string seams = "strict";                // --seams strict|permissive
   std::vector<std::string> lock;               // --lock seams,borders
@@ -77,9 +77,9 @@ LoadOptions to_load_options(const AlgorithmArgs& args);
 /// scalars) only keeps the default's light refit: on the colour assets it lowered E by up to 50 %
 /// and raised the colour error by at most 3 %, and no row of the attribute table lost the goal.
 unsigned attribute_refit_rounds(const AlgorithmArgs& args, const SimplifyOptions& options, const Mesh& mesh);
-/// Whether the edge flips run (SimplifyOptions::flip_edges): asked for, or with the refit of
-/// `options` unless --no-flip-edges.
-bool flips_wanted(const AlgorithmArgs& args, const SimplifyOptions& options);
+/// Whether the far places are repaired (SimplifyOptions::far_repair): asked for, or with the refit of
+/// `options` unless --no-far-repair.
+bool far_repair_wanted(const AlgorithmArgs& args, const SimplifyOptions& options);
 /// The same for a glTF document, whose primitives carry normals or texture coordinates as a rule.
 unsigned attribute_refit_rounds(const AlgorithmArgs& args, const SimplifyOptions& options);
 

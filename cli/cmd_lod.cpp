@@ -131,7 +131,7 @@ int run_lod(const LodArgs& a) {
     opt.target_faces = 1;
     check_options(opt);
     opt.refit_rounds = attribute_refit_rounds(a.algorithm, opt);  // as `qem simplify` on a document
-    opt.flip_edges = flips_wanted(a.algorithm, opt);
+    opt.far_repair = far_repair_wanted(a.algorithm, opt);
     return run_lod_gltf(args, opt);
   }
   return run_lod_mesh(args);
@@ -154,7 +154,7 @@ int run_lod_mesh(const LodArgs& a) {
   const RefitOptions refit = refit_options_for(opt);
   const SimplifyOptions refit_as = opt;  // each level's refit follows its reduction (refit_levels)
   opt.refit_rounds = 0;
-  opt.flip_edges = false;  // the levels are the recorded contractions', flipped after their refit
+  opt.far_repair = false;  // the levels are the recorded contractions', repaired after their refit
   ContractionRecorder recorder;
   if (!a.faces.empty())
     opt.target_faces = *std::min_element(a.faces.begin(), a.faces.end());
@@ -184,7 +184,7 @@ int run_lod_mesh(const LodArgs& a) {
     // Refitted in the run, which holds its seams (simplify.cpp): the chain's refit below sees no wedges.
     level.refit_rounds = refit.rounds, level.refit_points_per_vertex = refit.points_per_vertex;
     level.refit_rounds = attribute_refit_rounds(a.algorithm, level, mesh);
-    level.flip_edges = flips_wanted(a.algorithm, level);
+    level.far_repair = far_repair_wanted(a.algorithm, level);
     SimplifyResult r = simplify(mesh, level);
     r.mesh.material_names = mesh.material_names, r.mesh.material_library = mesh.material_library;
     levels.push_back({std::move(r.mesh), target, r.contractions, r.max_error});

@@ -159,8 +159,8 @@ int run_simplify(const SimplifyArgs& a) {
         "--record cannot be combined with --refit: a record replays the contractions, and the refit "
         "moves every vertex after them, so `qem replay` could not give back what simplify wrote; "
         "use `qem lod --refit`, or `qem refit` on a replayed level");
-  // Nor flips (they too come after the contractions).
-  if (!a.record.empty()) opt.refit_rounds = 0, opt.flip_edges = false;
+  // Nor the repair of the far places (it too comes after the contractions).
+  if (!a.record.empty()) opt.refit_rounds = 0, opt.far_repair = false;
   opt.target_faces = a.faces.value_or(0);
   opt.target_ratio = a.ratio.value_or(0);
   opt.target_vertices = a.vertices.value_or(0);
@@ -174,7 +174,7 @@ int run_simplify(const SimplifyArgs& a) {
   // refit is left out for them as for any mesh with attributes; --refit asks for it.
   if (gltf_document) {
     opt.refit_rounds = attribute_refit_rounds(a.algorithm, opt);
-    opt.flip_edges = flips_wanted(a.algorithm, opt);
+    opt.far_repair = far_repair_wanted(a.algorithm, opt);
   }
   if (gltf_document) return run_simplify_gltf(a, opt);
   // An input too large for memory goes the out-of-core way (qem/out_of_core.h); others as before.
@@ -196,7 +196,7 @@ int run_simplify(const SimplifyArgs& a) {
   apply_lock_property(a.algorithm, a.input, mesh, lock, opt);
   if (!mesh.attributes.empty()) {
     opt.refit_rounds = attribute_refit_rounds(a.algorithm, opt, mesh);
-    opt.flip_edges = flips_wanted(a.algorithm, opt);
+    opt.far_repair = far_repair_wanted(a.algorithm, opt);
   }
   const double load_s = t_load.seconds();
   if (!a.record.empty() && !mesh.attributes.empty())
@@ -239,7 +239,7 @@ int run_simplify(const SimplifyArgs& a) {
         "\"rejected_topology\":%zu,\"rejected_inversion\":%zu,\"rejected_error\":%zu,\"rejected_component\":%zu,"
         "\"rejected_distance\":%zu,\"output_to_input_distance\":%s,"
         "\"in_components\":%zu,\"out_components\":%zu,\"pruned_components\":%zu,\"refit_rounds\":%zu,"
-        "\"refit_rms_before\":%s,\"refit_rms_after\":%s,\"edge_flips\":%zu,\"dropped_degenerate\":%zu,\"dropped_duplicate\":%zu,"
+        "\"refit_rms_before\":%s,\"refit_rms_after\":%s,\"edge_flips\":%zu,\"vertex_moves\":%zu,\"dropped_degenerate\":%zu,\"dropped_duplicate\":%zu,"
         "\"parts\":%u,\"split_s\":%s,\"parts_s\":%s,\"final_pass_s\":%s,\"parts_cpu_s\":%s,\"busiest_thread_cpu_s\":%s,\"stop\":\"%s\"}\n",
         in_faces, a.faces.value_or(0), r.mesh.face_count(), r.mesh.vertex_count(), json_number(load_s).c_str(),
         json_number(simplify_s).c_str(), json_number(simplify_cpu_s).c_str(), json_number(write_s).c_str(),
@@ -248,7 +248,7 @@ int run_simplify(const SimplifyArgs& a) {
         r.virtual_pairs, r.rejected_topology, r.rejected_inversion, r.rejected_error, r.rejected_component,
         r.rejected_distance, json_number(r.output_to_input_distance).c_str(),
         r.input_components, r.output_components, r.pruned_components, r.refit_rounds,
-        json_number(r.refit_rms_before).c_str(), json_number(r.refit_rms_after).c_str(), r.edge_flips,
+        json_number(r.refit_rms_before).c_str(), json_number(r.refit_rms_after).c_str(), r.edge_flips, r.vertex_moves,
         r.dropped_degenerate_faces, r.dropped_duplicate_faces, parts,
         json_number(partition_report.split_seconds).c_str(), json_number(partition_report.parts_seconds).c_str(),
         json_number(partition_report.final_seconds).c_str(), json_number(partition_report.parts_cpu_seconds).c_str(),

@@ -215,7 +215,7 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
         o.max_error = local_error(world_max_error, info[jobs[j]].world_scale);
         o.max_error_is_relative = false;
         o.refit_rounds = 0;  // the curve is the contractions'; the final run refits
-        o.flip_edges = false;  // and flips
+        o.far_repair = false;  // and repairs
         o.threads = inner_threads;
         curves[j].stop_reason = simplify(meshes[j], o, &curves[j]).stop_reason;
       };

@@ -9,7 +9,7 @@
 #include <span>
 
 #include "core/distance_bound.h"
-#include "core/edge_flips.h"
+#include "core/far_repair.h"
 #include "core/parallel_chunks.h"
 #include "core/run.h"
 #include "core/settings.h"
@@ -65,8 +65,8 @@ void refit_levels(MeshView original, std::span<ReplayLevel> levels, const Simpli
     same->second.push_back(&level.mesh);
   }
   for (auto& [refit_options, meshes] : groups) qem::refit(original, meshes, refit_options);
-  if (!options.flip_edges || groups.empty()) return;
-  // Then the flips, as simplify makes them after its refit (the refitted levels only).
+  if (!options.far_repair || groups.empty() || std::isfinite(options.max_distance)) return;
+  // Then the repair of the far places, as simplify makes it after its refit (the refitted levels only).
   const unsigned threads = core::resolve_threads(options.threads);
   const std::vector<double> weights = refit_detail::vertex_areas(original, threads);
   const refit_detail::FitPoints points(original.positions, weights, threads);
@@ -77,17 +77,17 @@ void refit_levels(MeshView original, std::span<ReplayLevel> levels, const Simpli
   for (std::size_t v = 0; v < options.vertex_lock.size(); ++v)
     if (options.vertex_lock[v]) locked.push_back({original.positions[3 * v], original.positions[3 * v + 1], original.positions[3 * v + 2]});
   std::sort(locked.begin(), locked.end());
-  core::EdgeFlipOptions flip_options;
-  flip_options.max_normal_turn_degrees = options.max_normal_turn_degrees;
-  flip_options.threads = threads;
+  core::FarRepairOptions repair_options;
+  repair_options.max_normal_turn_degrees = options.max_normal_turn_degrees;
+  repair_options.threads = threads;
   for (auto& [refit_options, meshes] : groups)
     for (Mesh* mesh : meshes) {
       std::vector<std::uint8_t> held(locked.empty() ? 0 : mesh->vertex_count(), 0);
       for (std::size_t v = 0; v < held.size(); ++v)
         held[v] = std::binary_search(locked.begin(), locked.end(),
                                      std::array<double, 3>{mesh->positions[3 * v], mesh->positions[3 * v + 1], mesh->positions[3 * v + 2]});
-      flip_options.held = held;
-      core::flip_far_edges(*mesh, points.frame(), surface, points.position, points.weight, flip_options);
+      repair_options.held = held;
+      core::repair_far_places(*mesh, points.frame(), surface, points.position, points.weight, repair_options);
     }
 }
 
@@ -193,12 +193,12 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
   hooks.consumed_indices = consumed_indices;
   hooks.consumed_attributes = consumed_attributes;
   hooks.map_input_vertices = refit || fit_values;
-  core::WedgeRefitData wedge_refit;  // with attributes, for the refit, the attribute fit and the flips
-  const bool flip = options.flip_edges;
-  if ((refit || fit_values || flip) && !input.attributes.empty()) hooks.wedge_refit = &wedge_refit;
-  if (refit || bounded || fit_values || flip)
+  core::WedgeRefitData wedge_refit;  // with attributes, for the refit, the attribute fit and the repair
+  const bool repair = options.far_repair;
+  if ((refit || fit_values || repair) && !input.attributes.empty()) hooks.wedge_refit = &wedge_refit;
+  if (refit || bounded || fit_values || repair)
     hooks.before_release = [&](MeshView in) {
-      if (refit || flip) weights = refit_detail::vertex_areas(in, core::resolve_threads(options.threads));
+      if (refit || repair) weights = refit_detail::vertex_areas(in, core::resolve_threads(options.threads));
       kept_indices.assign(in.indices.begin(), in.indices.end());
     };
   SimplifyResult out = core::run(input, options, hooks);
@@ -211,14 +211,15 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
   const RefitOptions chosen = refit_options_for(options, out.input_vertices, out.mesh.vertex_count());
   const bool finished = out.contractions > 0 && out.stop_reason != StopReason::Cancelled;
   const bool refitted = refit && chosen.rounds > 0 && finished;
-  // The flips finish the refit's work: not where the refit was asked for and the reduction left it
+  // The repair finishes the refit's work: not where the refit was asked for and the reduction left it
   // out (refit_by_reduction), so that such a run stays GH97's; alone (no refit asked), they run.
-  const bool flipped = flip && finished && (refitted || !refit);
-  // The refit and the flips measure against the input's vertices (as points weighted by their
+  // Nor under a distance bound, which the repair's samples do not certify.
+  const bool repaired = repair && finished && (refitted || !refit) && !bounded;
+  // The refit and the repair measure against the input's vertices (as points weighted by their
   // share of the area) and faces, in the points' frame.
   refit_detail::FitPoints points;
   core::SurfaceDistance surface;
-  if (refitted || flipped) {
+  if (refitted || repaired) {
     const unsigned threads = core::resolve_threads(options.threads);
     if (!consumed_indices) weights = refit_detail::vertex_areas(input, threads);
     points = refit_detail::FitPoints(input.positions, weights, threads);
@@ -242,18 +243,19 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
     out.refit_rms_after = fit.rms_after;
     out.refit_rounds = fit.rounds;
   }
-  if (flipped) {
+  if (repaired) {
     // Seam wedges and locked vertices keep their edges.
     std::vector<std::uint8_t> held = wedge_refit.on_seam;
     held.resize(out.mesh.vertex_count(), 0);
     for (std::size_t v = 0; v < fixed.size(); ++v) held[v] |= fixed[v];
-    core::EdgeFlipOptions flip_options;
-    flip_options.held = held;
-    flip_options.max_normal_turn_degrees = options.max_normal_turn_degrees;
-    flip_options.threads = core::resolve_threads(options.threads);
-    const core::EdgeFlipResult flipped =
-        core::flip_far_edges(out.mesh, points.frame(), surface, points.position, points.weight, flip_options);
-    out.edge_flips = flipped.flips;
+    core::FarRepairOptions repair_options;
+    repair_options.held = held;
+    repair_options.max_normal_turn_degrees = options.max_normal_turn_degrees;
+    repair_options.threads = core::resolve_threads(options.threads);
+    const core::FarRepairResult made =
+        core::repair_far_places(out.mesh, points.frame(), surface, points.position, points.weight, repair_options);
+    out.edge_flips = made.flips;
+    out.vertex_moves = made.moves;
   }
   if (fit_values && out.contractions > 0 && out.stop_reason != StopReason::Cancelled) {
     // After the refit: the values fit the final positions. Seam and locked vertices keep theirs.

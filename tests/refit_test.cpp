@@ -443,14 +443,14 @@ TEST(Refit, CliSimplifyRefitEqualsRefitCommandAndLodLevel) {
   EXPECT_FALSE(fitted.empty());
   EXPECT_NE(fitted, slurp(dir + "/plain.obj"));
   // qem refit moves vertices only: simplify's flips after its refit are left out to compare.
-  ASSERT_EQ(run("simplify " + in + " " + dir + "/unflipped.obj --faces 500 --refit --no-flip-edges"), 0);
+  ASSERT_EQ(run("simplify " + in + " " + dir + "/unflipped.obj --faces 500 --refit --no-far-repair"), 0);
   EXPECT_NE(fitted, slurp(dir + "/unflipped.obj"));  // (the flips did something here)
   EXPECT_TRUE(slurp(dir + "/unflipped.obj") == slurp(dir + "/refitted.obj"))
       << "qem refit --lock-border differs from simplify --refit";
   ASSERT_EQ(run("simplify " + in + " " + dir + "/exact.obj --faces 500 --refit --exact-borders"), 0);
   EXPECT_TRUE(slurp(dir + "/exact.obj") == fitted) << "--exact-borders is not the default";
   // With GH97's penalty borders the refit moves border vertices too: qem refit without --lock-border.
-  ASSERT_EQ(run("simplify " + in + " " + dir + "/penalty.obj --faces 500 --refit --penalty-borders --no-flip-edges"), 0);
+  ASSERT_EQ(run("simplify " + in + " " + dir + "/penalty.obj --faces 500 --refit --penalty-borders --no-far-repair"), 0);
   ASSERT_EQ(run("simplify " + in + " " + dir + "/penalty_plain.obj --faces 500 --no-refit --penalty-borders"), 0);
   ASSERT_EQ(run("refit " + in + " " + dir + "/penalty_plain.obj " + dir + "/penalty_refitted.obj"), 0);
   EXPECT_NE(slurp(dir + "/penalty.obj"), fitted);
@@ -486,7 +486,7 @@ TEST(Refit, CliSampledRefitIsTheSameInSimplifyRefitAndLod) {
   EXPECT_FALSE(sampled.empty());
   EXPECT_NE(sampled, slurp(dir + "/full.obj"));
   EXPECT_NE(sampled, slurp(dir + "/plain.obj"));
-  ASSERT_EQ(run("simplify " + in + " " + dir + "/unflipped.obj --faces 400 --refit-sample 3 --no-flip-edges"), 0);
+  ASSERT_EQ(run("simplify " + in + " " + dir + "/unflipped.obj --faces 400 --refit-sample 3 --no-far-repair"), 0);
   EXPECT_TRUE(slurp(dir + "/unflipped.obj") == slurp(dir + "/refitted.obj")) << "qem refit --sample differs from simplify";
   EXPECT_TRUE(sampled == slurp(dir + "/lod/in_lod0.obj")) << "lod --refit-sample differs from simplify";
   EXPECT_NE(run("simplify " + in + " " + dir + "/neg.obj --faces 400 --refit-sample -1 2>/dev/null"), 0);

@@ -203,13 +203,14 @@ struct SimplifyOptions {
   /// for only a few of them (at half the faces the refit raised E by 13-22 %; docs/benchmarks.md,
   /// "Refit variants").
   bool refit_by_reduction = false;
-  /// After the last contraction and the refit, flip the output edges whose flip lowers the local
-  /// Hausdorff distance to the input without raising the local share of E (core/edge_flips.h;
-  /// Hoppe et al. 1993 §4.3's edge swap): no vertex moves, the face count and the topology stay.
-  /// Borders, seams, locked vertices and material boundaries are left as they are. As with the
-  /// refit, an observer's contractions are those made before it. The command line's --flip-edges
-  /// (what it costs and gains: docs/benchmarks.md, "Edge flips").
-  bool flip_edges = false;
+  /// After the last contraction and the refit, repair the places farthest from the input
+  /// (core/far_repair.h): flip an edge (Hoppe et al. 1993 §4.3's edge swap) or move an interior
+  /// vertex toward the input points far from it, where that lowers the local Hausdorff distance
+  /// without raising the local share of E. The face count and the topology stay; borders, seams,
+  /// locked vertices and material boundaries are left as they are. As with the refit, an
+  /// observer's contractions are those made before it. The command line's default, with its refit
+  /// (what it costs and gains: docs/benchmarks.md, "Far places").
+  bool far_repair = false;
 
   /// With attributes (MeshView::attributes), their weights in the error.
   AttributeWeights attribute_weights;
@@ -252,8 +253,9 @@ struct SimplifyResult {
   /// those it sampled) to the output, before and after it (model units), and the rounds it kept.
   double refit_rms_before = 0, refit_rms_after = 0;
   std::size_t refit_rounds = 0;
-  /// With flip_edges: the edges flipped (each output face keeps its face_source and material).
-  std::size_t edge_flips = 0;
+  /// With far_repair: the edges flipped (each output face keeps its face_source and material) and
+  /// the vertices moved.
+  std::size_t edge_flips = 0, vertex_moves = 0;
   /// Input faces left out: degenerate (a repeated corner) and duplicates (kept once).
   std::size_t dropped_degenerate_faces = 0, dropped_duplicate_faces = 0;
 

@@ -149,7 +149,7 @@ class SimplifyResult(Mesh):
       "input already at or below target" or "cancelled" (the CLI's --json "stop");
       stop_detail: a sentence saying why.
     contractions, input_faces, input_vertices, refit_rounds, refit_rms_before, refit_rms_after,
-      edge_flips, dropped_degenerate_faces, dropped_duplicate_faces: counts as in qem::SimplifyResult.
+      edge_flips, vertex_moves, dropped_degenerate_faces, dropped_duplicate_faces: counts as in qem::SimplifyResult.
     input_components, output_components: connected components of the input and the output
       (vertex-connected); pruned_components: removed by `prune`; rejected_component: contractions
       refused because a component would have dropped below its floor (keep_components).
@@ -166,7 +166,7 @@ class SimplifyResult(Mesh):
 
     __slots__ = (
         "max_error", "max_error_relative", "stop_reason", "stop_detail", "contractions", "input_faces",
-        "input_vertices", "refit_rounds", "refit_rms_before", "refit_rms_after", "edge_flips", "dropped_degenerate_faces",
+        "input_vertices", "refit_rounds", "refit_rms_before", "refit_rms_after", "edge_flips", "vertex_moves", "dropped_degenerate_faces",
         "dropped_duplicate_faces", "rejected_component", "input_components", "output_components",
         "pruned_components", "output_to_input_distance", "output_to_input_distance_relative",
         "rejected_distance", "vertex_source", "face_source", "output_vertex_of_input", "record",
@@ -332,7 +332,7 @@ def _options(*, target_faces, target_ratio, target_vertices, max_error, max_erro
                          "so record=True cannot be combined with a refit; use qem.lod, which refits each level")
     o.refit_rounds, o.refit_points_per_vertex = rounds, points
     o.refit_by_reduction = refit == "light"  # as the command line's: it follows the reduction
-    o.flip_edges = rounds > 0  # as the command line's: the edge flips finish the refit
+    o.far_repair = rounds > 0  # as the command line's: the repair of the far places finishes the refit
     return o
 
 
@@ -346,7 +346,7 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
              refit="light", threads: int = 0, keep_components: bool = True, prune: Optional[float] = None,
              prune_relative: Optional[float] = None, exact_border: bool = True, attributes: Optional[dict] = None,
              attribute_weights: Optional[dict] = None, fit_attributes: bool = False, vertex_lock=None,
-             return_mapping: bool = False, flip_edges: Optional[bool] = None,
+             return_mapping: bool = False, far_repair: Optional[bool] = None,
              record: bool = False, progress: Optional[Callable[[float], Optional[bool]]] = None) -> SimplifyResult:
     """Simplifies a triangle mesh by quadric-error pair contraction (Garland & Heckbert 1997).
 
@@ -385,9 +385,9 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
         or none at mild reductions, only with optimal placement, without record and without texture
         coordinates or normals), "full" (3 rounds, every vertex), "none", or
         (rounds, points_per_vertex).
-      flip_edges: after the refit, flip the edges whose flip lowers the local Hausdorff distance to
-        the input without raising the local error (no vertex moves); None (default): with the refit,
-        as the command line.
+      far_repair: after the refit, flip edges and move interior vertices where that lowers the local
+        Hausdorff distance to the input without raising the local error (borders and seams stay);
+        None (default): with the refit, as the command line.
       threads: threads for the parallel parts (0 = all cores); the result is the same for any count.
       keep_components: every connected part keeps at least one face (a closed one four); False lets
         a part contract to nothing (GH97 as published).
@@ -439,10 +439,10 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
     attribute_list = _attribute_list(attributes)
     if refit == "light" and any(kind in ("texcoord", "normal") for _, kind, _ in attribute_list):
         options.refit_rounds = 0
-    if record and flip_edges:
-        raise ValueError("flip_edges: a record replays the contractions, and the flips change faces after them, "
-                         "so record=True cannot be combined with flip_edges=True")
-    options.flip_edges = options.refit_rounds > 0 if flip_edges is None else bool(flip_edges)
+    if record and far_repair:
+        raise ValueError("far_repair: a record replays the contractions, and the repair changes the mesh after them, "
+                         "so record=True cannot be combined with far_repair=True")
+    options.far_repair = options.refit_rounds > 0 if far_repair is None else bool(far_repair)
     options.map_input_vertices = bool(return_mapping)
     options.fit_attributes = bool(fit_attributes)
     if attribute_weights is not None:

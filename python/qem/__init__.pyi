@@ -64,6 +64,7 @@ class SimplifyResult(Mesh):
     refit_rms_before: float
     refit_rms_after: float
     edge_flips: int
+    vertex_moves: int
     dropped_degenerate_faces: int
     dropped_duplicate_faces: int
     rejected_component: int
@@ -159,7 +160,7 @@ def simplify(
     fit_attributes: bool = ...,
     vertex_lock: Optional[npt.ArrayLike] = ...,
     return_mapping: bool = ...,
-    flip_edges: Optional[bool] = ...,
+    far_repair: Optional[bool] = ...,
     record: bool = ...,
     progress: Optional[Callable[[float], Optional[bool]]] = ...,
 ) -> SimplifyResult: ...

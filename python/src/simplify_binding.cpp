@@ -155,7 +155,7 @@ void bind_simplify(py::module_& m) {
       .def_readwrite("refit_rounds", &SimplifyOptions::refit_rounds)
       .def_readwrite("refit_points_per_vertex", &SimplifyOptions::refit_points_per_vertex)
       .def_readwrite("refit_by_reduction", &SimplifyOptions::refit_by_reduction)
-      .def_readwrite("flip_edges", &SimplifyOptions::flip_edges)
+      .def_readwrite("far_repair", &SimplifyOptions::far_repair)
       .def_readwrite("fit_attributes", &SimplifyOptions::fit_attributes)
       .def_readwrite("map_input_vertices", &SimplifyOptions::map_input_vertices)
       .def_property(
@@ -266,6 +266,7 @@ void bind_simplify(py::module_& m) {
         out["refit_rms_before"] = r.refit_rms_before;
         out["refit_rms_after"] = r.refit_rms_after;
         out["edge_flips"] = r.edge_flips;
+        out["vertex_moves"] = r.vertex_moves;
         out["dropped_degenerate_faces"] = r.dropped_degenerate_faces;
         out["dropped_duplicate_faces"] = r.dropped_duplicate_faces;
         out["vertex_source"] = take_indices(std::move(r.vertex_source), 1, p.data.size() / 3);

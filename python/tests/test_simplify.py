@@ -211,12 +211,12 @@ def test_components_and_target_zero():
 def test_edge_flips_follow_the_refit(small_torus):
     # On by default with the light refit (as the command line), off without it or when asked;
     # they change faces only, never a vertex.
-    kept = qem.simplify(*small_torus, target_faces=200, flip_edges=False)
+    kept = qem.simplify(*small_torus, target_faces=200, far_repair=False)
     flipped = qem.simplify(*small_torus, target_faces=200)
     assert kept.edge_flips == 0 and flipped.edge_flips > 0
     np.testing.assert_array_equal(kept.vertices, flipped.vertices)
     assert len(kept.faces) == len(flipped.faces)
     assert qem.simplify(*small_torus, target_faces=200, refit="none").edge_flips == 0
-    assert qem.simplify(*small_torus, target_faces=200, refit="none", flip_edges=True).edge_flips > 0
-    with pytest.raises(ValueError, match="flip_edges"):
-        qem.simplify(*small_torus, target_faces=200, record=True, flip_edges=True)
+    assert qem.simplify(*small_torus, target_faces=200, refit="none", far_repair=True).edge_flips > 0
+    with pytest.raises(ValueError, match="far_repair"):
+        qem.simplify(*small_torus, target_faces=200, record=True, far_repair=True)

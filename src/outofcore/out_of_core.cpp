@@ -655,7 +655,7 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
   const SimplifyOptions phase2_options = [&] {
     SimplifyOptions o = options;
     if (refit_to_input) o.refit_rounds = 0;
-    o.flip_edges = false;  // not measured out of core (docs/benchmarks.md, "Edge flips")
+    o.far_repair = false;  // not measured out of core (docs/benchmarks.md, "Far places")
     return o;
   }();
   const unsigned parts = ooc.parts ? ooc.parts

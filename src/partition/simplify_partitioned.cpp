@@ -12,7 +12,7 @@
 #include <thread>
 
 #include "analysis/disjoint_sets.h"
-#include "core/edge_flips.h"
+#include "core/far_repair.h"
 #include "core/parallel_chunks.h"
 #include "partition/partition_targets.h"
 #include "qem/error.h"
@@ -85,7 +85,7 @@ MeshPartResult simplify_part(const MeshPart& part, const SimplifyOptions& option
   o.target_vertices = part.target_vertices;
   o.vertex_lock = part.locked;
   o.refit_rounds = 0;  // the refit fits the final result to the whole input
-  o.flip_edges = false;  // the flips are made at the end, against the whole input
+  o.far_repair = false;  // the far places are repaired at the end, against the whole input
   o.map_input_vertices = true;
   SimplifyResult r = simplify(MeshView(part.mesh), o);
   MeshPartResult out;
@@ -157,7 +157,7 @@ SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options
   o.target_ratio = 0;
   o.target_vertices = total.vertices;
   o.refit_rounds = 0;
-  o.flip_edges = false;
+  o.far_repair = false;
   o.map_input_vertices = true;
   std::vector<std::uint8_t> lock;
   if (!options.vertex_lock.empty()) {
@@ -222,13 +222,14 @@ SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options
     result.refit_rms_before = fit.rms_before;
     result.refit_rms_after = fit.rms_after;
     result.refit_rounds = fit.rounds;
-    if (options.flip_edges) {  // after the refit, against the whole input, as simplify's
-      core::EdgeFlipOptions flip_options;
-      flip_options.held = fixed;
-      flip_options.max_normal_turn_degrees = options.max_normal_turn_degrees;
-      flip_options.threads = core::resolve_threads(options.threads);
-      result.edge_flips =
-          core::flip_far_edges(result.mesh, points.frame(), surface, points.position, points.weight, flip_options).flips;
+    if (options.far_repair) {  // after the refit, against the whole input, as simplify's
+      core::FarRepairOptions repair_options;
+      repair_options.held = fixed;
+      repair_options.max_normal_turn_degrees = options.max_normal_turn_degrees;
+      repair_options.threads = core::resolve_threads(options.threads);
+      const core::FarRepairResult made =
+          core::repair_far_places(result.mesh, points.frame(), surface, points.position, points.weight, repair_options);
+      result.edge_flips = made.flips, result.vertex_moves = made.moves;
     }
   }
   if (options.map_input_vertices) result.output_vertex_of_input = std::move(went);

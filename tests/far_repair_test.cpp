@@ -1,9 +1,10 @@
-// Tests of the edge flips after the run (core/edge_flips.h, SimplifyOptions::flip_edges): an edge
-// across a groove is flipped onto it, an edge that already lies on the input is left, held
-// vertices keep their edges, and on real simplifications the flips never fold a face, never make
-// an edge non-manifold or change the topology, move no vertex and do not raise the largest
-// distance to the input.
-#include "core/edge_flips.h"
+// Tests of the repair of the far places after the run (core/far_repair.h,
+// SimplifyOptions::far_repair): an edge across a groove is flipped onto it, an edge that already
+// lies on the input is left, held vertices keep their edges and positions, a vertex under a
+// cut-off bump moves onto it, and on real simplifications the repair never folds a face, never
+// makes an edge non-manifold or changes the topology, moves no border vertex and does not raise
+// the largest distance to the input.
+#include "core/far_repair.h"
 
 #include <gtest/gtest.h>
 
@@ -11,6 +12,7 @@
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <set>
 #include <vector>
 
 #include "core/distance_bound.h"
@@ -66,10 +68,10 @@ bool has_edge(const Mesh& m, std::uint32_t a, std::uint32_t b) {
   return test::edge_face_counts(m).count(std::minmax(a, b)) > 0;
 }
 
-core::EdgeFlipResult flip(Mesh& approx, const Mesh& input, const core::EdgeFlipOptions& options = {}) {
+core::FarRepairResult flip(Mesh& approx, const Mesh& input, const core::FarRepairOptions& options = {}) {
   const core::SurfaceDistance surface(corners_of(input));
   const std::vector<double> w = areas_of(input);
-  return core::flip_far_edges(approx, Frame{}, surface, input.positions, w, options);
+  return core::repair_far_places(approx, Frame{}, surface, input.positions, w, options);
 }
 
 // A V-shaped groove: banks a, b at z = 0, its floor from d to c at z = -0.05 (a crease of 28
@@ -85,11 +87,11 @@ struct Groove {
   }
 };
 
-TEST(EdgeFlips, AnEdgeAcrossAGrooveIsFlippedOntoItsFloor) {
+TEST(FarRepair, AnEdgeAcrossAGrooveIsFlippedOntoItsFloor) {
   Groove g;
   const core::SurfaceDistance surface(corners_of(g.input));
   ASSERT_GT(largest_distance(g.approx, surface), 0.04);  // the middle of a-b, above the floor
-  const core::EdgeFlipResult r = flip(g.approx, g.input);
+  const core::FarRepairResult r = flip(g.approx, g.input);
   EXPECT_EQ(r.flips, 1u);
   EXPECT_TRUE(has_edge(g.approx, 2, 3));
   EXPECT_FALSE(has_edge(g.approx, 0, 1));
@@ -98,20 +100,20 @@ TEST(EdgeFlips, AnEdgeAcrossAGrooveIsFlippedOntoItsFloor) {
   EXPECT_EQ(test::validity_problem(g.approx), "");
 }
 
-TEST(EdgeFlips, AnEdgeOnTheInputStays) {
+TEST(FarRepair, AnEdgeOnTheInputStays) {
   Groove g;
   Mesh approx = g.input;  // already the groove's own triangulation
-  const core::EdgeFlipResult r = flip(approx, g.input);
+  const core::FarRepairResult r = flip(approx, g.input);
   EXPECT_EQ(r.flips, 0u);
   EXPECT_EQ(approx.indices, g.input.indices);
 }
 
-TEST(EdgeFlips, HeldVerticesAndMaterialBoundariesKeepTheirEdges) {
+TEST(FarRepair, HeldVerticesAndMaterialBoundariesKeepTheirEdges) {
   for (int held = 0; held < 4; ++held) {
     Groove g;
     std::vector<std::uint8_t> mask(4, 0);
     mask[held] = 1;
-    core::EdgeFlipOptions o;
+    core::FarRepairOptions o;
     o.held = mask;
     const std::vector<std::uint32_t> before = g.approx.indices;
     EXPECT_EQ(flip(g.approx, g.input, o).flips, 0u) << "held vertex " << held;
@@ -122,7 +124,7 @@ TEST(EdgeFlips, HeldVerticesAndMaterialBoundariesKeepTheirEdges) {
   EXPECT_EQ(flip(g.approx, g.input).flips, 0u);
 }
 
-TEST(EdgeFlips, NoFlipThatFoldsOrDuplicatesAnEdge) {
+TEST(FarRepair, NoFlipThatFoldsOrDuplicatesAnEdge) {
   // Seen from above, b inside the triangle a, c, d: the new face (b,c,d) would face down, even
   // though it lies on the input.
   Groove g;
@@ -153,6 +155,12 @@ std::map<std::pair<std::uint32_t, std::uint32_t>, int> directed_counts(const Mes
     for (int k = 0; k < 3; ++k) ++c[{m.indices[3 * f + k], m.indices[3 * f + (k + 1) % 3]}];
   return c;
 }
+std::set<std::uint32_t> border_vertices(const Mesh& m) {
+  std::set<std::uint32_t> border;
+  for (const auto& [e, n] : test::edge_face_counts(m))
+    if (n == 1) border.insert(e.first), border.insert(e.second);
+  return border;
+}
 std::size_t folded_edges(const Mesh& m) {
   std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<Vec3>> normals;
   for (std::size_t f = 0; f < m.face_count(); ++f) {
@@ -169,7 +177,7 @@ std::size_t folded_edges(const Mesh& m) {
   return folds;
 }
 
-TEST(EdgeFlips, SimplifyFlipsWithoutFoldsTopologyChangesOrFartherPoints) {
+TEST(FarRepair, SimplifyFlipsWithoutFoldsTopologyChangesOrFartherPoints) {
   struct Case {
     Mesh input;
     std::size_t faces;
@@ -177,20 +185,25 @@ TEST(EdgeFlips, SimplifyFlipsWithoutFoldsTopologyChangesOrFartherPoints) {
   // (The bumpy sphere and the creased field at 1000 faces each have edges a flip brings closer.)
   const Case cases[] = {{test::height_field(60, creased), 1000}, {test::height_field(60, creased), 60},
                         {outofcore::bumpy_sphere(5000), 500}, {outofcore::bumpy_sphere(5000), 100}};
-  std::size_t total_flips = 0;
+  std::size_t total_flips = 0, total_moves = 0;
   for (const Case& c : cases) {
     SimplifyOptions o;
     o.target_faces = c.faces;
     o.refit_rounds = 2;
     o.threads = 1;
     const SimplifyResult plain = simplify(c.input, o);
-    o.flip_edges = true;
+    o.far_repair = true;
     const SimplifyResult flipped = simplify(c.input, o);
     total_flips += flipped.edge_flips;
     const Mesh &a = plain.mesh, &b = flipped.mesh;
-    EXPECT_EQ(plain.edge_flips, 0u);
+    EXPECT_EQ(plain.edge_flips + plain.vertex_moves, 0u);
+    total_moves += flipped.vertex_moves;
     ASSERT_EQ(test::validity_problem(b), "");
-    EXPECT_EQ(a.positions, b.positions);  // no vertex moved
+    // Only interior vertices moved: the border's stay where they were.
+    ASSERT_EQ(a.positions.size(), b.positions.size());
+    const std::set<std::uint32_t> border = border_vertices(a);
+    for (std::uint32_t v : border)
+      for (int k = 0; k < 3; ++k) EXPECT_EQ(a.positions[3 * v + k], b.positions[3 * v + k]);
     EXPECT_EQ(a.face_count(), b.face_count());
     EXPECT_EQ(test::non_manifold_edges(b), 0u);
     EXPECT_EQ(test::boundary_edges(a), test::boundary_edges(b));
@@ -204,6 +217,35 @@ TEST(EdgeFlips, SimplifyFlipsWithoutFoldsTopologyChangesOrFartherPoints) {
     EXPECT_EQ(simplify(c.input, o).mesh.indices, b.indices);
   }
   EXPECT_GT(total_flips, 0u);
+  EXPECT_GT(total_moves, 0u);
+}
+
+// A bump cut off: the input is a 5x5 grid with its middle vertex raised, the approximation the
+// same grid flat. The middle vertex moves up onto the bump's top; the border stays.
+TEST(FarRepair, AVertexUnderACutOffBumpMovesOntoIt) {
+  Mesh input = test::grid(4), approx = test::grid(4);
+  input.positions[3 * 12 + 2] = 0.1;  // vertex 12: (0.5, 0.5), the middle
+  const core::SurfaceDistance surface(corners_of(input));
+  ASSERT_GT(largest_distance(approx, surface), 0.05);
+  core::FarRepairOptions no_moves;
+  no_moves.move_vertices = false;
+  Mesh unmoved = approx;
+  EXPECT_EQ(flip(unmoved, input, no_moves).moves, 0u);
+  EXPECT_EQ(unmoved.positions, approx.positions);
+  const core::FarRepairResult r = flip(approx, input);
+  EXPECT_GE(r.moves, 1u);
+  EXPECT_NEAR(approx.positions[3 * 12 + 2], 0.1, 1e-12);
+  EXPECT_LT(largest_distance(approx, surface), 1e-9);
+  for (std::uint32_t v : border_vertices(approx))
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(approx.positions[3 * v + k], input.positions[3 * v + k]);
+  // Held, it stays.
+  Mesh held = test::grid(4);
+  std::vector<std::uint8_t> mask(held.vertex_count(), 0);
+  mask[12] = 1;
+  core::FarRepairOptions o;
+  o.held = mask;
+  flip(held, input, o);
+  EXPECT_EQ(held.positions[3 * 12 + 2], 0.0);
 }
 
 }  // namespace

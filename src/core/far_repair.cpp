@@ -1,4 +1,4 @@
-#include "core/edge_flips.h"
+#include "core/far_repair.h"
 
 #include <algorithm>
 #include <array>
@@ -50,8 +50,8 @@ struct FaceScore {
 class Flipper {
  public:
   Flipper(Mesh& approx, const Frame& frame, const SurfaceDistance& surface, std::span<const double> points,
-          std::span<const double> weights, const EdgeFlipOptions& options)
-      : mesh_(approx), surface_(surface), points_(points), weights_(weights), opt_(options),
+          std::span<const double> weights, const FarRepairOptions& options)
+      : mesh_(approx), frame_(frame), surface_(surface), points_(points), weights_(weights), opt_(options),
         cos_turn_(std::cos(options.max_normal_turn_degrees * std::numbers::pi / 180)),
         weight_scale_(1 / (frame.scale * frame.scale)) {
     const std::size_t n = approx.vertex_count();
@@ -78,8 +78,8 @@ class Flipper {
     scan_faces();
   }
 
-  EdgeFlipResult run() {
-    EdgeFlipResult r;
+  FarRepairResult run() {
+    FarRepairResult r;
     r.largest_before = largest_;
     // The first sweep tries every far face; each later one only the faces a flip of the sweep
     // before changed or bordered (elsewhere nothing changed, so no other flip became possible).
@@ -89,7 +89,13 @@ class Flipper {
       r.flips += flips;
       if (flips == 0) break;
     }
+    if (opt_.move_vertices) r.moves = move_vertices();
     mesh_.indices = tri_;
+    for (std::uint32_t v : moved_) {
+      const Vec3 p = frame_.to_model(x_[v]);
+      mesh_.positions[3 * std::size_t(v)] = p.x, mesh_.positions[3 * std::size_t(v) + 1] = p.y,
+                                 mesh_.positions[3 * std::size_t(v) + 2] = p.z;
+    }
     return r;
   }
 
@@ -310,6 +316,113 @@ class Flipper {
     return f2;
   }
 
+  // Whether v is interior: every edge at it has exactly one face on the other side (no border,
+  // no non-manifold edge), so a move keeps every border where it was.
+  bool interior(std::uint32_t v) const {
+    for (std::uint32_t f : faces_at_[v]) {
+      const std::uint32_t* t = &tri_[3 * f];
+      for (int k = 0; k < 3; ++k)
+        if (t[k] == v && (across(f, t[k], t[(k + 1) % 3]) == UINT32_MAX || across(f, t[(k + 2) % 3], t[k]) == UINT32_MAX))
+          return false;
+    }
+    return true;
+  }
+
+  // Tries to move v to y: made when the largest distance (both ways) over v's faces falls, their
+  // share of E does not rise, and no face turns by more than the limit.
+  bool try_move(std::uint32_t v, const Vec3& y) {
+    const std::vector<std::uint32_t>& fan = faces_at_[v];
+    double old_most = 0, old_energy = 0;
+    for (std::uint32_t f : fan) {
+      ensure_scored(f);
+      old_most = std::max(old_most, local(f));
+      old_energy += score_[f].energy;
+      for (std::uint32_t p : points_of_[f]) old_energy += weights_[p] * weight_scale_ * d2_[p];
+    }
+    const Vec3 x = x_[v];
+    std::vector<FaceScore> scores(fan.size());
+    for (std::size_t i = 0; i < fan.size(); ++i) {
+      const std::uint32_t* t = &tri_[3 * fan[i]];
+      const Vec3 n = normalized(normal(t[0], t[1], t[2]));
+      x_[v] = y;
+      const Vec3 m = normalized(normal(t[0], t[1], t[2]));
+      if (dot(m, m) == 0 || dot(n, m) < cos_turn_) return x_[v] = x, false;
+      scores[i] = score(x_[t[0]], x_[t[1]], x_[t[2]], score_[fan[i]].hint, old_most);
+      x_[v] = x;
+      if (scores[i].most >= old_most) return false;
+    }
+    // The fan's points, each to the nearest of the fan's faces after the move.
+    std::vector<std::uint32_t>& pts = scratch_points_;
+    pts.clear();
+    for (std::uint32_t f : fan) pts.insert(pts.end(), points_of_[f].begin(), points_of_[f].end());
+    x_[v] = y;
+    std::vector<std::uint32_t> nearest(pts.size());
+    double most2 = 0, energy = 0;
+    for (std::size_t i = 0; i < fan.size(); ++i) energy += scores[i].energy;
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      const Vec3 p = point(pts[i]);
+      double best = HUGE_VAL;
+      for (std::uint32_t f : fan) {
+        const std::uint32_t* t = &tri_[3 * f];
+        const double d2 = measure_detail::squared_distance(
+            p, measure_detail::closest_point_on_triangle(p, x_[t[0]], x_[t[1]], x_[t[2]]));
+        if (d2 < best) best = d2, nearest[i] = f;
+      }
+      most2 = std::max(most2, best);
+      energy += weights_[pts[i]] * weight_scale_ * best;
+      scratch_d2_.resize(pts.size());
+      scratch_d2_[i] = best;
+    }
+    if (std::sqrt(most2) >= old_most || energy > old_energy * (1 + opt_.error_margin)) return x_[v] = x, false;
+    for (std::size_t i = 0; i < fan.size(); ++i) score_[fan[i]] = scores[i], scored_[fan[i]] = 1, points_of_[fan[i]].clear();
+    for (std::size_t i = 0; i < pts.size(); ++i) d2_[pts[i]] = scratch_d2_[i], points_of_[nearest[i]].push_back(pts[i]);
+    for (std::uint32_t f : fan) near_most_[f] = nearest_most(f);
+    return true;
+  }
+
+  // GH97's placement and the refit can leave a small bump of the input cut off by one vertex (the
+  // bump's top far from the output next to that vertex): the input points at least from_fraction
+  // of the largest distance from the output, farthest first, pull the nearest corner of their
+  // face toward them (all the way, or half), where that lowers the local largest distance.
+  std::size_t move_vertices() {
+    std::vector<std::uint32_t> far;
+    const double from = opt_.from_fraction * largest_;
+    for (std::uint32_t p = 0; p < d2_.size(); ++p)
+      if (std::sqrt(d2_[p]) >= from) far.push_back(p);
+    std::sort(far.begin(), far.end(), [&](std::uint32_t a, std::uint32_t b) { return d2_[a] > d2_[b] || (d2_[a] == d2_[b] && a < b); });
+    std::vector<std::uint32_t> face_of(d2_.size(), UINT32_MAX);
+    for (std::uint32_t f = 0; f < face_count(); ++f)
+      for (std::uint32_t p : points_of_[f]) face_of[p] = f;
+    std::size_t moves = 0;
+    for (std::uint32_t p : far) {
+      const std::uint32_t f = face_of[p];
+      if (f == UINT32_MAX) continue;
+      const Vec3 q = point(p);
+      const std::uint32_t* t = &tri_[3 * f];
+      const Vec3 c = measure_detail::closest_point_on_triangle(q, x_[t[0]], x_[t[1]], x_[t[2]]);
+      // The corner nearest the closest point first.
+      std::array<std::uint32_t, 3> corners = {t[0], t[1], t[2]};
+      std::sort(corners.begin(), corners.end(), [&](std::uint32_t a, std::uint32_t b) {
+        const double da = measure_detail::squared_distance(c, x_[a]), db = measure_detail::squared_distance(c, x_[b]);
+        return da < db || (da == db && a < b);
+      });
+      bool made = false;
+      for (std::uint32_t v : corners) {
+        if (held(v) || !interior(v)) continue;
+        for (double step : {1.0, 0.5})
+          if (try_move(v, x_[v] + (q - c) * step)) {
+            made = true;
+            if (!std::binary_search(moved_.begin(), moved_.end(), v)) moved_.insert(std::lower_bound(moved_.begin(), moved_.end(), v), v);
+            break;
+          }
+        if (made) break;
+      }
+      for (std::uint32_t g = 0; made && g < face_count(); ++g) for (std::uint32_t r : points_of_[g]) face_of[r] = g;
+      moves += made;
+    }
+    return moves;
+  }
+
   // One sweep over the edges of the faces marked in `dirty` that are at least `from` from the
   // input (locally), in face order. Leaves in `dirty` the faces of this sweep's flips and their
   // neighbours.
@@ -340,9 +453,10 @@ class Flipper {
   }
 
   Mesh& mesh_;
+  const Frame frame_;
   const SurfaceDistance& surface_;
   std::span<const double> points_, weights_;
-  const EdgeFlipOptions& opt_;
+  const FarRepairOptions& opt_;
   const double cos_turn_;
   const double weight_scale_;  // model area to the frame's
   std::vector<Vec3> x_;                              // output positions in the frame
@@ -357,15 +471,16 @@ class Flipper {
   std::vector<std::vector<std::uint32_t>> points_of_;  // per face, the input points closest to it
   std::vector<double> near_most_;                    // per face, the largest of those points' distances
   std::vector<double> d2_;                           // per point, its squared distance to its face
+  std::vector<std::uint32_t> moved_;                 // vertices moved (ascending, once each)
   std::vector<std::uint32_t> scratch_points_;
   std::vector<double> scratch_d2_;
 };
 
 }  // namespace
 
-EdgeFlipResult flip_far_edges(Mesh& approx, const Frame& frame, const SurfaceDistance& surface,
+FarRepairResult repair_far_places(Mesh& approx, const Frame& frame, const SurfaceDistance& surface,
                               std::span<const double> points, std::span<const double> weights,
-                              const EdgeFlipOptions& options) {
+                              const FarRepairOptions& options) {
   if (approx.face_count() < 2 || surface.empty()) return {};
   return Flipper(approx, frame, surface, points, weights, options).run();
 }
