@@ -26,9 +26,14 @@ namespace qem {
 
 /// One part of a partitioned mesh, in its own vertex numbering.
 struct MeshPart {
-  Mesh mesh;  ///< positions and faces of the part only
-  /// Per part vertex: 1 = locked (shared with another part, or locked by the caller).
+  /// Positions and faces of the part only, with the input's attribute rows of its vertices and
+  /// the input's materials of its faces (indices into the input's material names).
+  Mesh mesh;
+  /// Per part vertex: 1 = locked (shared with another part, or locked by the caller). With
+  /// attributes a position is shared: every wedge at a position two parts use is locked.
   std::vector<std::uint8_t> locked;
+  /// Per part vertex (empty: the caller protects none): SimplifyOptions::vertex_protect.
+  std::vector<std::uint8_t> protect;
   std::vector<std::uint32_t> input_vertex;  ///< per part vertex: the input vertex it is
   std::vector<std::uint32_t> input_face;    ///< per part face: the input face it is
   /// This part's share of the target plus its locked vertices (the faces a locked cut keeps
