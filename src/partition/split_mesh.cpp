@@ -25,7 +25,9 @@ unsigned automatic_parts(std::size_t faces) {
   return parts;
 }
 
-std::string partition_refusal(MeshView input, const SimplifyOptions& o) {
+// The mesh no longer decides (its attributes and materials are carried); the signature keeps it for
+// the callers, which ask about a mesh and its options together.
+std::string partition_refusal(MeshView /*input*/, const SimplifyOptions& o) {
   if (std::isfinite(o.max_error))
     return "an error limit (--max-error) is measured against each part's quadrics, not the whole mesh's";
   if (std::isfinite(o.max_distance))
