@@ -215,6 +215,8 @@ int run_simplify(const SimplifyArgs& a) {
   SimplifyResult r = parts > 1            ? run_partitioned(mesh, opt, parts, show_progress, &partition_report)
                      : a.record.empty() ? simplify(std::move(mesh), opt, &watcher)
                                         : simplify(mesh, opt, &watcher);
+  // The partitioned run reads a view of the mesh, which has no material names: they stay the input's.
+  if (parts > 1) r.mesh.material_names = mesh.material_names, r.mesh.material_library = mesh.material_library;
   const double simplify_s = t_simplify.seconds();
   const double simplify_cpu_s = process_cpu_seconds() - cpu0;
   if (show_progress && parts <= 1) std::fprintf(stderr, "\n");

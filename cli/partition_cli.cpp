@@ -9,7 +9,7 @@ namespace qem::cli {
 void add_partition_option(CLI::App* sub, PartitionArgs& args) {
   sub->add_option("--partition", args.partition,
                   "Simplify part by part, the parts side by side on the threads: auto (default: from 1M faces, "
-                  "parts of at least 500k faces, a power of two up to 64; never for meshes with attributes, "
+                  "parts of at least 500k faces, a power of two up to 64; never for "
                   "--max-error, --max-distance, --threshold, --prune, a target of 0 or --record), off, or a number of parts. "
                   "Each part is simplified with the vertices it shares with others locked, then the parts are "
                   "welded and one pass over the whole reaches the target (docs/parallel.md). The output "

@@ -161,6 +161,12 @@ int run_root(const Args& a, int ranks) {
     cli::apply_lock_property(a.algorithm, a.input, mesh, lock, options);
     if (const std::string why = partition_refusal(mesh, options); !why.empty())
       throw Error(a.input + ": cannot simplify part by part: " + why);
+    // The parts go to the ranks as positions, faces and locks (send_part), which is all a mesh
+    // without attributes needs; the threaded run (qem simplify --partition) carries them.
+    if (!mesh.attributes.empty() || !mesh.face_materials.empty())
+      throw Error(a.input + ": qem-mpi sends the parts' positions and faces only, and this mesh has " +
+                  (mesh.attributes.empty() ? std::string("face materials") : "attributes (" + mesh.attributes.front().name + ", ...)") +
+                  "; simplify it with qem simplify --partition, or without them");
     // At least one part per rank, so that every rank has work.
     parts = a.parts > 0 ? a.parts : std::max(automatic_parts(mesh.face_count()), unsigned(ranks));
     MPI_Bcast(&parts, 1, MPI_UNSIGNED, 0, MPI_COMM_WORLD);

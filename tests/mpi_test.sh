@@ -41,4 +41,17 @@ if "$MPIEXEC" --oversubscribe --allow-run-as-root -np 2 "$BUILD/qem-mpi" "$DIR/b
 fi
 grep -q "qem-mpi: error: .*bad.ply" "$DIR/bad.err" || { echo "no clear error: $(cat "$DIR/bad.err")"; exit 1; }
 [ ! -e "$DIR/bad_out.ply" ] || { echo "an output was written for a broken input"; exit 1; }
+# A mesh with attributes: the parts travel as positions and faces, so qem-mpi says so (qem simplify
+# --partition carries them).
+/usr/bin/python3 - "$DIR/uv.obj" <<'PY'
+import sys
+with open(sys.argv[1], "w") as f:
+    f.write("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvt 0 0\nvt 1 0\nvt 0 1\n")
+    f.write("f 1/1 3/3 2/2\nf 1/1 2/2 4/3\nf 2/2 3/3 4/1\nf 3/3 1/1 4/2\n")
+PY
+if "$MPIEXEC" --oversubscribe --allow-run-as-root -np 2 "$BUILD/qem-mpi" "$DIR/uv.obj" "$DIR/uv_out.ply" \
+  --ratio 0.5 --quiet 2> "$DIR/uv.err"; then
+  echo "qem-mpi accepted a mesh with attributes"; exit 1
+fi
+grep -q "qem-mpi sends the parts' positions and faces only" "$DIR/uv.err" || { echo "no clear error: $(cat "$DIR/uv.err")"; exit 1; }
 echo "qem-mpi: 2 ranks, $in_faces -> $faces faces, closed, same bytes as the threads"

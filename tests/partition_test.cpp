@@ -188,12 +188,15 @@ TEST(Partition, TheCutLocksExactlyTheSharedVertices) {
     for (std::size_t l = 0; l < p.input_vertex.size(); ++l) EXPECT_EQ(p.locked[l] != 0, uses[p.input_vertex[l]] > 1);
 }
 
-TEST(Partition, RefusesWhatThePartsCannotCarry) {
+TEST(Partition, RefusesWhatThePartsCannotDo) {
   Mesh with_normals = test::icosphere(3);
   VertexAttribute normals{"NORMAL", AttributeKind::Normal, 3, with_normals.positions};
   with_normals.attributes.push_back(normals);
-  EXPECT_FALSE(partition_refusal(with_normals, ratio(0.1)).empty());
-  EXPECT_THROW(simplify_partitioned(with_normals, ratio(0.1), in_parts(2)), Error);
+  EXPECT_TRUE(partition_refusal(with_normals, ratio(0.1)).empty());  // the parts carry them (partition_attributes_test)
+  SimplifyOptions pruned = ratio(0.1);
+  pruned.prune_size = 0.01;  // judges whole components, which the cuts divide
+  EXPECT_FALSE(partition_refusal(with_normals, pruned).empty());
+  EXPECT_THROW(simplify_partitioned(with_normals, pruned, in_parts(2)), Error);
   SimplifyOptions limit;
   limit.max_error = 0.01;
   EXPECT_FALSE(partition_refusal(test::icosphere(3), limit).empty());

@@ -5,7 +5,8 @@
 // parts still meet vertex for vertex; the parts are welded on those vertices (exactly: they never
 // moved) and one in-core pass over the merged mesh, with the cut unlocked, reaches the target and
 // removes the dense strips the locks left along the cuts; the refit, if asked, fits the result to
-// the input as simplify's does.
+// the input as simplify's does. With attributes (wedges, qem/mesh.h) the same, the cut found by
+// position: every wedge at a position two parts use is locked (docs/parallel.md).
 //
 // The parts do not depend on the thread count, and each part's simplification gives the same bytes
 // on any thread count (qem/simplify.h), so the result depends on the number of parts only, never on
@@ -26,9 +27,14 @@ namespace qem {
 
 /// One part of a partitioned mesh, in its own vertex numbering.
 struct MeshPart {
-  Mesh mesh;  ///< positions and faces of the part only
-  /// Per part vertex: 1 = locked (shared with another part, or locked by the caller).
+  /// Positions and faces of the part only, with the input's attribute rows of its vertices and
+  /// the input's materials of its faces (indices into the input's material names).
+  Mesh mesh;
+  /// Per part vertex: 1 = locked (shared with another part, or locked by the caller). With
+  /// attributes a position is shared: every wedge at a position two parts use is locked.
   std::vector<std::uint8_t> locked;
+  /// Per part vertex (empty: the caller protects none): SimplifyOptions::vertex_protect.
+  std::vector<std::uint8_t> protect;
   std::vector<std::uint32_t> input_vertex;  ///< per part vertex: the input vertex it is
   std::vector<std::uint32_t> input_face;    ///< per part face: the input face it is
   /// This part's share of the target plus its locked vertices (the faces a locked cut keeps
@@ -84,8 +90,10 @@ struct PartitionReport {
 /// machine and any --threads.
 unsigned automatic_parts(std::size_t faces);
 
-/// Empty when `input` and `options` can be simplified part by part, else why not (attributes,
-/// materials, an error limit, a pair threshold, pruning, or no face or vertex target).
+/// Empty when `input` and `options` can be simplified part by part, else why not (an error limit,
+/// a distance bound, a pair threshold, pruning, a target of 0, or no face or vertex target).
+/// Attributes and face materials are carried (the parts have their rows, the cut is found by
+/// position so that no seam on it opens, the final pass and refit treat them as simplify does).
 std::string partition_refusal(MeshView input, const SimplifyOptions& options);
 
 /// Simplifies `input` in `partition.parts` parts (see the top of this file) to the target of

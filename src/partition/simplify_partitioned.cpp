@@ -14,11 +14,15 @@
 #include "analysis/disjoint_sets.h"
 #include "core/far_repair.h"
 #include "core/parallel_chunks.h"
+#include "core/run.h"
 #include "partition/partition_targets.h"
+#include "partition/same_position.h"
 #include "qem/error.h"
 #include "qem/partition.h"
+#include "refit/attribute_fit.h"
 #include "refit/refit_after_simplify.h"
 #include "refit/refit_points.h"
+#include "refit_with_seams.h"
 
 namespace qem {
 
@@ -29,12 +33,14 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 }
 
 // Connected components of the input (faces joined through shared vertices), as simplify counts
-// them on its input: union-find over the vertices of the non-degenerate faces.
-std::size_t count_input_components(MeshView input) {
+// them on its input: union-find over the vertices (with attributes, the positions: `point`, see
+// same_position.h; empty: the vertices) of the non-degenerate faces.
+std::size_t count_input_components(MeshView input, const std::vector<std::uint32_t>& point) {
   analysis::DisjointSets parts(input.vertex_count());
   std::vector<std::uint8_t> used(input.vertex_count(), 0);
+  const auto at = [&](std::uint32_t v) { return point.empty() ? v : point[v]; };
   for (std::size_t f = 0; f < input.face_count(); ++f) {
-    const std::uint32_t* t = &input.indices[3 * f];
+    const std::uint32_t t[3] = {at(input.indices[3 * f]), at(input.indices[3 * f + 1]), at(input.indices[3 * f + 2])};
     if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
     for (int k = 0; k < 3; ++k) used[t[k]] = 1;
     parts.unite(t[0], t[1]), parts.unite(t[0], t[2]);
@@ -84,8 +90,10 @@ MeshPartResult simplify_part(const MeshPart& part, const SimplifyOptions& option
   o.target_ratio = 0;
   o.target_vertices = part.target_vertices;
   o.vertex_lock = part.locked;
-  o.refit_rounds = 0;  // the refit fits the final result to the whole input
-  o.far_repair = false;  // the far places are repaired at the end, against the whole input
+  o.vertex_protect = part.protect;
+  o.refit_rounds = 0;         // the refit fits the final result to the whole input,
+  o.fit_attributes = false;  // and so does the attribute fit,
+  o.far_repair = false;      // and the far places are repaired there
   o.map_input_vertices = true;
   SimplifyResult r = simplify(MeshView(part.mesh), o);
   MeshPartResult out;
@@ -108,10 +116,17 @@ SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options
   constexpr std::uint32_t kNone = SimplifyResult::kUnmapped;
   // Weld: a vertex of a part's output that started as a cut vertex never moved and was never
   // removed (it was locked), so the parts' copies are one vertex, found through its input index.
+  // With attributes a cut vertex is a wedge: the wedges of a seam on the cut stay apart (their
+  // indices differ) at their common position, as in the input, and the final pass sees the seam.
+  // A wedge on the cut takes the values of the first part that has it (the parts may have refitted
+  // a locked wedge's normal or colour each on its side); a second copy of one input vertex from the
+  // same part (the two sides of a mirror line, kept apart by that part) stays its own vertex.
   Mesh merged;
+  for (const VertexAttribute& a : input.attributes) merged.attributes.push_back({a.name, a.kind, a.components, {}});
   std::vector<std::uint32_t> merged_source;  // per merged vertex: its input vertex
   std::vector<std::uint32_t> merged_face_source;
   std::vector<std::uint32_t> welded(input.vertex_count(), kNone);  // cut vertex -> merged vertex
+  std::vector<std::uint32_t> welded_by(input.vertex_count(), kNone);  // the part that made it
   std::vector<std::vector<std::uint32_t>> merged_of(parts.size());  // per part output vertex
   std::size_t nondegenerate = 0, part_dups = 0, contractions = 0;
   SimplifyResult result;
@@ -120,7 +135,10 @@ SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options
     const MeshPart& part = parts[p];
     const MeshPartResult& r = results[p];
     if (r.vertex_source.size() != r.mesh.vertex_count() || r.face_source.size() != r.mesh.face_count() ||
-        r.output_vertex_of_input.size() != part.input_vertex.size())
+        r.output_vertex_of_input.size() != part.input_vertex.size() ||
+        r.mesh.attributes.size() != merged.attributes.size() ||
+        (!input.face_materials.empty() && !input.attributes.empty() &&
+         r.mesh.face_materials.size() != r.mesh.face_count()))
       throw Error("finish_partitioned: part " + std::to_string(p) + "'s result does not match the part");
     nondegenerate += part.mesh.face_count();
     part_dups += r.dropped_duplicate_faces;
@@ -133,19 +151,25 @@ SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options
     for (std::size_t u = 0; u < r.mesh.vertex_count(); ++u) {
       const std::uint32_t g = part.input_vertex.at(r.vertex_source[u]);
       const bool cut = part.locked[r.vertex_source[u]] != 0;
-      if (cut && welded[g] != kNone) {
+      if (cut && welded[g] != kNone && welded_by[g] != p) {
         to_merged[u] = welded[g];
         continue;
       }
       to_merged[u] = std::uint32_t(merged_source.size());
-      if (cut) welded[g] = to_merged[u];
+      if (cut && welded[g] == kNone) welded[g] = to_merged[u], welded_by[g] = std::uint32_t(p);
       merged_source.push_back(g);
       merged.positions.insert(merged.positions.end(), &r.mesh.positions[3 * u], &r.mesh.positions[3 * u] + 3);
+      for (std::size_t a = 0; a < merged.attributes.size(); ++a) {
+        const std::size_t width = merged.attributes[a].components;
+        const double* row = &r.mesh.attributes[a].values.at(width * u);
+        merged.attributes[a].values.insert(merged.attributes[a].values.end(), row, row + width);
+      }
     }
     for (std::size_t f = 0; f < r.mesh.face_count(); ++f) {
       for (int k = 0; k < 3; ++k) merged.indices.push_back(to_merged[r.mesh.indices[3 * f + k]]);
       merged_face_source.push_back(part.input_face.at(r.face_source[f]));
     }
+    merged.face_materials.insert(merged.face_materials.end(), r.mesh.face_materials.begin(), r.mesh.face_materials.end());
   }
   if (report) report->merged_faces = merged.face_count();
 
@@ -158,15 +182,32 @@ SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options
   o.target_vertices = total.vertices;
   o.refit_rounds = 0;
   o.far_repair = false;
+  o.fit_attributes = false;
   o.map_input_vertices = true;
-  std::vector<std::uint8_t> lock;
+  std::vector<std::uint8_t> lock, protect;
   if (!options.vertex_lock.empty()) {
     lock.resize(merged_source.size());
     for (std::size_t v = 0; v < lock.size(); ++v) lock[v] = options.vertex_lock[merged_source[v]];
     o.vertex_lock = lock;
   }
+  if (!options.vertex_protect.empty()) {
+    protect.resize(merged_source.size());
+    for (std::size_t v = 0; v < protect.size(); ++v) protect[v] = options.vertex_protect[merged_source[v]];
+    o.vertex_protect = protect;
+  }
+  // The core itself (as simplify runs it), for what the refit with attributes needs of each output
+  // vertex: whether it is on a seam (core/wedges.h).
+  const bool refit = options.refit_rounds > 0;
+  const bool fit_values =
+      options.fit_attributes && refit_detail::has_fitted_attributes(input.attributes, options.attribute_weights);
+  core::WedgeRefitData wedge_refit;
+  core::RunHooks hooks;
+  hooks.consumed_indices = &merged.indices;
+  hooks.consumed_attributes = &merged.attributes;
+  if ((refit || fit_values) && !merged.attributes.empty()) hooks.wedge_refit = &wedge_refit;
   const auto start = std::chrono::steady_clock::now();
-  SimplifyResult last = simplify(std::move(merged), o);
+  SimplifyResult last = core::run(MeshView(merged), o, hooks);
+  std::vector<double>().swap(merged.positions);
   if (report) report->final_seconds = seconds_since(start);
 
   result.mesh = std::move(last.mesh);
@@ -176,7 +217,12 @@ SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options
   result.contractions = contractions + last.contractions;
   result.rejected_topology += last.rejected_topology, result.rejected_inversion += last.rejected_inversion;
   result.rejected_error += last.rejected_error, result.rejected_component += last.rejected_component;
-  result.input_components = count_input_components(input);
+  // With attributes the core counts positions, not wedges: its vertices and components are those
+  // of the surface welded by position (core/working_mesh.cpp), and so are these.
+  const std::vector<std::uint32_t> point = input.attributes.empty()
+                                               ? std::vector<std::uint32_t>{}
+                                               : partition_detail::first_at_same_position(input, core::resolve_threads(options.threads));
+  result.input_components = count_input_components(input, point);
   result.output_components = last.output_components;
   result.stop_reason = last.stop_reason;
   result.stop_detail = last.stop_detail;
@@ -199,32 +245,45 @@ SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options
       const std::uint32_t u = results[p].output_vertex_of_input[l];
       if (u != kNone) went[g] = last.output_vertex_of_input[merged_of[p].at(u)];
     }
+  if (!point.empty())
+    for (std::uint32_t v = 0; v < input.vertex_count(); ++v)
+      if (seen[v] && point[v] != v) seen[point[v]] = 1, seen[v] = 0;
   std::size_t referenced = 0;
   for (std::uint8_t s : seen) referenced += s;
   result.input_vertices = referenced;
+  result.output_vertex_of_input = std::move(went);
 
   // The refit fits the result to the whole input, as simplify's own refit does, with the input's
   // surface: without it the refit has no Hausdorff guard and far points still pull, and it raised
   // the one-sided distance by a third on a bumpy sphere where simplify's refit keeps it.
+  // With attributes, as simplify's: fitted welded by position with the seams held
+  // (refit_with_seams), then the attribute fit, against the input's attributes.
   RefitOptions refit_options = refit_options_for(options, referenced, result.mesh.vertex_count());
+  std::vector<std::uint8_t> fixed;  // per output vertex: the caller locked it
+  if (!options.vertex_lock.empty()) {
+    fixed.assign(result.mesh.vertex_count(), 0);
+    for (std::size_t v = 0; v < fixed.size(); ++v) fixed[v] = options.vertex_lock[result.vertex_source[v]];
+  }
   if (refit_options.rounds > 0 && result.contractions > 0) {
     const unsigned threads = core::resolve_threads(options.threads);
     const refit_detail::FitPoints points(input.positions, refit_detail::vertex_areas(input, threads), threads);
     const core::SurfaceDistance surface =
         refit_detail::surface_in_frame(input.positions, input.indices, points.frame(), threads);
-    std::vector<std::uint8_t> fixed;
-    if (!options.vertex_lock.empty()) {
-      fixed.assign(result.mesh.vertex_count(), 0);
-      for (std::size_t v = 0; v < fixed.size(); ++v) fixed[v] = options.vertex_lock[result.vertex_source[v]];
-      refit_options.fixed_vertices = fixed;
-    }
-    const RefitResult fit = refit_detail::refit_to_points(points, result.mesh, refit_options, went, &surface);
+    if (!fixed.empty()) refit_options.fixed_vertices = fixed;
+    const RefitResult fit =
+        result.mesh.attributes.empty()
+            ? refit_detail::refit_to_points(points, result.mesh, refit_options, result.output_vertex_of_input, &surface)
+            : refit_with_seams(points, result, refit_options, fixed, wedge_refit, &surface);
     result.refit_rms_before = fit.rms_before;
     result.refit_rms_after = fit.rms_after;
     result.refit_rounds = fit.rounds;
     if (options.far_repair) {  // after the refit, against the whole input, as simplify's
+      // Seam wedges and locked vertices stay, as in simplify's.
+      std::vector<std::uint8_t> held = wedge_refit.on_seam;
+      held.resize(result.mesh.vertex_count(), 0);
+      for (std::size_t v = 0; v < fixed.size(); ++v) held[v] |= fixed[v];
       core::FarRepairOptions repair_options;
-      repair_options.held = fixed;
+      repair_options.held = held;
       repair_options.max_normal_turn_degrees = options.max_normal_turn_degrees;
       repair_options.threads = core::resolve_threads(options.threads);
       const core::FarRepairResult made =
@@ -232,7 +291,15 @@ SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options
       result.edge_flips = made.flips, result.vertex_moves = made.moves;
     }
   }
-  if (options.map_input_vertices) result.output_vertex_of_input = std::move(went);
+  if (fit_values && result.contractions > 0) {
+    // After the refit: the values fit the final positions. Seam and locked vertices keep theirs.
+    std::vector<std::uint8_t> held = wedge_refit.on_seam;
+    held.resize(result.mesh.vertex_count(), 0);
+    for (std::size_t v = 0; v < fixed.size(); ++v) held[v] |= fixed[v];
+    refit_detail::fit_attributes(input.positions, input.indices, input.attributes, options.attribute_weights,
+                                 result.output_vertex_of_input, held, result.mesh);
+  }
+  if (!options.map_input_vertices) std::vector<std::uint32_t>().swap(result.output_vertex_of_input);
   return result;
 }
 

@@ -10,6 +10,7 @@
 #include "core/parallel_chunks.h"
 #include "core/spatial_order.h"
 #include "partition/partition_targets.h"
+#include "partition/same_position.h"
 #include "qem/error.h"
 #include "qem/partition.h"
 
@@ -24,10 +25,9 @@ unsigned automatic_parts(std::size_t faces) {
   return parts;
 }
 
-std::string partition_refusal(MeshView input, const SimplifyOptions& o) {
-  if (!input.attributes.empty())
-    return "the mesh has vertex attributes (normals, UVs, colours), which the parts do not carry";
-  if (!input.face_materials.empty()) return "the mesh has face materials, which the parts do not carry";
+// The mesh no longer decides (its attributes and materials are carried); the signature keeps it for
+// the callers, which ask about a mesh and its options together.
+std::string partition_refusal(MeshView /*input*/, const SimplifyOptions& o) {
   if (std::isfinite(o.max_error))
     return "an error limit (--max-error) is measured against each part's quadrics, not the whole mesh's";
   if (std::isfinite(o.max_distance))
@@ -57,14 +57,18 @@ Targets resolve_targets(const SimplifyOptions& o, std::size_t faces) {
 
 namespace {
 
+std::uint32_t point_of(const std::vector<std::uint32_t>& point, std::uint32_t v) { return point.empty() ? v : point[v]; }
+
 constexpr std::uint32_t kNone = 0xffffffffu;
 constexpr std::uint16_t kNoPart = 0xffff;
 constexpr std::size_t kChunk = std::size_t(1) << 16;  // faces per chunk of the parallel loops
 
 // The Morton code of each face's centroid over the input's bounding box (21 bits per axis, as the
 // core's vertex order), UINT64_MAX for a degenerate face (a repeated corner: no plane, left out as
-// the core leaves it out).
-std::vector<std::uint64_t> centroid_codes(MeshView input, unsigned threads) {
+// the core leaves it out). `point`: each vertex's point of the surface (itself, or with attributes
+// the first vertex at its position: two wedges of one position make a face degenerate in the core;
+// empty: each vertex is its own point).
+std::vector<std::uint64_t> centroid_codes(MeshView input, const std::vector<std::uint32_t>& point, unsigned threads) {
   const Box box = bounding_box(input);
   const double extent = std::max({box.hi[0] - box.lo[0], box.hi[1] - box.lo[1], box.hi[2] - box.lo[2]});
   const double scale = extent > 0 ? double((1 << 21) - 1) / extent : 0;
@@ -72,7 +76,8 @@ std::vector<std::uint64_t> centroid_codes(MeshView input, unsigned threads) {
   core::for_chunks(code.size(), kChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
     for (std::size_t f = begin; f < end; ++f) {
       const std::uint32_t* t = &input.indices[3 * f];
-      if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
+      const std::uint32_t x = point_of(point, t[0]), y = point_of(point, t[1]), z = point_of(point, t[2]);
+      if (x == y || y == z || x == z) {
         code[f] = UINT64_MAX;
         continue;
       }
@@ -99,11 +104,20 @@ std::vector<MeshPart> split_mesh(MeshView input, const SimplifyOptions& options,
   if (!options.vertex_lock.empty() && options.vertex_lock.size() != input.vertex_count())
     throw Error("vertex_lock has " + std::to_string(options.vertex_lock.size()) + " entries for " +
                 std::to_string(input.vertex_count()) + " vertices");
+  if (!options.vertex_protect.empty() && options.vertex_protect.size() != input.vertex_count())
+    throw Error("vertex_protect has " + std::to_string(options.vertex_protect.size()) + " entries for " +
+                std::to_string(input.vertex_count()) + " vertices");
   if (part_count > kNoPart) throw Error("at most " + std::to_string(kNoPart) + " parts");
   part_count = std::max(1u, part_count);
   const unsigned threads = core::resolve_threads(options.threads);
   const std::size_t nf = input.face_count();
-  const std::vector<std::uint64_t> code = centroid_codes(input, threads);
+  // With attributes the core welds the wedges of a position into one point of the surface, and so
+  // does the cut: a seam that crosses it (wedge a on one side's faces, wedge b on the other's, the
+  // same position) has no vertex index that two parts share, and found by index neither wedge
+  // would be locked, each part would move its own, and the seam would open into a crack.
+  const std::vector<std::uint32_t> point =
+      input.attributes.empty() ? std::vector<std::uint32_t>{} : partition_detail::first_at_same_position(input, threads);
+  const std::vector<std::uint64_t> code = centroid_codes(input, point, threads);
 
   // The cut: P-quantiles of the codes, taken from a sample of every k-th face (deterministic), so
   // that no serial sort of all faces is needed; parts then hold equal face counts to within about
@@ -144,7 +158,8 @@ std::vector<MeshPart> split_mesh(MeshView input, const SimplifyOptions& options,
       if (part_of[f] != kNoPart) faces[at[c][part_of[f]]++] = std::uint32_t(f);
   });
 
-  // A vertex is on a cut when faces of two parts use it: the first part to claim it (whichever
+  // A vertex is on a cut when faces of two parts use it (with attributes: its position; then every
+  // wedge there is on the cut, in each part that has it): the first part to claim it (whichever
   // thread is first) finds no owner, any other part finds one that is not itself. Which part
   // claims first varies; whether a second one exists does not, so `shared` is deterministic.
   std::vector<std::atomic<std::uint32_t>> owner(input.vertex_count());
@@ -154,7 +169,7 @@ std::vector<MeshPart> split_mesh(MeshView input, const SimplifyOptions& options,
   core::for_chunks(part_count, 1, threads, [&](std::size_t p, std::size_t, std::size_t) {
     for (std::size_t i = part_begin[p]; i < part_begin[p + 1]; ++i)
       for (int k = 0; k < 3; ++k) {
-        const std::uint32_t v = input.indices[3 * std::size_t(faces[i]) + k];
+        const std::uint32_t v = point_of(point, input.indices[3 * std::size_t(faces[i]) + k]);
         std::uint32_t expected = kNone;
         if (!owner[v].compare_exchange_strong(expected, std::uint32_t(p), std::memory_order_relaxed) &&
             expected != p)
@@ -164,7 +179,7 @@ std::vector<MeshPart> split_mesh(MeshView input, const SimplifyOptions& options,
   std::vector<std::uint8_t> shared(input.vertex_count());
   std::size_t referenced = 0;
   for (std::size_t v = 0; v < shared.size(); ++v) {
-    shared[v] = shared_flag[v].load(std::memory_order_relaxed);
+    shared[v] = shared_flag[point_of(point, std::uint32_t(v))].load(std::memory_order_relaxed);
     referenced += owner[v].load(std::memory_order_relaxed) != kNone;
   }
   std::vector<std::atomic<std::uint8_t>>().swap(shared_flag);
@@ -190,10 +205,19 @@ std::vector<MeshPart> split_mesh(MeshView input, const SimplifyOptions& options,
     part.mesh.positions.reserve(3 * vertices_guess);
     part.input_vertex.reserve(vertices_guess);
     part.locked.reserve(vertices_guess);
+    // The attribute rows of the part's vertices and the materials of its faces (the names stay the
+    // input's: face_materials index them), the caller's protection in the part's numbering.
+    for (const VertexAttribute& a : input.attributes) {
+      part.mesh.attributes.push_back({a.name, a.kind, a.components, {}});
+      part.mesh.attributes.back().values.reserve(a.components * vertices_guess);
+    }
+    if (!input.face_materials.empty()) part.mesh.face_materials.reserve(end - begin);
+    if (!options.vertex_protect.empty()) part.protect.reserve(vertices_guess);
     std::size_t locked_count = 0;
     for (std::size_t i = begin; i < end; ++i) {
       const std::uint32_t f = faces[i];
       part.input_face.push_back(f);
+      if (!input.face_materials.empty()) part.mesh.face_materials.push_back(input.face_materials[f]);
       for (int k = 0; k < 3; ++k) {
         const std::uint32_t v = input.indices[3 * std::size_t(f) + k];
         std::uint32_t* id = nullptr;
@@ -207,6 +231,12 @@ std::vector<MeshPart> split_mesh(MeshView input, const SimplifyOptions& options,
           const bool lock = shared[v] || (!options.vertex_lock.empty() && options.vertex_lock[v]);
           part.locked.push_back(lock);
           locked_count += shared[v];
+          for (std::size_t a = 0; a < input.attributes.size(); ++a) {
+            const std::size_t width = input.attributes[a].components;
+            const double* row = &input.attributes[a].values[width * v];
+            part.mesh.attributes[a].values.insert(part.mesh.attributes[a].values.end(), row, row + width);
+          }
+          if (!options.vertex_protect.empty()) part.protect.push_back(options.vertex_protect[v]);
         }
         part.mesh.indices.push_back(*id);
       }
