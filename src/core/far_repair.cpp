@@ -389,7 +389,15 @@ class Flipper {
     const double from = opt_.from_fraction * largest_;
     for (std::uint32_t p = 0; p < d2_.size(); ++p)
       if (std::sqrt(d2_[p]) >= from) far.push_back(p);
-    std::sort(far.begin(), far.end(), [&](std::uint32_t a, std::uint32_t b) { return d2_[a] > d2_[b] || (d2_[a] == d2_[b] && a < b); });
+    // The farthest kMovesTried only: the largest distance is won or lost at the top, and at
+    // coarse targets a fraction of the largest takes in a large share of the input's points.
+    constexpr std::size_t kMovesTried = 64;
+    const auto farther = [&](std::uint32_t a, std::uint32_t b) { return d2_[a] > d2_[b] || (d2_[a] == d2_[b] && a < b); };
+    if (far.size() > kMovesTried) {
+      std::nth_element(far.begin(), far.begin() + kMovesTried, far.end(), farther);
+      far.resize(kMovesTried);
+    }
+    std::sort(far.begin(), far.end(), farther);
     std::vector<std::uint32_t> face_of(d2_.size(), UINT32_MAX);
     for (std::uint32_t f = 0; f < face_count(); ++f)
       for (std::uint32_t p : points_of_[f]) face_of[p] = f;
