@@ -389,7 +389,15 @@ class Flipper {
     const double from = opt_.from_fraction * largest_;
     for (std::uint32_t p = 0; p < d2_.size(); ++p)
       if (std::sqrt(d2_[p]) >= from) far.push_back(p);
-    std::sort(far.begin(), far.end(), [&](std::uint32_t a, std::uint32_t b) { return d2_[a] > d2_[b] || (d2_[a] == d2_[b] && a < b); });
+    // The farthest kMovesTried only: the largest distance is won or lost at the top, and at
+    // coarse targets a fraction of the largest takes in a large share of the input's points.
+    constexpr std::size_t kMovesTried = 64;
+    const auto farther = [&](std::uint32_t a, std::uint32_t b) { return d2_[a] > d2_[b] || (d2_[a] == d2_[b] && a < b); };
+    if (far.size() > kMovesTried) {
+      std::nth_element(far.begin(), far.begin() + kMovesTried, far.end(), farther);
+      far.resize(kMovesTried);
+    }
+    std::sort(far.begin(), far.end(), farther);
     std::vector<std::uint32_t> face_of(d2_.size(), UINT32_MAX);
     for (std::uint32_t f = 0; f < face_count(); ++f)
       for (std::uint32_t p : points_of_[f]) face_of[p] = f;
@@ -412,7 +420,7 @@ class Flipper {
         for (double step : {1.0, 0.5})
           if (try_move(v, x_[v] + (q - c) * step)) {
             made = true;
-            if (!std::binary_search(moved_.begin(), moved_.end(), v)) moved_.insert(std::lower_bound(moved_.begin(), moved_.end(), v), v);
+            note_moved(v);
             break;
           }
         if (made) break;
@@ -420,7 +428,61 @@ class Flipper {
       for (std::uint32_t g = 0; made && g < face_count(); ++g) for (std::uint32_t r : points_of_[g]) face_of[r] = g;
       moves += made;
     }
+    return moves + move_toward_input(from);
+  }
+
+  // The other way round: a face whose sample is far from the input (the output bulging over a
+  // dent, or sagging under a ridge) pushes the corner nearest that sample along the face's normal,
+  // either way, by the sample's distance or half of it. The farthest kMovesTried faces only.
+  std::size_t move_toward_input(double from) {
+    constexpr std::size_t kMovesTried = 64;
+    std::vector<std::uint32_t> far;
+    for (std::uint32_t f = 0; f < face_count(); ++f)
+      if ((scored_[f] ? score_[f].most : near_[f]) >= from) far.push_back(f);
+    const auto most = [&](std::uint32_t f) { return scored_[f] ? score_[f].most : near_[f]; };
+    const auto farther = [&](std::uint32_t a, std::uint32_t b) { return most(a) > most(b) || (most(a) == most(b) && a < b); };
+    if (far.size() > kMovesTried) {
+      std::nth_element(far.begin(), far.begin() + kMovesTried, far.end(), farther);
+      far.resize(kMovesTried);
+    }
+    std::sort(far.begin(), far.end(), farther);
+    std::size_t moves = 0;
+    for (std::uint32_t f : far) {
+      const std::uint32_t* t = &tri_[3 * f];
+      const Vec3 &a = x_[t[0]], &b = x_[t[1]], &c = x_[t[2]];
+      // The face's farthest sample.
+      std::uint32_t hint = hint_[f];
+      double d = 0;
+      Vec3 at{};
+      for (const SampleAt& w : kOrder) {
+        const Vec3 q = a + (b - a) * w.u + (c - a) * w.v;
+        const double e = surface_.distance(q, &hint);
+        if (e > d) d = e, at = q;
+      }
+      const Vec3 n = normalized(normal(t[0], t[1], t[2]));
+      if (d < from || dot(n, n) == 0) continue;
+      std::array<std::uint32_t, 3> corners = {t[0], t[1], t[2]};
+      std::sort(corners.begin(), corners.end(), [&](std::uint32_t u, std::uint32_t v) {
+        const double du = measure_detail::squared_distance(at, x_[u]), dv = measure_detail::squared_distance(at, x_[v]);
+        return du < dv || (du == dv && u < v);
+      });
+      bool made = false;
+      for (std::uint32_t v : corners) {
+        if (held(v) || !interior(v)) continue;
+        for (double step : {1.0, -1.0, 0.5, -0.5})
+          if (try_move(v, x_[v] + n * (d * step))) {
+            made = true;
+            note_moved(v);
+            break;
+          }
+        if (made) break;
+      }
+      moves += made;
+    }
     return moves;
+  }
+  void note_moved(std::uint32_t v) {
+    if (!std::binary_search(moved_.begin(), moved_.end(), v)) moved_.insert(std::lower_bound(moved_.begin(), moved_.end(), v), v);
   }
 
   // One sweep over the edges of the faces marked in `dirty` that are at least `from` from the
