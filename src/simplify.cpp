@@ -92,6 +92,26 @@ void refit_levels(MeshView original, std::span<ReplayLevel> levels, const Simpli
     }
 }
 
+std::vector<std::uint8_t> seam_or_locked(std::span<const std::uint8_t> on_seam, std::span<const std::uint8_t> fixed,
+                                         std::size_t vertices) {
+  std::vector<std::uint8_t> held(vertices, 0);
+  for (std::size_t v = 0; v < vertices; ++v)
+    held[v] = (v < on_seam.size() && on_seam[v]) || (v < fixed.size() && fixed[v]);
+  return held;
+}
+
+void repair_after_refit(SimplifyResult& result, const SimplifyOptions& options, const refit_detail::FitPoints& points,
+                        const core::SurfaceDistance& surface, std::span<const std::uint8_t> held) {
+  core::FarRepairOptions repair_options;
+  repair_options.held = held;
+  repair_options.max_normal_turn_degrees = options.max_normal_turn_degrees;
+  repair_options.threads = core::resolve_threads(options.threads);
+  const core::FarRepairResult made =
+      core::repair_far_places(result.mesh, points.frame(), surface, points.position, points.weight, repair_options);
+  result.edge_flips = made.flips;
+  result.vertex_moves = made.moves;
+}
+
 void check_options(const SimplifyOptions& options) {
   core::validate(options);
   if (options.refit_rounds > 0) refit_detail::check_options(refit_options_for(options));
@@ -195,26 +215,10 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
     out.refit_rms_after = fit.rms_after;
     out.refit_rounds = fit.rounds;
   }
-  if (repaired) {
-    // Seam wedges and locked vertices keep their edges.
-    std::vector<std::uint8_t> held = wedge_refit.on_seam;
-    held.resize(out.mesh.vertex_count(), 0);
-    for (std::size_t v = 0; v < fixed.size(); ++v) held[v] |= fixed[v];
-    core::FarRepairOptions repair_options;
-    repair_options.held = held;
-    repair_options.max_normal_turn_degrees = options.max_normal_turn_degrees;
-    repair_options.threads = core::resolve_threads(options.threads);
-    const core::FarRepairResult made =
-        core::repair_far_places(out.mesh, points.frame(), surface, points.position, points.weight, repair_options);
-    out.edge_flips = made.flips;
-    out.vertex_moves = made.moves;
-  }
+  if (repaired) repair_after_refit(out, options, points, surface, seam_or_locked(wedge_refit.on_seam, fixed, out.mesh.vertex_count()));
   if (fit_values && out.contractions > 0 && out.stop_reason != StopReason::Cancelled) {
     // After the refit: the values fit the final positions. Seam and locked vertices keep theirs.
-    std::vector<std::uint8_t> held = wedge_refit.on_seam;
-    held.resize(out.mesh.vertex_count(), 0);
-    if (!options.vertex_lock.empty())
-      for (std::size_t v = 0; v < out.vertex_source.size(); ++v) held[v] |= options.vertex_lock[out.vertex_source[v]];
+    const std::vector<std::uint8_t> held = seam_or_locked(wedge_refit.on_seam, fixed, out.mesh.vertex_count());
     refit_detail::fit_attributes(input.positions, input_faces, input.attributes,
                                  options.attribute_weights, out.output_vertex_of_input, held, out.mesh);
   }

@@ -12,7 +12,6 @@
 #include <thread>
 
 #include "analysis/disjoint_sets.h"
-#include "core/far_repair.h"
 #include "core/parallel_chunks.h"
 #include "core/run.h"
 #include "partition/partition_targets.h"
@@ -277,25 +276,13 @@ SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options
     result.refit_rms_before = fit.rms_before;
     result.refit_rms_after = fit.rms_after;
     result.refit_rounds = fit.rounds;
-    if (options.far_repair) {  // after the refit, against the whole input, as simplify's
-      // Seam wedges and locked vertices stay, as in simplify's.
-      std::vector<std::uint8_t> held = wedge_refit.on_seam;
-      held.resize(result.mesh.vertex_count(), 0);
-      for (std::size_t v = 0; v < fixed.size(); ++v) held[v] |= fixed[v];
-      core::FarRepairOptions repair_options;
-      repair_options.held = held;
-      repair_options.max_normal_turn_degrees = options.max_normal_turn_degrees;
-      repair_options.threads = core::resolve_threads(options.threads);
-      const core::FarRepairResult made =
-          core::repair_far_places(result.mesh, points.frame(), surface, points.position, points.weight, repair_options);
-      result.edge_flips = made.flips, result.vertex_moves = made.moves;
-    }
+    if (options.far_repair)  // after the refit, against the whole input, as simplify's
+      repair_after_refit(result, options, points, surface,
+                         seam_or_locked(wedge_refit.on_seam, fixed, result.mesh.vertex_count()));
   }
   if (fit_values && result.contractions > 0) {
     // After the refit: the values fit the final positions. Seam and locked vertices keep theirs.
-    std::vector<std::uint8_t> held = wedge_refit.on_seam;
-    held.resize(result.mesh.vertex_count(), 0);
-    for (std::size_t v = 0; v < fixed.size(); ++v) held[v] |= fixed[v];
+    const std::vector<std::uint8_t> held = seam_or_locked(wedge_refit.on_seam, fixed, result.mesh.vertex_count());
     refit_detail::fit_attributes(input.positions, input.indices, input.attributes, options.attribute_weights,
                                  result.output_vertex_of_input, held, result.mesh);
   }

@@ -3,12 +3,17 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <span>
+#include <vector>
+
+#include "core/distance_bound.h"
 
 #include "qem/mesh.h"
 #include "qem/progressive.h"
 #include "qem/refit.h"
 #include "qem/simplify.h"
+#include "refit/refit_points.h"
 
 namespace qem {
 
@@ -28,5 +33,16 @@ RefitOptions refit_options_for(const SimplifyOptions& options, std::size_t input
 /// that level: the levels that get the same refit are refitted together.
 void refit_levels(MeshView original, std::span<ReplayLevel> levels, const SimplifyOptions& options,
                   std::size_t input_vertices);
+
+/// Per output vertex (`vertices` of them): on a seam (`on_seam`, from the core's wedge data) or
+/// locked (`fixed`): what the refit's followers, the far-place repair and the attribute fit,
+/// leave as it is. Either span may be shorter (empty: none).
+std::vector<std::uint8_t> seam_or_locked(std::span<const std::uint8_t> on_seam, std::span<const std::uint8_t> fixed,
+                                         std::size_t vertices);
+
+/// The far-place repair (core/far_repair.h) of `result` after its refit, against the input's
+/// points and surface (those of the refit), `held` vertices left as they are; counts it in `result`.
+void repair_after_refit(SimplifyResult& result, const SimplifyOptions& options, const refit_detail::FitPoints& points,
+                        const core::SurfaceDistance& surface, std::span<const std::uint8_t> held);
 
 }  // namespace qem
