@@ -47,9 +47,9 @@ struct FaceScore {
   std::uint32_t hint = UINT32_MAX;  // a face of the input near the face, where searches start
 };
 
-class Flipper {
+class Repairer {
  public:
-  Flipper(Mesh& approx, const Frame& frame, const SurfaceDistance& surface, std::span<const double> points,
+  Repairer(Mesh& approx, const Frame& frame, const SurfaceDistance& surface, std::span<const double> points,
           std::span<const double> weights, const FarRepairOptions& options)
       : mesh_(approx), frame_(frame), surface_(surface), points_(points), weights_(weights), opt_(options),
         cos_turn_(std::cos(options.max_normal_turn_degrees * std::numbers::pi / 180)),
@@ -544,7 +544,7 @@ FarRepairResult repair_far_places(Mesh& approx, const Frame& frame, const Surfac
                               std::span<const double> points, std::span<const double> weights,
                               const FarRepairOptions& options) {
   if (approx.face_count() < 2 || surface.empty()) return {};
-  return Flipper(approx, frame, surface, points, weights, options).run();
+  return Repairer(approx, frame, surface, points, weights, options).run();
 }
 
 }  // namespace qem::core

@@ -41,7 +41,7 @@ struct FarRepairOptions {
   /// Only edges of faces whose local largest distance is at least this fraction of the output's
   /// largest are tried (the Hausdorff distance is a maximum: the far places are where it is won).
   /// 0.75 won the same Hausdorff distances as 0.5 on the benchmark meshes for fewer tries; lower
-  /// fractions flip for E away from the far places (docs/benchmarks.md, "Edge flips").
+  /// fractions flip for E away from the far places (docs/benchmarks.md, "Far places").
   double from_fraction = 0.75;
   /// Sweeps over those edges; a sweep that flips nothing ends the pass.
   unsigned sweeps = 4;
