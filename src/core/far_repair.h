@@ -35,8 +35,8 @@
 namespace qem::core {
 
 struct FarRepairOptions {
-  /// Per output vertex: 1 = no flip may add or remove an edge at it (locked vertices, seam
-  /// wedges). Empty: none held.
+  /// Per output vertex: 1 = held: no flip may add or remove an edge at it and it does not move
+  /// (locked vertices, seam wedges). Empty: none held.
   std::span<const std::uint8_t> held;
   /// Only edges of faces whose local largest distance is at least this fraction of the output's
   /// largest are tried (the Hausdorff distance is a maximum: the far places are where it is won).
@@ -61,15 +61,16 @@ struct FarRepairResult {
   /// Before the flips, the largest distance (in the surface's frame) of the output's face
   /// centroids and edge midpoints to the input, and of the input's points to the output.
   double largest_before = 0;
-  std::size_t moves = 0;
+  std::size_t moves = 0;  ///< vertices moved (a vertex moved twice counts twice)
 };
 
-/// Flips edges of `approx` (positions in model units; `frame` maps them to the surface's frame).
-/// `surface`: the input's triangles in that frame. `points` (3 per point, in the frame) and `weights`
-/// (each one's share of the input's area, in model units): the input's vertices
-/// (refit_detail::FitPoints). Only approx.indices change.
+/// Repairs the far places of `approx` (positions in model units; `frame` maps them to the
+/// surface's frame). `surface`: the input's triangles in that frame. `points` (3 per point, in the
+/// frame) and `weights` (each one's share of the input's area, in model units): the input's
+/// vertices (refit_detail::FitPoints). approx.indices change by flips, and the positions of the
+/// moved vertices; the counts of faces and vertices stay.
 FarRepairResult repair_far_places(Mesh& approx, const Frame& frame, const SurfaceDistance& surface,
-                              std::span<const double> points, std::span<const double> weights,
-                              const FarRepairOptions& options);
+                                  std::span<const double> points, std::span<const double> weights,
+                                  const FarRepairOptions& options);
 
 }  // namespace qem::core
