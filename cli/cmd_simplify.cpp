@@ -175,8 +175,8 @@ int run_simplify(const SimplifyArgs& a) {
   if (gltf_document) {
     opt.refit_rounds = attribute_refit_rounds(a.algorithm, opt);
     opt.far_repair = far_repair_wanted(a.algorithm, opt);
+    return run_simplify_gltf(a, opt);
   }
-  if (gltf_document) return run_simplify_gltf(a, opt);
   // An input too large for memory goes the out-of-core way (qem/out_of_core.h); others as before.
   if (a.record.empty() && wants_out_of_core(a.input, a.out_of_core)) {
     OutOfCoreArgs ooc = a.out_of_core;

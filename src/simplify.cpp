@@ -53,6 +53,20 @@ RefitOptions refit_options_for(const SimplifyOptions& options, std::size_t input
   return r;
 }
 
+namespace {
+
+// The far-place repair of `mesh` with `options`' turn limit and threads (core/far_repair.h).
+core::FarRepairResult repair_mesh(Mesh& mesh, const SimplifyOptions& options, const refit_detail::FitPoints& points,
+                                  const core::SurfaceDistance& surface, std::span<const std::uint8_t> held) {
+  core::FarRepairOptions repair_options;
+  repair_options.held = held;
+  repair_options.max_normal_turn_degrees = options.max_normal_turn_degrees;
+  repair_options.threads = core::resolve_threads(options.threads);
+  return core::repair_far_places(mesh, points.frame(), surface, points.position, points.weight, repair_options);
+}
+
+}  // namespace
+
 void refit_levels(MeshView original, std::span<ReplayLevel> levels, const SimplifyOptions& options,
                   std::size_t input_vertices) {
   std::vector<std::pair<RefitOptions, std::vector<Mesh*>>> groups;
@@ -78,17 +92,13 @@ void refit_levels(MeshView original, std::span<ReplayLevel> levels, const Simpli
   for (std::size_t v = 0; v < options.vertex_lock.size(); ++v)
     if (options.vertex_lock[v]) locked.push_back({original.positions[3 * v], original.positions[3 * v + 1], original.positions[3 * v + 2]});
   std::sort(locked.begin(), locked.end());
-  core::FarRepairOptions repair_options;
-  repair_options.max_normal_turn_degrees = options.max_normal_turn_degrees;
-  repair_options.threads = threads;
   for (auto& [refit_options, meshes] : groups)
     for (Mesh* mesh : meshes) {
       std::vector<std::uint8_t> held(locked.empty() ? 0 : mesh->vertex_count(), 0);
       for (std::size_t v = 0; v < held.size(); ++v)
         held[v] = std::binary_search(locked.begin(), locked.end(),
                                      std::array<double, 3>{mesh->positions[3 * v], mesh->positions[3 * v + 1], mesh->positions[3 * v + 2]});
-      repair_options.held = held;
-      core::repair_far_places(*mesh, points.frame(), surface, points.position, points.weight, repair_options);
+      repair_mesh(*mesh, options, points, surface, held);
     }
 }
 
@@ -102,12 +112,7 @@ std::vector<std::uint8_t> seam_or_locked(std::span<const std::uint8_t> on_seam, 
 
 void repair_after_refit(SimplifyResult& result, const SimplifyOptions& options, const refit_detail::FitPoints& points,
                         const core::SurfaceDistance& surface, std::span<const std::uint8_t> held) {
-  core::FarRepairOptions repair_options;
-  repair_options.held = held;
-  repair_options.max_normal_turn_degrees = options.max_normal_turn_degrees;
-  repair_options.threads = core::resolve_threads(options.threads);
-  const core::FarRepairResult made =
-      core::repair_far_places(result.mesh, points.frame(), surface, points.position, points.weight, repair_options);
+  const core::FarRepairResult made = repair_mesh(result.mesh, options, points, surface, held);
   result.edge_flips = made.flips;
   result.vertex_moves = made.moves;
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <initializer_list>
 #include <numbers>
 #include <vector>
 
@@ -357,6 +358,7 @@ class Repairer {
     for (std::uint32_t f : fan) pts.insert(pts.end(), points_of_[f].begin(), points_of_[f].end());
     x_[v] = y;
     std::vector<std::uint32_t> nearest(pts.size());
+    scratch_d2_.resize(pts.size());
     double most2 = 0, energy = 0;
     for (std::size_t i = 0; i < fan.size(); ++i) energy += scores[i].energy;
     for (std::size_t i = 0; i < pts.size(); ++i) {
@@ -370,7 +372,6 @@ class Repairer {
       }
       most2 = std::max(most2, best);
       energy += weights_[pts[i]] * weight_scale_ * best;
-      scratch_d2_.resize(pts.size());
       scratch_d2_[i] = best;
     }
     if (std::sqrt(most2) >= old_most || energy > old_energy * (1 + opt_.error_margin)) return x_[v] = x, false;
@@ -389,15 +390,7 @@ class Repairer {
     const double from = opt_.from_fraction * largest_;
     for (std::uint32_t p = 0; p < d2_.size(); ++p)
       if (std::sqrt(d2_[p]) >= from) far.push_back(p);
-    // The farthest kMovesTried only: the largest distance is won or lost at the top, and at
-    // coarse targets a fraction of the largest takes in a large share of the input's points.
-    constexpr std::size_t kMovesTried = 64;
-    const auto farther = [&](std::uint32_t a, std::uint32_t b) { return d2_[a] > d2_[b] || (d2_[a] == d2_[b] && a < b); };
-    if (far.size() > kMovesTried) {
-      std::nth_element(far.begin(), far.begin() + kMovesTried, far.end(), farther);
-      far.resize(kMovesTried);
-    }
-    std::sort(far.begin(), far.end(), farther);
+    keep_farthest(far, [&](std::uint32_t a, std::uint32_t b) { return d2_[a] > d2_[b] || (d2_[a] == d2_[b] && a < b); });
     std::vector<std::uint32_t> face_of(d2_.size(), UINT32_MAX);
     for (std::uint32_t f = 0; f < face_count(); ++f)
       for (std::uint32_t p : points_of_[f]) face_of[p] = f;
@@ -408,25 +401,12 @@ class Repairer {
       const Vec3 q = point(p);
       const std::uint32_t* t = &tri_[3 * f];
       const Vec3 c = measure_detail::closest_point_on_triangle(q, x_[t[0]], x_[t[1]], x_[t[2]]);
-      // The corner nearest the closest point first.
-      std::array<std::uint32_t, 3> corners = {t[0], t[1], t[2]};
-      std::sort(corners.begin(), corners.end(), [&](std::uint32_t a, std::uint32_t b) {
-        const double da = measure_detail::squared_distance(c, x_[a]), db = measure_detail::squared_distance(c, x_[b]);
-        return da < db || (da == db && a < b);
-      });
-      bool made = false;
-      for (std::uint32_t v : corners) {
-        if (held(v) || !interior(v)) continue;
-        for (double step : {1.0, 0.5})
-          if (try_move(v, x_[v] + (q - c) * step)) {
-            made = true;
-            note_moved(v);
-            break;
-          }
-        if (made) break;
-      }
-      for (std::uint32_t g = 0; made && g < face_count(); ++g) for (std::uint32_t r : points_of_[g]) face_of[r] = g;
-      moves += made;
+      const std::uint32_t v = move_a_corner(f, c, {1.0, 0.5}, [&](std::uint32_t u, double step) { return x_[u] + (q - c) * step; });
+      if (v == UINT32_MAX) continue;
+      ++moves;
+      // A move hands points only among the faces of the vertex moved.
+      for (std::uint32_t g : faces_at_[v])
+        for (std::uint32_t r : points_of_[g]) face_of[r] = g;
     }
     return moves + move_toward_input(from);
   }
@@ -435,17 +415,11 @@ class Repairer {
   // dent, or sagging under a ridge) pushes the corner nearest that sample along the face's normal,
   // either way, by the sample's distance or half of it. The farthest kMovesTried faces only.
   std::size_t move_toward_input(double from) {
-    constexpr std::size_t kMovesTried = 64;
+    const auto most = [&](std::uint32_t f) { return scored_[f] ? score_[f].most : near_[f]; };
     std::vector<std::uint32_t> far;
     for (std::uint32_t f = 0; f < face_count(); ++f)
-      if ((scored_[f] ? score_[f].most : near_[f]) >= from) far.push_back(f);
-    const auto most = [&](std::uint32_t f) { return scored_[f] ? score_[f].most : near_[f]; };
-    const auto farther = [&](std::uint32_t a, std::uint32_t b) { return most(a) > most(b) || (most(a) == most(b) && a < b); };
-    if (far.size() > kMovesTried) {
-      std::nth_element(far.begin(), far.begin() + kMovesTried, far.end(), farther);
-      far.resize(kMovesTried);
-    }
-    std::sort(far.begin(), far.end(), farther);
+      if (most(f) >= from) far.push_back(f);
+    keep_farthest(far, [&](std::uint32_t a, std::uint32_t b) { return most(a) > most(b) || (most(a) == most(b) && a < b); });
     std::size_t moves = 0;
     for (std::uint32_t f : far) {
       const std::uint32_t* t = &tri_[3 * f];
@@ -461,26 +435,47 @@ class Repairer {
       }
       const Vec3 n = normalized(normal(t[0], t[1], t[2]));
       if (d < from || dot(n, n) == 0) continue;
-      std::array<std::uint32_t, 3> corners = {t[0], t[1], t[2]};
-      std::sort(corners.begin(), corners.end(), [&](std::uint32_t u, std::uint32_t v) {
-        const double du = measure_detail::squared_distance(at, x_[u]), dv = measure_detail::squared_distance(at, x_[v]);
-        return du < dv || (du == dv && u < v);
-      });
-      bool made = false;
-      for (std::uint32_t v : corners) {
-        if (held(v) || !interior(v)) continue;
-        for (double step : {1.0, -1.0, 0.5, -0.5})
-          if (try_move(v, x_[v] + n * (d * step))) {
-            made = true;
-            note_moved(v);
-            break;
-          }
-        if (made) break;
-      }
-      moves += made;
+      moves += move_a_corner(f, at, {1.0, -1.0, 0.5, -0.5},
+                             [&](std::uint32_t u, double step) { return x_[u] + n * (d * step); }) != UINT32_MAX;
     }
     return moves;
   }
+
+  // Keeps of `items` the kMovesTried first by `farther` (a strict order, farthest first), sorted:
+  // the largest distance is won or lost at the top, and at coarse targets a fraction of the
+  // largest takes in a large share of the input's points or the output's faces.
+  template <class Farther>
+  static void keep_farthest(std::vector<std::uint32_t>& items, Farther farther) {
+    constexpr std::size_t kMovesTried = 64;
+    if (items.size() > kMovesTried) {
+      std::nth_element(items.begin(), items.begin() + kMovesTried, items.end(), farther);
+      items.resize(kMovesTried);
+    }
+    std::sort(items.begin(), items.end(), farther);
+  }
+
+  // Moves a corner of face f, the one nearest `near` first, to the first position `to(corner,
+  // step)` over `steps` that try_move accepts; held and non-interior corners stay. Returns the
+  // corner moved, or UINT32_MAX.
+  template <class Target>
+  std::uint32_t move_a_corner(std::uint32_t f, const Vec3& near, std::initializer_list<double> steps, Target to) {
+    const std::uint32_t* t = &tri_[3 * f];
+    std::array<std::uint32_t, 3> corners = {t[0], t[1], t[2]};
+    std::sort(corners.begin(), corners.end(), [&](std::uint32_t a, std::uint32_t b) {
+      const double da = measure_detail::squared_distance(near, x_[a]), db = measure_detail::squared_distance(near, x_[b]);
+      return da < db || (da == db && a < b);
+    });
+    for (std::uint32_t v : corners) {
+      if (held(v) || !interior(v)) continue;
+      for (double step : steps)
+        if (try_move(v, to(v, step))) {
+          note_moved(v);
+          return v;
+        }
+    }
+    return UINT32_MAX;
+  }
+
   void note_moved(std::uint32_t v) {
     if (!std::binary_search(moved_.begin(), moved_.end(), v)) moved_.insert(std::lower_bound(moved_.begin(), moved_.end(), v), v);
   }
