@@ -113,11 +113,12 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
   sub->add_flag("--no-refit", a.no_refit,
                 "No refit, not even the default's light one: every vertex stays where GH97 placed it");
   sub->add_flag("--far-repair", a.far_repair,
-                "After the run and the refit, repair the places farthest from the input: flip an edge, or "
-                "move an interior vertex toward the input points far from it, where that lowers the local "
-                "Hausdorff distance without raising the local error; borders, seams and locked vertices "
-                "stay (docs/benchmarks.md, \"Far places\"). On by default with the refit; this turns it "
-                "on without it");
+                "After the run and the refit, repair the places farthest from the input: flip an edge, "
+                "move an interior vertex toward the input points far from it, or take a vertex from the "
+                "flattest place to the farthest (a split there, a collapse here), where that lowers the "
+                "local Hausdorff distance without raising the local error; borders stay on the input's, "
+                "seams and locked vertices stay (docs/benchmarks.md, \"Far places\"). On by default with "
+                "the refit; this turns it on without it");
   sub->add_flag("--no-far-repair", a.no_far_repair, "No repair of the far places after the run (see --far-repair)");
   sub->add_flag("--attribute-fit", a.attribute_fit,
                 "With attributes, after the run fit each vertex's values (off the seams) by least squares to "

@@ -55,14 +55,31 @@ RefitOptions refit_options_for(const SimplifyOptions& options, std::size_t input
 
 namespace {
 
-// The far-place repair of `mesh` with `options`' turn limit and threads (core/far_repair.h).
-core::FarRepairResult repair_mesh(Mesh& mesh, const SimplifyOptions& options, const refit_detail::FitPoints& points,
+// The far-place repair of `mesh` with `options`' turn limit and threads (core/far_repair.h), against
+// the input (`positions`, `faces`) as `points` and `surface`. A relocated vertex that stands at an
+// input vertex takes its exact coordinates (on a border: on the input's border, as exact borders
+// promise).
+core::FarRepairResult repair_mesh(Mesh& mesh, const SimplifyOptions& options, std::span<const double> positions,
+                                  std::span<const std::uint32_t> faces, const refit_detail::FitPoints& points,
                                   const core::SurfaceDistance& surface, std::span<const std::uint8_t> held) {
   core::FarRepairOptions repair_options;
   repair_options.held = held;
   repair_options.max_normal_turn_degrees = options.max_normal_turn_degrees;
   repair_options.threads = core::resolve_threads(options.threads);
-  return core::repair_far_places(mesh, points.frame(), surface, points.position, points.weight, repair_options);
+  // Each relocation mends the one farthest place, until one cannot be made; a few were made on the
+  // benchmark meshes (docs/benchmarks.md, "Far places"): the cap only bounds the work.
+  repair_options.relocations = 256;
+  repair_options.add_vertices = options.target_vertices == 0;  // a vertex target stays a bound
+  const std::vector<std::uint8_t> on_border = core::points_on_border(faces, points.source);
+  repair_options.point_on_border = on_border;
+  core::FarRepairResult made =
+      core::repair_far_places(mesh, points.frame(), surface, points.position, points.weight, repair_options);
+  for (const core::Relocation& r : made.relocations)
+    if (r.at_point)
+      for (std::uint32_t v : {r.removed, r.added})
+        if (v != UINT32_MAX)
+          for (int k = 0; k < 3; ++k) mesh.positions[3 * std::size_t(v) + k] = positions[3 * std::size_t(points.source[r.point]) + k];
+  return made;
 }
 
 }  // namespace
@@ -98,7 +115,7 @@ void refit_levels(MeshView original, std::span<ReplayLevel> levels, const Simpli
       for (std::size_t v = 0; v < held.size(); ++v)
         held[v] = std::binary_search(locked.begin(), locked.end(),
                                      std::array<double, 3>{mesh->positions[3 * v], mesh->positions[3 * v + 1], mesh->positions[3 * v + 2]});
-      repair_mesh(*mesh, options, points, surface, held);
+      repair_mesh(*mesh, options, original.positions, original.indices, points, surface, held);
     }
 }
 
@@ -110,11 +127,42 @@ std::vector<std::uint8_t> seam_or_locked(std::span<const std::uint8_t> on_seam, 
   return held;
 }
 
-void repair_after_refit(SimplifyResult& result, const SimplifyOptions& options, const refit_detail::FitPoints& points,
-                        const core::SurfaceDistance& surface, std::span<const std::uint8_t> held) {
-  const core::FarRepairResult made = repair_mesh(result.mesh, options, points, surface, held);
+void repair_after_refit(SimplifyResult& result, const SimplifyOptions& options, MeshView input,
+                        const refit_detail::FitPoints& points, const core::SurfaceDistance& surface,
+                        std::span<const std::uint8_t> held) {
+  const core::FarRepairResult made = repair_mesh(result.mesh, options, input.positions, input.indices, points, surface, held);
   result.edge_flips = made.flips;
   result.vertex_moves = made.moves;
+  result.vertex_relocations = made.relocations.size();
+  // Provenance across relocations: the removed vertex's inputs went into the kept one; the new
+  // vertex starts from the input point it stands at (or nearest to); a face of a split is of the
+  // face it divided.
+  // (A new vertex is never removed again, so the inputs of removed vertices follow the relocations
+  // in order, and the new vertices' sources are set after them.)
+  std::vector<std::uint8_t> removed(result.mesh.vertex_count(), 0);
+  for (const core::Relocation& r : made.relocations) removed[r.removed] = 1;
+  for (std::uint32_t& v : result.output_vertex_of_input)
+    if (v < removed.size() && removed[v])
+      for (const core::Relocation& r : made.relocations)
+        if (v == r.removed) v = r.kept;
+  for (const core::Relocation& r : made.relocations) {
+    if (r.point != UINT32_MAX) {
+      const std::uint32_t source = points.source[r.point];
+      if (r.removed < result.vertex_source.size()) result.vertex_source[r.removed] = source;
+      if (r.added != UINT32_MAX && !result.vertex_source.empty()) result.vertex_source.push_back(source);
+      if (source < result.output_vertex_of_input.size()) result.output_vertex_of_input[source] = r.removed;
+    }
+    for (int k = 0; k < 2; ++k)
+      if (r.reused[k] < result.face_source.size()) result.face_source[r.reused[k]] = result.face_source[r.parent[k]];
+  }
+  // The face slots left empty go, as from the mesh's faces.
+  std::vector<std::uint8_t> dropped(result.face_source.size(), 0);
+  for (const core::Relocation& r : made.relocations)
+    if (r.dropped < dropped.size()) dropped[r.dropped] = 1;
+  std::size_t next = 0;
+  for (std::size_t f = 0; f < result.face_source.size(); ++f)
+    if (!dropped[f]) result.face_source[next++] = result.face_source[f];
+  result.face_source.resize(next);
 }
 
 void check_options(const SimplifyOptions& options) {
@@ -220,7 +268,8 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
     out.refit_rms_after = fit.rms_after;
     out.refit_rounds = fit.rounds;
   }
-  if (repaired) repair_after_refit(out, options, points, surface, seam_or_locked(wedge_refit.on_seam, fixed, out.mesh.vertex_count()));
+  if (repaired)
+    repair_after_refit(out, options, MeshView(input.positions, input_faces), points, surface, seam_or_locked(wedge_refit.on_seam, fixed, out.mesh.vertex_count()));
   if (fit_values && out.contractions > 0 && out.stop_reason != StopReason::Cancelled) {
     // After the refit: the values fit the final positions. Seam and locked vertices keep theirs.
     const std::vector<std::uint8_t> held = seam_or_locked(wedge_refit.on_seam, fixed, out.mesh.vertex_count());

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -177,6 +178,20 @@ std::size_t folded_edges(const Mesh& m) {
   return folds;
 }
 
+// The distance from p to the input's border (its edges with one face).
+double to_border(const Mesh& input, const double* p) {
+  const auto at = [&](std::uint32_t v) { return Vec3{input.positions[3 * v], input.positions[3 * v + 1], input.positions[3 * v + 2]}; };
+  double best = HUGE_VAL;
+  const Vec3 q{p[0], p[1], p[2]};
+  for (const auto& [e, n] : test::edge_face_counts(input)) {
+    if (n != 1) continue;
+    const Vec3 a = at(e.first), d = at(e.second) - a;
+    const double t = std::clamp(dot(q - a, d) / dot(d, d), 0.0, 1.0);
+    best = std::min(best, length(q - (a + d * t)));
+  }
+  return best;
+}
+
 TEST(FarRepair, SimplifyFlipsWithoutFoldsTopologyChangesOrFartherPoints) {
   struct Case {
     Mesh input;
@@ -185,7 +200,7 @@ TEST(FarRepair, SimplifyFlipsWithoutFoldsTopologyChangesOrFartherPoints) {
   // (The bumpy sphere and the creased field at 1000 faces each have edges a flip brings closer.)
   const Case cases[] = {{test::height_field(60, creased), 1000}, {test::height_field(60, creased), 60},
                         {outofcore::bumpy_sphere(5000), 500}, {outofcore::bumpy_sphere(5000), 100}};
-  std::size_t total_flips = 0, total_moves = 0;
+  std::size_t total_flips = 0, total_moves = 0, total_relocations = 0;
   for (const Case& c : cases) {
     SimplifyOptions o;
     o.target_faces = c.faces;
@@ -199,15 +214,30 @@ TEST(FarRepair, SimplifyFlipsWithoutFoldsTopologyChangesOrFartherPoints) {
     EXPECT_EQ(plain.edge_flips + plain.vertex_moves, 0u);
     total_moves += flipped.vertex_moves;
     ASSERT_EQ(test::validity_problem(b), "");
-    // Only interior vertices moved: the border's stay where they were.
+    // Only interior vertices moved: the border's stay where they were (without relocations, which
+    // may take a border vertex along the border and put a new one on the input's border); every
+    // border vertex is on the input's border.
     ASSERT_EQ(a.positions.size(), b.positions.size());
-    const std::set<std::uint32_t> border = border_vertices(a);
-    for (std::uint32_t v : border)
-      for (int k = 0; k < 3; ++k) EXPECT_EQ(a.positions[3 * v + k], b.positions[3 * v + k]);
-    EXPECT_EQ(a.face_count(), b.face_count());
+    if (flipped.vertex_relocations == 0) {
+      for (std::uint32_t v : border_vertices(a))
+        for (int k = 0; k < 3; ++k) EXPECT_EQ(a.positions[3 * v + k], b.positions[3 * v + k]);
+    }
+    for (std::uint32_t v : border_vertices(b)) EXPECT_LT(to_border(c.input, &b.positions[3 * std::size_t(v)]), 1e-12);
+    // A relocation keeps the faces' count, or gives one up (a border split paired with an interior
+    // collapse, at most one in 256).
+    EXPECT_LE(b.face_count(), a.face_count());
+    EXPECT_GE(b.face_count() + a.face_count() / 256, a.face_count());
+    total_relocations += flipped.vertex_relocations;
+    // Provenance follows: a source for every vertex and face, each face's an input face.
+    EXPECT_EQ(flipped.vertex_source.size(), b.vertex_count());
+    EXPECT_EQ(flipped.face_source.size(), b.face_count());
+    for (std::uint32_t f : flipped.face_source) EXPECT_LT(f, c.input.face_count());
     EXPECT_EQ(test::non_manifold_edges(b), 0u);
-    EXPECT_EQ(test::boundary_edges(a), test::boundary_edges(b));
-    EXPECT_EQ(test::edge_face_counts(a).size(), test::edge_face_counts(b).size());  // same Euler characteristic
+    // Same Euler characteristic (V - E + F).
+    const auto euler = [](const Mesh& m) {
+      return std::ptrdiff_t(m.vertex_count()) - std::ptrdiff_t(test::edge_face_counts(m).size()) + std::ptrdiff_t(m.face_count());
+    };
+    EXPECT_EQ(euler(a), euler(b));
     for (const auto& [e, n] : directed_counts(b)) EXPECT_EQ(n, 1) << "an edge used twice the same way round";
     EXPECT_LE(folded_edges(b), folded_edges(a));
     const core::SurfaceDistance surface(corners_of(c.input));
@@ -218,6 +248,7 @@ TEST(FarRepair, SimplifyFlipsWithoutFoldsTopologyChangesOrFartherPoints) {
   }
   EXPECT_GT(total_flips, 0u);
   EXPECT_GT(total_moves, 0u);
+  EXPECT_GT(total_relocations, 0u);
 }
 
 // A bump cut off: the input is a 5x5 grid with its middle vertex raised, the approximation the
@@ -246,6 +277,145 @@ TEST(FarRepair, AVertexUnderACutOffBumpMovesOntoIt) {
   o.held = mask;
   flip(held, input, o);
   EXPECT_EQ(held.positions[3 * 12 + 2], 0.0);
+}
+
+// Relocations: a tent over the middle of an interior edge of a coarse flat grid (no flip or move
+// of that edge's corners brings the grid nearer its top without lifting flat ground), or a bulge
+// of the border between two border vertices. A vertex from the flat part of the grid goes to the
+// far place: the counts of faces and vertices stay, the largest distance falls, the mesh stays
+// valid with its border where it was, and the new vertex stands on the input.
+double tent(double x, double y) { return 0.03 * std::max(0.0, 1 - std::hypot(x - 0.3125, y - 0.5) / 0.1); }
+
+core::FarRepairResult relocate(Mesh& approx, const Mesh& input, std::size_t relocations, bool add_vertices = false) {
+  std::vector<std::uint32_t> source(input.vertex_count());
+  for (std::uint32_t v = 0; v < source.size(); ++v) source[v] = v;
+  const std::vector<std::uint8_t> on_border = core::points_on_border(input.indices, source);
+  core::FarRepairOptions o;
+  o.relocations = relocations;
+  o.point_on_border = on_border;
+  o.add_vertices = add_vertices;
+  return flip(approx, input, o);
+}
+
+// The larger of the largest distances from a's faces to the input's and from the input's to a's.
+double both_ways(const Mesh& a, const Mesh& input) {
+  return std::max(largest_distance(a, core::SurfaceDistance(corners_of(input))),
+                  largest_distance(input, core::SurfaceDistance(corners_of(a))));
+}
+
+void expect_relocated(const Mesh& input, const Mesh& grid) {
+  const core::SurfaceDistance surface(corners_of(input));
+  Mesh without = grid, with = grid;
+  EXPECT_TRUE(relocate(without, input, 0).relocations.empty());
+  const core::FarRepairResult r = relocate(with, input, 8);
+  ASSERT_GE(r.relocations.size(), 1u);
+  EXPECT_EQ(with.face_count(), grid.face_count());
+  EXPECT_EQ(with.vertex_count(), grid.vertex_count());
+  EXPECT_LT(both_ways(with, input), 0.8 * both_ways(without, input));
+  EXPECT_EQ(test::validity_problem(with), "");
+  EXPECT_EQ(test::non_manifold_edges(with), 0u);
+  EXPECT_EQ(test::boundary_edges(with), test::boundary_edges(grid));
+  EXPECT_EQ(folded_edges(with), 0u);
+  for (const auto& [e, n] : directed_counts(with)) EXPECT_EQ(n, 1) << "an edge used twice the same way round";
+  for (const core::Relocation& rel : r.relocations) {
+    EXPECT_NE(rel.removed, rel.kept);
+    const double* p = &with.positions[3 * std::size_t(rel.removed)];
+    std::uint32_t hint = UINT32_MAX;
+    EXPECT_LT(surface.distance({p[0], p[1], p[2]}, &hint), 1e-12);
+  }
+  // Every border vertex of the result lies on the input's border (the square's outline, or the
+  // bulge's), and the corners stay.
+  for (std::uint32_t v : border_vertices(with)) {
+    const double* p = &with.positions[3 * std::size_t(v)];
+    bool on_input = false;
+    for (std::uint32_t u : border_vertices(input))
+      on_input = on_input || (input.positions[3 * u] == p[0] && input.positions[3 * u + 1] == p[1] && input.positions[3 * u + 2] == p[2]);
+    EXPECT_TRUE(on_input) << "border vertex " << v << " at " << p[0] << " " << p[1];
+  }
+}
+
+TEST(FarRepair, ATentOverAnEdgeGetsAVertexFromTheFlat) {
+  const Mesh grid = test::grid(8);
+  expect_relocated(test::height_field(64, tent), grid);
+  // Without relocations the tent's top stays as far as the moves and flips leave it.
+  Mesh kept = grid;
+  const core::FarRepairResult r = relocate(kept, test::height_field(64, tent), 0);
+  EXPECT_GT(largest_distance(kept, core::SurfaceDistance(corners_of(test::height_field(64, tent)))), 0.01) << r.moves;
+}
+
+TEST(FarRepair, ABorderBulgeGetsABorderVertexFromAStraightBorder) {
+  // The input's border y = 0 bulges out (in the plane) between the grid's border vertices at
+  // x = 0.25 and 0.375; the grid's border edge there is a chord of the bulge.
+  Mesh input = test::grid(64);
+  for (std::size_t v = 0; v < input.vertex_count(); ++v) {
+    double* p = &input.positions[3 * v];
+    if (p[1] == 0) p[1] = -0.03 * std::max(0.0, 1 - std::abs(p[0] - 0.3125) / 0.0625);
+  }
+  expect_relocated(input, test::grid(8));
+}
+
+// height_field(n, f) cut along x = 0.5: the faces right of the cut use copies of the vertices on
+// it (a crack the mesh never welded).
+Mesh cracked(int n, double (*f)(double, double)) {
+  Mesh m = test::height_field(n, f);
+  std::vector<std::uint32_t> copy(m.vertex_count(), UINT32_MAX);
+  const auto column = [&](std::uint32_t v) { return int(v % std::uint32_t(n + 1)); };
+  for (std::size_t t = 0; t < m.face_count(); ++t) {
+    std::uint32_t* c = &m.indices[3 * t];
+    if (std::max({column(c[0]), column(c[1]), column(c[2])}) <= n / 2) continue;
+    for (int k = 0; k < 3; ++k) {
+      if (column(c[k]) != n / 2) continue;
+      if (copy[c[k]] == UINT32_MAX) {
+        copy[c[k]] = std::uint32_t(m.vertex_count());
+        m.positions.insert(m.positions.end(), {m.positions[3 * c[k]], m.positions[3 * c[k] + 1], m.positions[3 * c[k] + 2]});
+      }
+      c[k] = copy[c[k]];
+    }
+  }
+  return m;
+}
+double flat(double, double) { return 0; }
+double cone_on_the_cut(double x, double y) { return 0.03 * std::max(0.0, 1 - std::hypot(x - 0.5, y - 0.3125) / 0.0625); }
+
+// The places of the cut's vertices as each side has them.
+std::pair<std::vector<std::array<double, 3>>, std::vector<std::array<double, 3>>> sides_of_the_cut(const Mesh& m) {
+  std::set<std::uint32_t> left, right;
+  for (std::size_t t = 0; t < m.face_count(); ++t) {
+    const std::uint32_t* c = &m.indices[3 * t];
+    const double x = (m.positions[3 * c[0]] + m.positions[3 * c[1]] + m.positions[3 * c[2]]) / 3;
+    for (int k = 0; k < 3; ++k)
+      if (m.positions[3 * c[k]] == 0.5) (x < 0.5 ? left : right).insert(c[k]);
+  }
+  const auto places = [&](const std::set<std::uint32_t>& side) {
+    std::vector<std::array<double, 3>> p;
+    for (std::uint32_t v : side) p.push_back({m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]});
+    std::sort(p.begin(), p.end());
+    return p;
+  };
+  return {places(left), places(right)};
+}
+
+TEST(FarRepair, ACracksTwoSidesSplitTogether) {
+  // A cone whose top is on the cut, between two of the grid's vertices on it: the far place is an
+  // edge of the cut, which both sides have.
+  const Mesh input = cracked(64, cone_on_the_cut), grid = cracked(8, flat);
+  Mesh without = grid, alone = grid, with = grid;
+  EXPECT_TRUE(relocate(without, input, 0).relocations.empty());
+  // Without adding a vertex, neither side splits alone: the crack stays closed.
+  for (const core::Relocation& r : relocate(alone, input, 8).relocations) EXPECT_EQ(r.added, UINT32_MAX);
+  const auto [left_alone, right_alone] = sides_of_the_cut(alone);
+  EXPECT_EQ(left_alone, right_alone);
+  const core::FarRepairResult r = relocate(with, input, 8, true);
+  std::size_t added = 0;
+  for (const core::Relocation& rel : r.relocations) added += rel.added != UINT32_MAX;
+  ASSERT_GE(added, 1u);
+  EXPECT_EQ(with.face_count(), grid.face_count());
+  EXPECT_EQ(with.vertex_count(), grid.vertex_count() + added);
+  EXPECT_LT(both_ways(with, input), 0.8 * both_ways(without, input));
+  EXPECT_EQ(test::validity_problem(with), "");
+  const auto [left, right] = sides_of_the_cut(with);
+  EXPECT_EQ(left, right);
+  EXPECT_GT(left.size(), sides_of_the_cut(grid).first.size());
 }
 
 }  // namespace

@@ -204,12 +204,17 @@ struct SimplifyOptions {
   /// "Refit variants").
   bool refit_by_reduction = false;
   /// After the last contraction and the refit, repair the places farthest from the input
-  /// (core/far_repair.h): flip an edge (Hoppe et al. 1993 §4.3's edge swap) or move an interior
-  /// vertex toward the input points far from it, where that lowers the local Hausdorff distance
-  /// without raising the local share of E. The face count and the topology stay; borders, seams,
-  /// locked vertices and material boundaries are left as they are. As with the refit, an
-  /// observer's contractions are those made before it. The command line's default, with its refit
-  /// (what it costs and gains: docs/benchmarks.md, "Far places").
+  /// (core/far_repair.h): flip an edge (Hoppe et al. 1993 §4.3's edge swap), move an interior
+  /// vertex toward the input points far from it, or relocate a vertex (split the farthest place's
+  /// edge or face at the input, collapse the flattest vertex; on meshes without attributes,
+  /// materials or vertex properties), where that lowers the local Hausdorff distance without
+  /// raising the local share of E. The topology stays (Euler characteristic, components); the face
+  /// count too, but for a relocation that splits a border edge with no border vertex to spare (one
+  /// face fewer, at most one face in 256); the vertex count too, but for a split of both sides of a
+  /// crack (two coincident border edges: a vertex more; never with target_vertices). Border
+  /// vertices stay on the input's border, seams, locked vertices and material boundaries as they
+  /// are. As with the refit, an observer's contractions are those made before it. The command
+  /// line's default, with its refit (what it costs and gains: docs/benchmarks.md, "Far places").
   bool far_repair = false;
 
   /// With attributes (MeshView::attributes), their weights in the error.
@@ -256,6 +261,9 @@ struct SimplifyResult {
   /// With far_repair: the edges flipped (each output face keeps its face_source and material) and
   /// the vertices moved.
   std::size_t edge_flips = 0, vertex_moves = 0;
+  /// With far_repair: vertices taken from the flattest places to the farthest (see far_repair; the
+  /// provenance follows: a relocated vertex's source is the input vertex it stands at or nearest).
+  std::size_t vertex_relocations = 0;
   /// Input faces left out: degenerate (a repeated corner) and duplicates (kept once).
   std::size_t dropped_degenerate_faces = 0, dropped_duplicate_faces = 0;
 

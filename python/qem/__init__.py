@@ -149,7 +149,7 @@ class SimplifyResult(Mesh):
       "input already at or below target" or "cancelled" (the CLI's --json "stop");
       stop_detail: a sentence saying why.
     contractions, input_faces, input_vertices, refit_rounds, refit_rms_before, refit_rms_after,
-      edge_flips, vertex_moves, dropped_degenerate_faces, dropped_duplicate_faces: counts as in qem::SimplifyResult.
+      edge_flips, vertex_moves, vertex_relocations, dropped_degenerate_faces, dropped_duplicate_faces: counts as in qem::SimplifyResult.
     input_components, output_components: connected components of the input and the output
       (vertex-connected); pruned_components: removed by `prune`; rejected_component: contractions
       refused because a component would have dropped below its floor (keep_components).
@@ -166,7 +166,7 @@ class SimplifyResult(Mesh):
 
     __slots__ = (
         "max_error", "max_error_relative", "stop_reason", "stop_detail", "contractions", "input_faces",
-        "input_vertices", "refit_rounds", "refit_rms_before", "refit_rms_after", "edge_flips", "vertex_moves", "dropped_degenerate_faces",
+        "input_vertices", "refit_rounds", "refit_rms_before", "refit_rms_after", "edge_flips", "vertex_moves", "vertex_relocations", "dropped_degenerate_faces",
         "dropped_duplicate_faces", "rejected_component", "input_components", "output_components",
         "pruned_components", "output_to_input_distance", "output_to_input_distance_relative",
         "rejected_distance", "vertex_source", "face_source", "output_vertex_of_input", "record",
@@ -385,9 +385,10 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
         or none at mild reductions, only with optimal placement, without record and without texture
         coordinates or normals), "full" (3 rounds, every vertex), "none", or
         (rounds, points_per_vertex).
-      far_repair: after the refit, flip edges and move interior vertices where that lowers the local
-        Hausdorff distance to the input without raising the local error (borders and seams stay);
-        None (default): with the refit, as the command line.
+      far_repair: after the refit, flip edges, move interior vertices and relocate vertices from
+        flat places to far ones where that lowers the local Hausdorff distance to the input without
+        raising the local error (borders stay on the input's, seams stay); None (default): with the
+        refit, as the command line.
       threads: threads for the parallel parts (0 = all cores); the result is the same for any count.
       keep_components: every connected part keeps at least one face (a closed one four); False lets
         a part contract to nothing (GH97 as published).

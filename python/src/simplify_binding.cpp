@@ -267,6 +267,7 @@ void bind_simplify(py::module_& m) {
         out["refit_rms_after"] = r.refit_rms_after;
         out["edge_flips"] = r.edge_flips;
         out["vertex_moves"] = r.vertex_moves;
+        out["vertex_relocations"] = r.vertex_relocations;
         out["dropped_degenerate_faces"] = r.dropped_degenerate_faces;
         out["dropped_duplicate_faces"] = r.dropped_duplicate_faces;
         out["vertex_source"] = take_indices(std::move(r.vertex_source), 1, p.data.size() / 3);

@@ -58,6 +58,19 @@ class SurfaceDistance {
     if (hint != UINT32_MAX && std::sqrt(tree_.triangle_d2(q, hint)) <= d) return true;
     return distance(p, &hint) <= d;
   }
+  /// The point of the surface closest to p; `hint` as in distance().
+  Vec3 closest_point(const Vec3& p, std::uint32_t* hint) const {
+    const double q[3] = {p.x, p.y, p.z};
+    const measure_detail::TriangleBvh::Hit hit = tree_.closest(q, hint);
+    return {hit.point[0], hit.point[1], hit.point[2]};
+  }
+  /// The triangles of the surface within `radius` of p (appended to `out`, in no fixed order).
+  void triangles_near(const Vec3& p, double radius, std::vector<std::uint32_t>& out) const {
+    const double q[3] = {p.x, p.y, p.z};
+    tree_.within(q, radius * radius, out);
+  }
+  /// The corners of triangle t (9 doubles).
+  const double* triangle(std::uint32_t t) const { return tree_.triangle(t); }
   /// Distance from p to triangle t of the surface (at least distance(p)).
   double distance_to(const Vec3& p, std::uint32_t t) const {
     const double q[3] = {p.x, p.y, p.z};

@@ -4,9 +4,12 @@
 #include <array>
 #include <cmath>
 #include <initializer_list>
+#include <iterator>
 #include <numbers>
+#include <queue>
 #include <vector>
 
+#include "core/border_placement.h"
 #include "core/parallel_chunks.h"
 #include "measure/bvh.h"
 #include "measure/point_triangle.h"
@@ -46,6 +49,7 @@ struct FaceScore {
   double most = 0;    // largest sample distance
   double energy = 0;  // area * mean squared sample distance (complete only when all were taken)
   std::uint32_t hint = UINT32_MAX;  // a face of the input near the face, where searches start
+  double u = 0, v = 0;              // where the largest is (weights of b - a and c - a)
 };
 
 class Repairer {
@@ -70,8 +74,22 @@ class Repairer {
     for (std::uint32_t v = 0; v < n; ++v) order[v] = v;
     const auto key = [&](std::uint32_t v) { return std::array<double, 3>{x_[v].x, x_[v].y, x_[v].z}; };
     std::sort(order.begin(), order.end(), [&](std::uint32_t u, std::uint32_t v) { return key(u) < key(v); });
-    for (std::size_t i = 1; i < n; ++i)
-      if (key(order[i]) == key(order[i - 1])) held_[order[i]] = held_[order[i - 1]] = 1;
+    twin_.assign(n, UINT32_MAX);
+    caller_held_ = held_;
+    alike_.assign(n, UINT32_MAX);
+    for (std::size_t i = 0; i < n; ++i) {
+      std::size_t j = i;
+      while (j + 1 < n && key(order[j + 1]) == key(order[i])) ++j;
+      if (j > i) {
+        // Vertices at one place: the sides of a seam or crack the input never welded.
+        places_.emplace_back(order.begin() + std::ptrdiff_t(i), order.begin() + std::ptrdiff_t(j) + 1);
+        for (std::size_t k = i; k <= j; ++k) held_[order[k]] = 1, alike_[order[k]] = std::uint32_t(places_.size() - 1);
+      }
+      // A pair, neither held by the caller: a crack's two sides (relocations split both together).
+      const std::uint32_t a = order[i], b = order[j];
+      if (j == i + 1 && !caller_held_[a] && !caller_held_[b]) twin_[a] = b, twin_[b] = a;
+      i = j;
+    }
     faces_at_.assign(n, {});
     for (std::uint32_t f = 0; f < face_count(); ++f)
       for (int k = 0; k < 3; ++k) faces_at_[tri_[3 * f + k]].push_back(f);
@@ -91,7 +109,16 @@ class Repairer {
       if (flips == 0) break;
     }
     if (opt_.move_vertices) r.moves = move_vertices();
+    if (opt_.relocations > 0 && mesh_.attributes.empty() && mesh_.face_materials.empty() && mesh_.vertex_properties.empty())
+      r.relocations = relocate();
+    if (std::find(dead_face_.begin(), dead_face_.end(), 1) != dead_face_.end()) {
+      std::size_t next = 0;
+      for (std::size_t f = 0; f < face_count(); ++f)
+        if (!dead_face_[f]) std::copy_n(&tri_[3 * f], 3, &tri_[3 * next++]);
+      tri_.resize(3 * next);
+    }
     mesh_.indices = tri_;
+    mesh_.positions.resize(3 * x_.size());
     for (std::uint32_t v : moved_) {
       const Vec3 p = frame_.to_model(x_[v]);
       mesh_.positions[3 * std::size_t(v)] = p.x, mesh_.positions[3 * std::size_t(v) + 1] = p.y,
@@ -111,13 +138,31 @@ class Repairer {
     FaceScore s;
     for (const SampleAt& at : kOrder) {
       const double d = surface_.distance(a + (b - a) * at.u + (c - a) * at.v, &hint);
-      s.most = std::max(s.most, d);
+      if (d > s.most) s.most = d, s.u = at.u, s.v = at.v;
       s.energy += d * d;
       if (d >= limit) break;
     }
     s.energy *= 0.5 * length(cross(b - a, c - a)) / kSamples;
     s.hint = hint;
     return s;
+  }
+  // Moves s's largest sample of face abc to the peak of the distance near it (a grid's points miss
+  // the peak between them): a climb over the face in halving steps.
+  void climb(const Vec3& a, const Vec3& b, const Vec3& c, FaceScore& s) const {
+    constexpr int kSteps = 4;
+    constexpr double kMoves[6][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}, {1, -1}, {-1, 1}};
+    double &u = s.u, &v = s.v, &most = s.most, h = 1.0 / kGrid;
+    std::uint32_t hint = s.hint;
+    for (int step = 0; step < kSteps; ++step) {
+      h *= 0.5;
+      const double u0 = u, v0 = v;
+      for (const auto& m : kMoves) {
+        const double x = u0 + m[0] * h, y = v0 + m[1] * h;
+        if (x < 0 || y < 0 || x + y > 1) continue;
+        const double d = surface_.distance(a + (b - a) * x + (c - a) * y, &hint);
+        if (d > most) most = d, u = x, v = y;
+      }
+    }
   }
   FaceScore score(std::uint32_t f, double limit = HUGE_VAL) const {
     const std::uint32_t* t = &tri_[3 * f];
@@ -509,6 +554,560 @@ class Repairer {
     return flips;
   }
 
+  // ---- Relocations: a vertex taken from the flattest place to the farthest ----
+
+  static constexpr std::uint32_t kNew = UINT32_MAX - 1;  // the new vertex, in a planned face
+  static constexpr std::uint32_t kNewTwin = UINT32_MAX - 2;  // its twin, on a crack's other side
+  static constexpr double kNothingFar = 1e-9;
+  // At most one face in this many may be given up by border splits paired with interior collapses.
+  static constexpr std::size_t kGiveUpShare = 256;
+  static constexpr std::size_t kStuck = 8;
+  using Corners = std::array<std::uint32_t, 3>;
+
+  // A planned set of new faces replacing `old` faces: their scores, and the old faces' input points
+  // each with its nearest new face.
+  struct Plan {
+    std::vector<std::uint32_t> old;    // the faces replaced (their slots are reused first)
+    std::vector<Corners> faces;        // the new faces (kNew: the new vertex)
+    std::vector<std::uint32_t> parent;  // per new face, the old face it comes from
+    std::vector<FaceScore> scores;
+    std::vector<std::uint32_t> points, nearest;  // the old faces' points; index into faces
+    std::vector<double> d2;
+    double most = 0;          // the new faces' largest distance, both ways
+    double old_energy = 0, energy = 0;
+  };
+  struct Split : Plan {
+    Vec3 y{};                        // where the new vertex goes
+    std::uint32_t point = UINT32_MAX;  // the input point at or nearest y
+    bool border = false;             // a border edge's: one face more, not two
+    bool at_point = false;           // y is the point's place
+    bool crack = false;              // a border edge and its twin: two new vertices, two faces more
+    bool hold_new = false;           // the new vertex is held (it splits a held edge)
+  };
+  struct Collapse : Plan {
+    std::uint32_t u = 0, v = 0;  // u goes into v
+  };
+
+  // The faces that have edge ab (either way round).
+  int edge_faces(std::uint32_t a, std::uint32_t b) const {
+    int n = 0;
+    for (std::uint32_t g : faces_at_[a]) {
+      const std::uint32_t* t = &tri_[3 * g];
+      n += t[0] == b || t[1] == b || t[2] == b;
+    }
+    return n;
+  }
+  bool border_edge(std::uint32_t a, std::uint32_t b) const { return edge_faces(a, b) == 1; }
+  // The other vertices at v's position.
+  std::span<const std::uint32_t> alike(std::uint32_t v) const {
+    if (v >= alike_.size() || alike_[v] == UINT32_MAX) return {};
+    return places_[alike_[v]];
+  }
+  // Whether another vertex at a's position has an edge to another at b's.
+  bool joined_elsewhere(std::uint32_t a, std::uint32_t b) const {
+    for (std::uint32_t x : alike(a))
+      for (std::uint32_t y : alike(b))
+        if (x != a && y != b && edge_faces(x, y) > 0) return true;
+    return false;
+  }
+  // The border neighbours of v (the other ends of its border edges).
+  std::vector<std::uint32_t> border_neighbours(std::uint32_t v) const {
+    std::vector<std::uint32_t> r;
+    for (std::uint32_t x : ring(v))
+      if (border_edge(v, x)) r.push_back(x);
+    return r;
+  }
+
+  Vec3 at(std::uint32_t v, const Vec3& y) const { return v == kNew || v == kNewTwin ? y : x_[v]; }
+
+  // Scores plan p's faces (the new vertex at y), stopping at the first whose samples reach
+  // `limit`, and hands its old faces' points to the nearest new face. False: a face reached the
+  // limit (p.most is then not final).
+  bool score_plan(Plan& p, const Vec3& y, double limit) const {
+    p.scores.resize(p.faces.size());
+    p.most = 0, p.energy = 0, p.old_energy = 0;
+    for (std::size_t i = 0; i < p.faces.size(); ++i) {
+      const Corners& t = p.faces[i];
+      p.scores[i] = score(at(t[0], y), at(t[1], y), at(t[2], y), score_[p.parent[i]].hint, limit);
+      if (p.scores[i].most >= limit) return false;
+      climb(at(t[0], y), at(t[1], y), at(t[2], y), p.scores[i]);
+      if (p.scores[i].most >= limit) return false;
+      p.most = std::max(p.most, p.scores[i].most);
+      p.energy += p.scores[i].energy;
+    }
+    p.points.clear();
+    for (std::uint32_t f : p.old) {
+      p.old_energy += score_[f].energy;
+      for (std::uint32_t q : points_of_[f]) p.points.push_back(q), p.old_energy += weights_[q] * weight_scale_ * d2_[q];
+    }
+    p.nearest.resize(p.points.size());
+    p.d2.resize(p.points.size());
+    double most2 = 0;
+    for (std::size_t i = 0; i < p.points.size(); ++i) {
+      const Vec3 q = point(p.points[i]);
+      double best = HUGE_VAL;
+      for (std::size_t k = 0; k < p.faces.size(); ++k) {
+        const Corners& t = p.faces[k];
+        const double d2 = measure_detail::squared_distance(
+            q, measure_detail::closest_point_on_triangle(q, at(t[0], y), at(t[1], y), at(t[2], y)));
+        if (d2 < best) best = d2, p.nearest[i] = std::uint32_t(k);
+      }
+      p.d2[i] = best;
+      most2 = std::max(most2, best);
+      p.energy += weights_[p.points[i]] * weight_scale_ * best;
+    }
+    p.most = std::max(p.most, std::sqrt(most2));
+    return p.most < limit;
+  }
+
+  // Whether each new face of p is not degenerate and turns by at most the limit from its parent.
+  bool keeps_facing(const Plan& p, const Vec3& y) const {
+    for (std::size_t i = 0; i < p.faces.size(); ++i) {
+      const Corners& t = p.faces[i];
+      const std::uint32_t* o = &tri_[3 * p.parent[i]];
+      const Vec3 m = normalized(cross(at(t[1], y) - at(t[0], y), at(t[2], y) - at(t[0], y)));
+      const Vec3 n = normalized(normal(o[0], o[1], o[2]));
+      if (dot(m, m) == 0 || dot(n, n) == 0 || dot(m, n) < cos_turn_) return false;
+    }
+    return true;
+  }
+
+  // The input's surface between its vertices round plan p (the points are only its vertices, and
+  // a large input triangle, such as a flat cap's, has none where the output may leave it): a sample
+  // of an input triangle near p's new faces may not end `limit` or farther from them and from the
+  // faces round the plan (a crack's other side included) when it was nearer than that to the old
+  // faces. (Samples already that far, by this local view, are near other faces or far already.)
+  bool input_stays_near(const Plan& p, const Vec3& y, double limit) {
+    Vec3 centre{0, 0, 0};
+    for (const Corners& t : p.faces)
+      for (std::uint32_t v : t) centre = centre + at(v, y);
+    centre = centre * (1.0 / double(3 * p.faces.size()));
+    double radius = 0;
+    for (const Corners& t : p.faces)
+      for (std::uint32_t v : t) radius = std::max(radius, length(at(v, y) - centre));
+    std::vector<std::uint32_t>& context = scratch_context_;
+    context.clear();
+    for (const Corners& t : p.faces)
+      for (std::uint32_t v : t)
+        if (v < kNewTwin) {
+          const auto add = [&](std::uint32_t u) {
+            for (std::uint32_t g : faces_at_[u])
+              if (std::find(p.old.begin(), p.old.end(), g) == p.old.end()) context.push_back(g);
+          };
+          add(v);
+          for (std::uint32_t u : alike(v)) add(u);  // a crack's other side too
+        }
+    std::sort(context.begin(), context.end());
+    context.erase(std::unique(context.begin(), context.end()), context.end());
+    const auto nearest2 = [&](const Vec3& q, const auto& faces, const auto& corner) {
+      double best = HUGE_VAL;
+      for (const auto& f : faces) {
+        const auto [a, b, c] = corner(f);
+        best = std::min(best, measure_detail::squared_distance(q, measure_detail::closest_point_on_triangle(q, a, b, c)));
+      }
+      return best;
+    };
+    const auto planned = [&](const Corners& t) { return std::array<Vec3, 3>{at(t[0], y), at(t[1], y), at(t[2], y)}; };
+    const auto current = [&](std::uint32_t f) {
+      return std::array<Vec3, 3>{x_[tri_[3 * f]], x_[tri_[3 * f + 1]], x_[tri_[3 * f + 2]]};
+    };
+    std::vector<std::uint32_t>& near = scratch_near_;
+    near.clear();
+    surface_.triangles_near(centre, radius, near);
+    const double limit2 = limit * limit, radius2 = radius * radius;
+    for (std::uint32_t t : near) {
+      const double* c = surface_.triangle(t);
+      const Vec3 a{c[0], c[1], c[2]}, b{c[3], c[4], c[5]}, d{c[6], c[7], c[8]};
+      // Samples no farther apart than a quarter of the region, up to 16 divisions an edge.
+      const double longest = std::max({length(b - a), length(d - b), length(a - d)});
+      const int m = std::clamp(int(std::ceil(4 * longest / std::max(radius, 1e-300))), 1, 16);
+      for (int i = 0; i <= m; ++i)
+        for (int j = 0; i + j <= m; ++j) {
+          const Vec3 q = a + (b - a) * (double(i) / m) + (d - a) * (double(j) / m);
+          if (measure_detail::squared_distance(q, centre) > radius2) continue;
+          const double made = nearest2(q, p.faces, planned);
+          if (made < limit2) continue;
+          const double rest = nearest2(q, context, current);
+          if (std::min(made, rest) < limit2) continue;
+          if (nearest2(q, p.old, current) < limit2) return false;
+        }
+    }
+    return true;
+  }
+
+  // The split of far face f: at the point of f nearest the input's farthest from it (or of the
+  // input's farthest point from f), the edge there divided when the point is near an interior
+  // edge, else the face; the new vertex on the input. False: it would not lower the distance.
+  bool plan_split(std::uint32_t f, Split& s) {
+    const std::uint32_t* t = &tri_[3 * f];
+    const Vec3 &a = x_[t[0]], &b = x_[t[1]], &c = x_[t[2]];
+    Vec3 near{};
+    if (near_most_[f] >= score_[f].most) {
+      std::uint32_t far = UINT32_MAX;
+      for (std::uint32_t q : points_of_[f])
+        if (far == UINT32_MAX || d2_[q] > d2_[far]) far = q;
+      if (far == UINT32_MAX) return false;
+      s.point = far, s.y = point(far), s.at_point = true;
+      near = measure_detail::closest_point_on_triangle(s.y, a, b, c);
+    } else {
+      std::uint32_t hint = score_[f].hint;
+      near = a + (b - a) * score_[f].u + (c - a) * score_[f].v;
+      s.y = surface_.closest_point(near, &hint), s.at_point = false;
+      double best = HUGE_VAL;
+      for (std::uint32_t q : points_of_[f]) {
+        const double d2 = measure_detail::squared_distance(point(q), s.y);
+        if (d2 < best) best = d2, s.point = q;
+      }
+    }
+    const std::array<double, 3> w = measure_detail::closest_point_weights(near, a, b, c);
+    const int k = int(std::min_element(w.begin(), w.end()) - w.begin());
+    s.old = {f};
+    s.faces.clear(), s.parent.clear();
+    // Near an edge (the corner across it weighs little): the edge splits, so that no sliver is
+    // left between the point and the edge.
+    constexpr double kNearEdge = 0.2;
+    const std::uint32_t ea = t[(k + 1) % 3], eb = t[(k + 2) % 3], ec = t[k];
+    const std::uint32_t g = w[k] < kNearEdge ? across(f, ea, eb) : UINT32_MAX;
+    std::uint32_t ed = UINT32_MAX;
+    if (g != UINT32_MAX)
+      for (int i = 0; i < 3; ++i)
+        if (tri_[3 * g + i] != ea && tri_[3 * g + i] != eb) ed = tri_[3 * g + i];
+    s.border = false, s.crack = false, s.hold_new = false;
+    if (w[k] < kNearEdge && g == UINT32_MAX) {
+      // A border edge: split along the input's border, at its input point farthest from the
+      // output edge (or, when the output is what is far, nearest the far sample), so that the
+      // border stays on the input's (a split that adds one face, paired with a border collapse).
+      if (opt_.point_on_border.empty() || !border_edge(ea, eb)) return false;
+      // Held ends stay as they are, unless only their place holds them (other vertices share it:
+      // the sides of a crack the input never welded): where another side has the same edge, a
+      // crack's two sides split together (a vertex more); where none has, the sides already part
+      // there and this one splits alone.
+      std::uint32_t f2 = UINT32_MAX;
+      s.hold_new = held(ea) || held(eb);
+      if (s.hold_new) {
+        if (caller_held_[ea] || caller_held_[eb]) return false;
+        if (joined_elsewhere(ea, eb)) {
+          if (twin_[ea] == UINT32_MAX || twin_[eb] == UINT32_MAX) return false;
+          if (!opt_.add_vertices || !border_edge(twin_[ea], twin_[eb])) return false;
+          for (std::uint32_t h : faces_at_[twin_[ea]]) {
+            const std::uint32_t* o = &tri_[3 * h];
+            if (o[0] == twin_[eb] || o[1] == twin_[eb] || o[2] == twin_[eb]) f2 = h;
+          }
+          if (f2 == UINT32_MAX || f2 == f) return false;
+        }
+      }
+      // The input's border points nearest the faces round the edge's ends (and their twins': the
+      // points at a crack go to either side).
+      std::vector<std::uint32_t>& around = scratch_context_;
+      around.clear();
+      for (std::uint32_t v : {ea, eb}) {
+        around.insert(around.end(), faces_at_[v].begin(), faces_at_[v].end());
+        for (std::uint32_t u : alike(v)) around.insert(around.end(), faces_at_[u].begin(), faces_at_[u].end());
+      }
+      std::sort(around.begin(), around.end());
+      around.erase(std::unique(around.begin(), around.end()), around.end());
+      std::uint32_t best = UINT32_MAX;
+      double key = 0;
+      for (std::uint32_t g : around)
+        for (std::uint32_t q : points_of_[g]) {
+          if (!opt_.point_on_border[q]) continue;
+          const double d2 = near_most_[f] >= score_[f].most ? -d2_[q] : measure_detail::squared_distance(point(q), near);
+          if (best == UINT32_MAX || d2 < key || (d2 == key && q < best)) best = q, key = d2;
+        }
+      if (best == UINT32_MAX) return false;
+      s.point = best, s.y = point(best), s.border = true, s.at_point = true, s.crack = false;
+      s.faces = {{ea, kNew, ec}, {kNew, eb, ec}};
+      s.parent = {f, f};
+      if (f2 != UINT32_MAX) {
+        // The other side's face, split the same way at the same place (the twin of the new vertex).
+        const std::uint32_t* o = &tri_[3 * f2];
+        int k2 = 0;
+        while (o[k2] != twin_[ea]) ++k2;
+        const bool along = o[(k2 + 1) % 3] == twin_[eb];
+        const std::uint32_t other = o[(k2 + (along ? 2 : 1)) % 3];  // the corner off the edge
+        // (a', b', c) -> (a', w', c), (w', b', c); (a', c, b') -> (a', c, w'), (w', c, b').
+        const Corners first = along ? Corners{twin_[ea], kNewTwin, other} : Corners{twin_[ea], other, kNewTwin};
+        const Corners second = along ? Corners{kNewTwin, twin_[eb], other} : Corners{kNewTwin, other, twin_[eb]};
+        ensure_scored(f2);
+        s.old.push_back(f2);
+        s.faces = {s.faces[0], first, s.faces[1], second};
+        s.parent = {f, f2, f, f2};
+        s.border = false, s.crack = true;
+      }
+    } else if (g != UINT32_MAX && ed != UINT32_MAX && ed != ec) {
+      ensure_scored(g);
+      s.old.push_back(g);
+      // The first of each parent's new faces takes its slot (apply).
+      s.faces = {{ea, kNew, ec}, {eb, kNew, ed}, {kNew, eb, ec}, {kNew, ea, ed}};
+      s.parent = {f, g, f, g};
+    } else {
+      s.faces = {{t[0], t[1], kNew}, {t[1], t[2], kNew}, {t[2], t[0], kNew}};
+      s.parent = {f, f, f};
+    }
+    if (!keeps_facing(s, s.y)) return false;
+    return score_plan(s, s.y, HUGE_VAL) && s.most < local(f) && input_stays_near(s, s.y, local(f));
+  }
+
+  // The vertices adjacent to v (ascending, once each).
+  std::vector<std::uint32_t> ring(std::uint32_t v) const {
+    std::vector<std::uint32_t> r;
+    for (std::uint32_t f : faces_at_[v])
+      for (int k = 0; k < 3; ++k)
+        if (tri_[3 * f + k] != v) r.push_back(tri_[3 * f + k]);
+    std::sort(r.begin(), r.end());
+    r.erase(std::unique(r.begin(), r.end()), r.end());
+    return r;
+  }
+
+  // What removing interior vertex v would add to E, roughly: its distance to the plane of its ring
+  // (through the ring's centroid, normal to the fan), squared, times the fan's area.
+  double removal_cost(std::uint32_t v) const {
+    const std::vector<std::uint32_t> r = ring(v);
+    Vec3 centroid{0, 0, 0}, n{0, 0, 0};
+    double area = 0;
+    for (std::uint32_t u : r) centroid = centroid + x_[u];
+    centroid = centroid * (1.0 / double(r.size()));
+    for (std::uint32_t f : faces_at_[v]) {
+      const Vec3 m = normal(tri_[3 * f], tri_[3 * f + 1], tri_[3 * f + 2]);
+      n = n + m;
+      area += 0.5 * length(m);
+    }
+    const double d = dot(x_[v] - centroid, normalized(n));
+    return d * d * area;
+  }
+
+  // The best collapse of u into a neighbour (lowest energy), its faces within `limit`; false: none.
+  // `border`: u is a border vertex, and goes into one of its two border neighbours (the one face of
+  // that edge dies); a corner (a turn above kCornerDegrees, as the contractions keep) stays.
+  bool plan_collapse(std::uint32_t u, double limit, bool border, Collapse& best) {
+    const std::vector<std::uint32_t> around = ring(u);
+    for (std::uint32_t x : around)
+      if (held(x)) return false;
+    std::vector<std::uint32_t> targets = around;
+    if (border) {
+      targets = border_neighbours(u);
+      if (targets.size() != 2) return false;
+      const Vec3 in = normalized(x_[u] - x_[targets[0]]), out = normalized(x_[targets[1]] - x_[u]);
+      if (dot(in, out) < std::cos(kCornerDegrees * std::numbers::pi / 180)) return false;
+    }
+    const std::size_t dying = border ? 1 : 2;
+    bool found = false;
+    Collapse c;
+    for (std::uint32_t v : targets) {
+      // The faces of edge uv die; their third corners must be the only common neighbours of u and
+      // v (the link condition: else the collapse pinches the surface).
+      std::vector<std::uint32_t> opposite;
+      c.old.clear(), c.faces.clear(), c.parent.clear();
+      for (std::uint32_t f : faces_at_[u]) {
+        const std::uint32_t* t = &tri_[3 * f];
+        c.old.push_back(f);
+        if (t[0] == v || t[1] == v || t[2] == v) {
+          for (int k = 0; k < 3; ++k)
+            if (t[k] != u && t[k] != v) opposite.push_back(t[k]);
+          continue;
+        }
+        Corners moved{t[0], t[1], t[2]};
+        for (std::uint32_t& k : moved)
+          if (k == u) k = v;
+        c.faces.push_back(moved), c.parent.push_back(f);
+      }
+      std::sort(opposite.begin(), opposite.end());
+      if (opposite.size() != dying || std::adjacent_find(opposite.begin(), opposite.end()) != opposite.end()) continue;
+      const std::vector<std::uint32_t> other = ring(v);
+      std::vector<std::uint32_t> common;
+      std::set_intersection(around.begin(), around.end(), other.begin(), other.end(), std::back_inserter(common));
+      if (common != opposite) continue;
+      if (!keeps_facing(c, {}) || !score_plan(c, {}, limit) || !input_stays_near(c, {}, limit)) continue;
+      if (!found || c.energy - c.old_energy < best.energy - best.old_energy) {
+        best = c, best.u = u, best.v = v;
+        found = true;
+      }
+    }
+    return found;
+  }
+
+  // Whether border vertex v may go along its border: two border edges, every edge at it with one
+  // or two faces.
+  bool border_removable(std::uint32_t v) const {
+    for (std::uint32_t x : ring(v))
+      if (edge_faces(v, x) > 2) return false;
+    return border_neighbours(v).size() == 2;
+  }
+  // As removal_cost, for a border vertex: its distance to the line of its border neighbours.
+  double border_removal_cost(std::uint32_t v) const {
+    const std::vector<std::uint32_t> ends = border_neighbours(v);
+    const Vec3 along = normalized(x_[ends[1]] - x_[ends[0]]), off = x_[v] - x_[ends[0]];
+    const Vec3 d = off - along * dot(off, along);
+    double area = 0;
+    for (std::uint32_t f : faces_at_[v]) area += 0.5 * length(normal(tri_[3 * f], tri_[3 * f + 1], tri_[3 * f + 2]));
+    return dot(d, d) * area;
+  }
+
+  // Replaces plan p's old faces by its new ones (the new vertex is w), in the old faces' slots
+  // and then in `spare` ones.
+  void apply(const Plan& p, std::uint32_t w, std::uint32_t twin, std::span<const std::uint32_t> spare) {
+    for (std::uint32_t f : p.old) {
+      for (int k = 0; k < 3; ++k) std::erase(faces_at_[tri_[3 * f + k]], f);
+      points_of_[f].clear();
+    }
+    std::vector<std::uint32_t> slot(p.faces.size());
+    for (std::size_t i = 0; i < p.faces.size(); ++i) {
+      slot[i] = i < p.old.size() ? p.old[i] : spare[i - p.old.size()];
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t v = p.faces[i][k] == kNew ? w : p.faces[i][k] == kNewTwin ? twin : p.faces[i][k];
+        tri_[3 * slot[i] + k] = v;
+        faces_at_[v].push_back(slot[i]);
+      }
+      score_[slot[i]] = p.scores[i], scored_[slot[i]] = 1, hint_[slot[i]] = p.scores[i].hint, peaked_[slot[i]] = 1;
+    }
+    for (std::size_t i = 0; i < p.points.size(); ++i) d2_[p.points[i]] = p.d2[i], points_of_[slot[p.nearest[i]]].push_back(p.points[i]);
+    for (std::uint32_t f : slot) near_most_[f] = nearest_most(f);
+  }
+
+  // Relocations, farthest place first, until one cannot be made or opt_.relocations are.
+  std::vector<Relocation> relocate() {
+    std::vector<Relocation> made;
+    const std::uint32_t nv = std::uint32_t(x_.size());
+    // The interior vertices that may go, flattest first.
+    // (Listed when the first split is found: most runs have a far place no split mends.)
+    std::vector<std::pair<double, std::uint32_t>> flat, flat_border;
+    const auto list_removable = [&] {
+      for (std::uint32_t v = 0; v < nv; ++v) {
+        if (held(v) || faces_at_[v].empty()) continue;
+        if (interior(v))
+          flat.push_back({removal_cost(v), v});
+        else if (!opt_.point_on_border.empty() && border_removable(v))
+          flat_border.push_back({border_removal_cost(v), v});
+      }
+      std::sort(flat.begin(), flat.end());
+      std::sort(flat_border.begin(), flat_border.end());
+    };
+    std::vector<std::uint8_t> spent(nv, 0);  // new vertices: they stay
+    peaked_.assign(face_count(), 0);
+    dead_face_.assign(face_count(), 0);
+    std::size_t faces_given_up = 0, stuck = 0;
+    const std::size_t max_given_up = face_count() / kGiveUpShare;
+    // What the relocations together may add to E: a share of its input side (the points' squared
+    // distances by their areas; the output side is about as large), so that E stays where the
+    // contractions and the refit put it while the largest distance falls.
+    double budget = 0;
+    for (std::size_t q = 0; q < d2_.size(); ++q) budget += weights_[q] * weight_scale_ * d2_[q];
+    budget *= 2 * opt_.relocation_budget;
+    // The faces by local(), farthest first; an entry whose face changed since is skipped.
+    std::priority_queue<std::pair<double, std::uint32_t>> heap;
+    for (std::uint32_t f = 0; f < face_count(); ++f) heap.push({local(f), f});
+    // Collapses tried per relocation: the flattest places are the cheapest, so the first few that
+    // are allowed at all are as good as any.
+    constexpr std::size_t kCollapsesTried = 32;
+    Split split;
+    Collapse collapse, candidate;
+    while (made.size() < opt_.relocations) {
+      std::uint32_t f = UINT32_MAX;
+      while (!heap.empty() && f == UINT32_MAX) {
+        const auto [value, g] = heap.top();
+        heap.pop();
+        if (dead_face_[g] || value != local(g)) continue;
+        if (!scored_[g]) {
+          ensure_scored(g);
+          heap.push({local(g), g});
+          continue;
+        }
+        if (!peaked_[g]) {
+          const std::uint32_t* t = &tri_[3 * g];
+          climb(x_[t[0]], x_[t[1]], x_[t[2]], score_[g]);
+          peaked_[g] = 1;
+          heap.push({local(g), g});
+          continue;
+        }
+        f = g;
+      }
+      // Distances at the rounding's scale (the frame's diagonal is 1) are not far places. A place
+      // no split mends is passed over (the next farthest may still be), up to kStuck in a row.
+      if (f == UINT32_MAX || local(f) < kNothingFar) break;
+      if (!plan_split(f, split)) {
+        if (++stuck == kStuck) break;
+        continue;
+      }
+      if (made.empty() && flat.empty() && flat_border.empty()) list_removable();
+      const double largest = local(f);
+      // The collapse may not make a new far place: its faces stay well below the farthest.
+      const double limit = 0.5 * largest;
+      std::vector<std::uint8_t> near_split(x_.size(), 0);  // vertices of the split's faces
+      for (std::uint32_t g : split.old)
+        for (int k = 0; k < 3; ++k) near_split[tri_[3 * g + k]] = 1;
+      // The first allowed collapse of the flattest `list`'s vertices (border ones: along the border).
+      const auto find_collapse = [&](const std::vector<std::pair<double, std::uint32_t>>& list, bool border) {
+        std::size_t tried = 0;
+        for (const auto& [cost, u] : list) {
+          if (tried == kCollapsesTried) break;
+          if (spent[u] || faces_at_[u].empty() || near_split[u]) continue;
+          bool apart = true;
+          for (std::uint32_t x : ring(u)) apart = apart && !near_split[x];
+          if (!apart) continue;
+          ++tried;
+          if (!plan_collapse(u, limit, border, candidate)) continue;
+          const double rise = split.energy + candidate.energy - (split.old_energy + candidate.old_energy);
+          if (rise > budget) continue;
+          budget -= std::max(rise, 0.0);
+          collapse = candidate;
+          return true;
+        }
+        return false;
+      };
+      bool found = find_collapse(split.border ? flat_border : flat, split.border);
+      // A border split with no border vertex to spare takes an interior one, and the output ends a
+      // face below its count (a few: the target is a bound, and lod levels stay nested in size).
+      bool short_one = false;
+      if (!found && split.border && faces_given_up < max_given_up) found = short_one = find_collapse(flat, false);
+      if (!found) {
+        if (++stuck == kStuck) break;
+        continue;
+      }
+      stuck = 0;
+      const std::uint32_t w = collapse.u;
+      Relocation r;
+      r.removed = w, r.kept = collapse.v, r.point = split.point, r.at_point = split.at_point;
+      // The collapse's old faces list the two that die among the rest: its new faces go in the
+      // others' slots, the dead ones' are spare.
+      std::vector<std::uint32_t> kept_slots;
+      std::vector<std::uint32_t> freed;
+      for (std::uint32_t g : collapse.old) {
+        const std::uint32_t* t = &tri_[3 * g];
+        (t[0] == collapse.v || t[1] == collapse.v || t[2] == collapse.v ? freed : kept_slots).push_back(g);
+      }
+      collapse.old = kept_slots;
+      collapse.old.insert(collapse.old.end(), freed.begin(), freed.end());
+      apply(collapse, UINT32_MAX, UINT32_MAX, {});
+      faces_at_[w].clear();
+      x_[w] = split.y;
+      note_moved(w);
+      spent[w] = 1;
+      // (Held so: no later split joins it to a place it may share with another vertex.)
+      held_[w] = caller_held_[w] = split.hold_new;
+      if (split.crack) {
+        // The new vertex's twin, on the crack's other side: a vertex more.
+        r.added = std::uint32_t(x_.size());
+        x_.push_back(split.y), held_.push_back(1), twin_.push_back(w), faces_at_.emplace_back(), spent.push_back(1);
+        caller_held_.push_back(1), alike_.push_back(UINT32_MAX);
+        held_[w] = 1, twin_[w] = r.added;
+        note_moved(r.added);
+      }
+      apply(split, w, r.added, freed);
+      const std::size_t reused = split.faces.size() - split.old.size();
+      for (std::size_t k = 0; k < reused; ++k) r.reused[k] = freed[k], r.parent[k] = split.parent[split.old.size() + k];
+      if (short_one) {
+        r.dropped = freed[1];
+        dead_face_[freed[1]] = 1;
+        ++faces_given_up;
+      }
+      for (std::uint32_t g : collapse.old) heap.push({local(g), g});
+      for (std::uint32_t g : split.old) heap.push({local(g), g});
+      for (std::uint32_t g : freed) heap.push({local(g), g});
+      made.push_back(r);
+    }
+    return made;
+  }
+
   Mesh& mesh_;
   const Frame frame_;
   const SurfaceDistance& surface_;
@@ -518,10 +1117,16 @@ class Repairer {
   const double weight_scale_;  // model area to the frame's
   std::vector<Vec3> x_;                              // output positions in the frame
   std::vector<std::uint8_t> held_;                   // per vertex: its edges stay
+  std::vector<std::uint32_t> twin_;                  // per vertex, the other vertex at its position (a pair only)
+  std::vector<std::uint8_t> caller_held_;            // per vertex: held by the caller (or a relocation)
+  std::vector<std::uint32_t> alike_;                 // per vertex, its index in places_ (UINT32_MAX: alone)
+  std::vector<std::vector<std::uint32_t>> places_;   // vertices that share a position
   std::vector<std::uint32_t> tri_;                   // output faces (3 per face), flipped in place
   std::vector<std::vector<std::uint32_t>> faces_at_;  // per vertex, the faces that have it
   std::vector<FaceScore> score_;                     // per face, its samples (where scored_)
   std::vector<std::uint8_t> scored_;                 // per face: score_ is exact
+  std::vector<std::uint8_t> dead_face_;              // per face slot: dropped by a relocation (compacted at the end)
+  std::vector<std::uint8_t> peaked_;                 // per face: score_.most climbed to its peak (relocations)
   std::vector<double> near_;                         // per face, its centroid's and edge midpoints' largest
   std::vector<std::uint32_t> hint_;                  // per face, a face of the input near it
   double largest_ = 0;                               // the largest distance both ways, at the start (scanned)
@@ -529,11 +1134,34 @@ class Repairer {
   std::vector<double> near_most_;                    // per face, the largest of those points' distances
   std::vector<double> d2_;                           // per point, its squared distance to its face
   std::vector<std::uint32_t> moved_;                 // vertices moved (ascending, once each)
-  std::vector<std::uint32_t> scratch_points_;
+  std::vector<std::uint32_t> scratch_points_, scratch_context_, scratch_near_;
   std::vector<double> scratch_d2_;
 };
 
 }  // namespace
+
+std::vector<std::uint8_t> points_on_border(std::span<const std::uint32_t> indices,
+                                           std::span<const std::uint32_t> point_source) {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
+  edges.reserve(indices.size());
+  for (std::size_t f = 0; f + 2 < indices.size(); f += 3)
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t a = indices[f + k], b = indices[f + (k + 1) % 3];
+      edges.push_back({std::min(a, b), std::max(a, b)});
+    }
+  std::sort(edges.begin(), edges.end());
+  std::vector<std::uint32_t> border;
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i;
+    while (j < edges.size() && edges[j] == edges[i]) ++j;
+    if (j - i == 1) border.push_back(edges[i].first), border.push_back(edges[i].second);
+    i = j;
+  }
+  std::sort(border.begin(), border.end());
+  std::vector<std::uint8_t> on(point_source.size(), 0);
+  for (std::size_t p = 0; p < point_source.size(); ++p) on[p] = std::binary_search(border.begin(), border.end(), point_source[p]);
+  return on;
+}
 
 FarRepairResult repair_far_places(Mesh& approx, const Frame& frame, const SurfaceDistance& surface,
                               std::span<const double> points, std::span<const double> weights,

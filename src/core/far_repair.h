@@ -20,13 +20,34 @@
 // their closest face toward them (all the way, or half way); no face of the vertex turns by more
 // than `max_normal_turn_degrees`. Border, seam and locked vertices never move.
 //
-// Borders and faces of different materials stay as they are. Deterministic: repairs are tried one
-// at a time in a fixed order.
+// Relocations. Where neither mends the farthest place (a far point along an edge whose flip and
+// whose corners' moves all make something else worse), a vertex is added there and one taken
+// away where the output is flattest (Hoppe et al. 1993 §4's edge split, paired with its edge
+// collapse), so that the counts of faces and vertices stay:
+//   - the split: the far place's edge (or face) divides at the point nearest the farthest input
+//     point, or nearest the input to the farthest sample (each face's largest sample climbed to
+//     its peak first: a grid misses the peak between its points); the new vertex on the input.
+//     A border edge divides at an input border vertex, so the border stays on the input's. At a
+//     crack (two coincident border edges, the sides of a seam the input never welded) both sides
+//     divide together, a vertex more (`add_vertices`); where the sides already part, one alone.
+//   - the collapse: an interior vertex whose removal moves the surface least (its distance to its
+//     ring's plane, squared, times its fan's area: the share of E it would add) goes into a
+//     neighbour; for a border split, a border vertex along its border (not a corner, as the
+//     contractions keep them), or, when none can go, an interior one and the output ends a face
+//     short (at most one face in 256).
+// Made only where the largest distance falls (the split's faces below the farthest, the
+// collapse's below half of it, input samples between the input's vertices included), the link
+// condition holds and no face folds; together they may raise E by at most `relocation_budget`.
+// Farthest place first; a place no relocation mends is passed over, up to 8 in a row. Not on
+// meshes with attributes, materials or vertex properties, whose new vertex would need values.
+//
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include "core/distance_bound.h"
 #include "geometry/frame.h"
@@ -54,6 +75,35 @@ struct FarRepairOptions {
   unsigned threads = 1;
   /// After the flips, move interior vertices toward the farthest input points near them.
   bool move_vertices = true;
+  /// Then at most this many relocations (0: none).
+  std::size_t relocations = 0;
+  /// The relocations together may raise E (estimated) by at most this fraction.
+  double relocation_budget = 0.005;
+  /// Per point: 1 = on the input's border (points_on_border). Empty: no relocation at a border.
+  std::span<const std::uint8_t> point_on_border;
+  /// Whether a relocation may add a vertex: at a crack (two border edges at the same positions, the
+  /// sides of a seam the input never welded), both sides split together, so the faces' count
+  /// stays and the vertices' grows by one.
+  bool add_vertices = false;
+};
+
+/// One relocation: output vertex `removed` collapsed into `kept`, and its slot holds the new
+/// vertex; the two faces the collapse removed hold two of the split's faces, each divided from
+/// the face in `parent` (the split divides one face, or the two of an edge).
+struct Relocation {
+  std::uint32_t removed = 0, kept = 0;
+  /// The input point (FitPoints index) the new vertex stands at (`at_point`) or nearest to;
+  /// UINT32_MAX: none.
+  std::uint32_t point = UINT32_MAX;
+  bool at_point = false;
+  /// The new vertex's twin at a crack (appended to the vertices), or UINT32_MAX.
+  std::uint32_t added = UINT32_MAX;
+  /// A face slot left empty (a border split paired with an interior collapse: one face fewer), or
+  /// UINT32_MAX. Such slots are dropped from approx.indices at the end, the others keeping their
+  /// order; reused, parent and the other relocations' slots count them.
+  std::uint32_t dropped = UINT32_MAX;
+  /// UINT32_MAX in the second when a border split took one face.
+  std::array<std::uint32_t, 2> reused{UINT32_MAX, UINT32_MAX}, parent{UINT32_MAX, UINT32_MAX};
 };
 
 struct FarRepairResult {
@@ -62,13 +112,20 @@ struct FarRepairResult {
   /// centroids and edge midpoints to the input, and of the input's points to the output.
   double largest_before = 0;
   std::size_t moves = 0;  ///< vertices moved (a vertex moved twice counts twice)
+  std::vector<Relocation> relocations;  ///< in the order made
 };
 
 /// Repairs the far places of `approx` (positions in model units; `frame` maps them to the
 /// surface's frame). `surface`: the input's triangles in that frame. `points` (3 per point, in the
 /// frame) and `weights` (each one's share of the input's area, in model units): the input's
-/// vertices (refit_detail::FitPoints). approx.indices change by flips, and the positions of the
-/// moved vertices; the counts of faces and vertices stay.
+/// vertices (refit_detail::FitPoints). approx.indices change by flips and relocations, and the
+/// positions of the moved vertices; the counts of faces and vertices stay, but for the
+/// relocations' `dropped` faces and `added` vertices.
+/// Per point of `point_source` (an input vertex each, FitPoints::source): 1 where that vertex is an
+/// end of an edge that only one of `indices`' faces has.
+std::vector<std::uint8_t> points_on_border(std::span<const std::uint32_t> indices,
+                                           std::span<const std::uint32_t> point_source);
+
 FarRepairResult repair_far_places(Mesh& approx, const Frame& frame, const SurfaceDistance& surface,
                                   std::span<const double> points, std::span<const double> weights,
                                   const FarRepairOptions& options);

@@ -40,9 +40,11 @@ void refit_levels(MeshView original, std::span<ReplayLevel> levels, const Simpli
 std::vector<std::uint8_t> seam_or_locked(std::span<const std::uint8_t> on_seam, std::span<const std::uint8_t> fixed,
                                          std::size_t vertices);
 
-/// The far-place repair (core/far_repair.h) of `result` after its refit, against the input's
-/// points and surface (those of the refit), `held` vertices left as they are; counts it in `result`.
-void repair_after_refit(SimplifyResult& result, const SimplifyOptions& options, const refit_detail::FitPoints& points,
-                        const core::SurfaceDistance& surface, std::span<const std::uint8_t> held);
+/// The far-place repair (core/far_repair.h) of `result` after its refit, against the input (its
+/// positions and the faces the run used) as points and surface (those of the refit), `held`
+/// vertices left as they are; counts it in `result` and carries its provenance across relocations.
+void repair_after_refit(SimplifyResult& result, const SimplifyOptions& options, MeshView input,
+                        const refit_detail::FitPoints& points, const core::SurfaceDistance& surface,
+                        std::span<const std::uint8_t> held);
 
 }  // namespace qem
