@@ -598,6 +598,17 @@ class Repairer {
     return n;
   }
   bool border_edge(std::uint32_t a, std::uint32_t b) const { return edge_faces(a, b) == 1; }
+  // Whether a face with the same three corners as one of `faces` is already there.
+  bool any_face_exists(const std::vector<Corners>& faces) const {
+    for (const Corners& t : faces) {
+      const auto same = [&](std::uint32_t g) {
+        const std::uint32_t* o = &tri_[3 * g];
+        return std::is_permutation(o, o + 3, t.begin());
+      };
+      if (std::any_of(faces_at_[t[0]].begin(), faces_at_[t[0]].end(), same)) return true;
+    }
+    return false;
+  }
   // The other vertices at v's position.
   std::span<const std::uint32_t> alike(std::uint32_t v) const {
     if (v >= alike_.size() || alike_[v] == UINT32_MAX) return {};
@@ -862,16 +873,18 @@ class Repairer {
   // What removing interior vertex v would add to E, roughly: its distance to the plane of its ring
   // (through the ring's centroid, normal to the fan), squared, times the fan's area.
   double removal_cost(std::uint32_t v) const {
-    const std::vector<std::uint32_t> r = ring(v);
+    // (Round an interior vertex each neighbour is a corner of two of its faces: the mean of the
+    // faces' other corners is the ring's centroid.)
     Vec3 centroid{0, 0, 0}, n{0, 0, 0};
     double area = 0;
-    for (std::uint32_t u : r) centroid = centroid + x_[u];
-    centroid = centroid * (1.0 / double(r.size()));
     for (std::uint32_t f : faces_at_[v]) {
-      const Vec3 m = normal(tri_[3 * f], tri_[3 * f + 1], tri_[3 * f + 2]);
+      const std::uint32_t* t = &tri_[3 * f];
+      centroid = centroid + x_[t[0]] + x_[t[1]] + x_[t[2]] - x_[v];
+      const Vec3 m = normal(t[0], t[1], t[2]);
       n = n + m;
       area += 0.5 * length(m);
     }
+    centroid = centroid * (1.0 / double(2 * faces_at_[v].size()));
     const double d = dot(x_[v] - centroid, normalized(n));
     return d * d * area;
   }
@@ -917,6 +930,9 @@ class Repairer {
       std::vector<std::uint32_t> common;
       std::set_intersection(around.begin(), around.end(), other.begin(), other.end(), std::back_inserter(common));
       if (common != opposite) continue;
+      // Nothing left of u's part (a lone triangle), or a face twice (a tetrahedron's): refused, so
+      // that no part vanishes or folds onto itself.
+      if (c.faces.empty() || any_face_exists(c.faces)) continue;
       if (!keeps_facing(c, {}) || !score_plan(c, {}, limit) || !input_stays_near(c, {}, limit)) continue;
       if (!found || c.energy - c.old_energy < best.energy - best.old_energy) {
         best = c, best.u = u, best.v = v;
