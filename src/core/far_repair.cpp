@@ -819,8 +819,8 @@ class Repairer {
       around.erase(std::unique(around.begin(), around.end()), around.end());
       std::uint32_t best = UINT32_MAX;
       double key = 0;
-      for (std::uint32_t g : around)
-        for (std::uint32_t q : points_of_[g]) {
+      for (std::uint32_t h : around)
+        for (std::uint32_t q : points_of_[h]) {
           if (!opt_.point_on_border[q]) continue;
           const double d2 = near_most_[f] >= score_[f].most ? -d2_[q] : measure_detail::squared_distance(point(q), near);
           if (best == UINT32_MAX || d2 < key || (d2 == key && q < best)) best = q, key = d2;
