@@ -55,12 +55,20 @@ RefitOptions refit_options_for(const SimplifyOptions& options, std::size_t input
 
 namespace {
 
+// Per point of `points`, whether it is on the input's border (`faces`), for relocations; empty
+// when `mesh` has what a relocation could not give its new vertex (no relocation runs then).
+std::vector<std::uint8_t> border_points_for(const Mesh& mesh, std::span<const std::uint32_t> faces,
+                                            const refit_detail::FitPoints& points) {
+  if (!mesh.attributes.empty() || !mesh.face_materials.empty() || !mesh.vertex_properties.empty()) return {};
+  return core::points_on_border(faces, points.source);
+}
+
 // The far-place repair of `mesh` with `options`' turn limit and threads (core/far_repair.h), against
-// the input (`positions`, `faces`) as `points` and `surface`. A relocated vertex that stands at an
-// input vertex takes its exact coordinates (on a border: on the input's border, as exact borders
-// promise).
+// the input (`positions`) as `points` and `surface`, `on_border` per point (border_points_for). A
+// relocated vertex that stands at an input vertex takes its exact coordinates (on a border: on the
+// input's border, as exact borders promise).
 core::FarRepairResult repair_mesh(Mesh& mesh, const SimplifyOptions& options, std::span<const double> positions,
-                                  std::span<const std::uint32_t> faces, const refit_detail::FitPoints& points,
+                                  std::span<const std::uint8_t> on_border, const refit_detail::FitPoints& points,
                                   const core::SurfaceDistance& surface, std::span<const std::uint8_t> held) {
   core::FarRepairOptions repair_options;
   repair_options.held = held;
@@ -70,7 +78,6 @@ core::FarRepairResult repair_mesh(Mesh& mesh, const SimplifyOptions& options, st
   // benchmark meshes (docs/benchmarks.md, "Far places"): the cap only bounds the work.
   repair_options.relocations = 256;
   repair_options.add_vertices = options.target_vertices == 0;  // a vertex target stays a bound
-  const std::vector<std::uint8_t> on_border = core::points_on_border(faces, points.source);
   repair_options.point_on_border = on_border;
   core::FarRepairResult made =
       core::repair_far_places(mesh, points.frame(), surface, points.position, points.weight, repair_options);
@@ -109,13 +116,17 @@ void refit_levels(MeshView original, std::span<ReplayLevel> levels, const Simpli
   for (std::size_t v = 0; v < options.vertex_lock.size(); ++v)
     if (options.vertex_lock[v]) locked.push_back({original.positions[3 * v], original.positions[3 * v + 1], original.positions[3 * v + 2]});
   std::sort(locked.begin(), locked.end());
+  // The input's border points, once for every level (the levels share the input and carry the
+  // same kinds of data).
+  const std::vector<std::uint8_t> on_border =
+      border_points_for(*groups.front().second.front(), original.indices, points);
   for (auto& [refit_options, meshes] : groups)
     for (Mesh* mesh : meshes) {
       std::vector<std::uint8_t> held(locked.empty() ? 0 : mesh->vertex_count(), 0);
       for (std::size_t v = 0; v < held.size(); ++v)
         held[v] = std::binary_search(locked.begin(), locked.end(),
                                      std::array<double, 3>{mesh->positions[3 * v], mesh->positions[3 * v + 1], mesh->positions[3 * v + 2]});
-      repair_mesh(*mesh, options, original.positions, original.indices, points, surface, held);
+      repair_mesh(*mesh, options, original.positions, on_border, points, surface, held);
     }
 }
 
@@ -130,7 +141,8 @@ std::vector<std::uint8_t> seam_or_locked(std::span<const std::uint8_t> on_seam, 
 void repair_after_refit(SimplifyResult& result, const SimplifyOptions& options, MeshView input,
                         const refit_detail::FitPoints& points, const core::SurfaceDistance& surface,
                         std::span<const std::uint8_t> held) {
-  const core::FarRepairResult made = repair_mesh(result.mesh, options, input.positions, input.indices, points, surface, held);
+  const core::FarRepairResult made = repair_mesh(result.mesh, options, input.positions,
+                                                 border_points_for(result.mesh, input.indices, points), points, surface, held);
   result.edge_flips = made.flips;
   result.vertex_moves = made.moves;
   result.vertex_relocations = made.relocations.size();

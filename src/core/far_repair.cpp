@@ -1048,18 +1048,20 @@ class Repairer {
       const double largest = local(f);
       // The collapse may not make a new far place: its faces stay well below the farthest.
       const double limit = 0.5 * largest;
-      std::vector<std::uint8_t> near_split(x_.size(), 0);  // vertices of the split's faces
-      for (std::uint32_t g : split.old)
-        for (int k = 0; k < 3; ++k) near_split[tri_[3 * g + k]] = 1;
+      std::vector<std::uint32_t>& split_corners = scratch_split_;  // the split's faces' corners
+      split_corners.clear();
+      for (std::uint32_t g : split.old) split_corners.insert(split_corners.end(), &tri_[3 * g], &tri_[3 * g] + 3);
+      const auto near_split = [&](std::uint32_t v) {
+        return std::find(split_corners.begin(), split_corners.end(), v) != split_corners.end();
+      };
       // The first allowed collapse of the flattest `list`'s vertices (border ones: along the border).
       const auto find_collapse = [&](const std::vector<std::pair<double, std::uint32_t>>& list, bool border) {
         std::size_t tried = 0;
         for (const auto& [cost, u] : list) {
           if (tried == kCollapsesTried) break;
-          if (spent[u] || faces_at_[u].empty() || near_split[u]) continue;
-          bool apart = true;
-          for (std::uint32_t x : ring(u)) apart = apart && !near_split[x];
-          if (!apart) continue;
+          if (spent[u] || faces_at_[u].empty() || near_split(u)) continue;
+          const std::vector<std::uint32_t> around = ring(u);
+          if (std::any_of(around.begin(), around.end(), near_split)) continue;
           ++tried;
           if (!plan_collapse(u, limit, border, candidate)) continue;
           const double rise = split.energy + candidate.energy - (split.old_energy + candidate.old_energy);
@@ -1150,7 +1152,7 @@ class Repairer {
   std::vector<double> near_most_;                    // per face, the largest of those points' distances
   std::vector<double> d2_;                           // per point, its squared distance to its face
   std::vector<std::uint32_t> moved_;                 // vertices moved (ascending, once each)
-  std::vector<std::uint32_t> scratch_points_, scratch_context_, scratch_near_;
+  std::vector<std::uint32_t> scratch_points_, scratch_context_, scratch_near_, scratch_split_;
   std::vector<double> scratch_d2_;
 };
 
