@@ -11,6 +11,7 @@
 
 #include "core/border_placement.h"
 #include "core/parallel_chunks.h"
+#include "core/same_position.h"
 #include "measure/bvh.h"
 #include "measure/point_triangle.h"
 
@@ -70,25 +71,25 @@ class Repairer {
     // an edge added at one could duplicate an edge of its twin.
     held_.assign(n, 0);
     for (std::size_t v = 0; v < n && v < options.held.size(); ++v) held_[v] = options.held[v];
-    std::vector<std::uint32_t> order(n);
-    for (std::uint32_t v = 0; v < n; ++v) order[v] = v;
-    const auto key = [&](std::uint32_t v) { return std::array<double, 3>{x_[v].x, x_[v].y, x_[v].z}; };
-    std::sort(order.begin(), order.end(), [&](std::uint32_t u, std::uint32_t v) { return key(u) < key(v); });
     twin_.assign(n, UINT32_MAX);
     caller_held_ = held_;
     alike_.assign(n, UINT32_MAX);
-    for (std::size_t i = 0; i < n; ++i) {
-      std::size_t j = i;
-      while (j + 1 < n && key(order[j + 1]) == key(order[i])) ++j;
-      if (j > i) {
-        // Vertices at one place: the sides of a seam or crack the input never welded.
-        places_.emplace_back(order.begin() + std::ptrdiff_t(i), order.begin() + std::ptrdiff_t(j) + 1);
-        for (std::size_t k = i; k <= j; ++k) held_[order[k]] = 1, alike_[order[k]] = std::uint32_t(places_.size() - 1);
+    // Vertices at one place: the sides of a seam or crack the input never welded.
+    const std::vector<std::uint32_t> first = first_at_same_position(MeshView(approx), 1);
+    for (std::uint32_t v = 0; v < n; ++v) {
+      if (first[v] == v) continue;
+      if (alike_[first[v]] == UINT32_MAX) {
+        alike_[first[v]] = std::uint32_t(places_.size());
+        places_.push_back({first[v]});
       }
+      alike_[v] = alike_[first[v]];
+      places_[alike_[v]].push_back(v);
+    }
+    for (const std::vector<std::uint32_t>& place : places_) {
+      for (std::uint32_t v : place) held_[v] = 1;
       // A pair, neither held by the caller: a crack's two sides (relocations split both together).
-      const std::uint32_t a = order[i], b = order[j];
-      if (j == i + 1 && !caller_held_[a] && !caller_held_[b]) twin_[a] = b, twin_[b] = a;
-      i = j;
+      const std::uint32_t a = place[0], b = place[1];
+      if (place.size() == 2 && !caller_held_[a] && !caller_held_[b]) twin_[a] = b, twin_[b] = a;
     }
     faces_at_.assign(n, {});
     for (std::uint32_t f = 0; f < face_count(); ++f)
@@ -280,21 +281,28 @@ class Repairer {
     return dot(n, m) >= std::min(cos_turn_, dot(o, m));
   }
 
-  // The largest and the area-weighted squared distances of the input points `pts` to the nearer of
-  // faces g1, g2 (corners given).
-  void near_points(const std::vector<std::uint32_t>& pts, const Vec3* g1, const Vec3* g2,
-                   std::vector<double>& d2, double& most, double& energy) const {
-    using measure_detail::closest_point_on_triangle;
-    using measure_detail::squared_distance;
+  // Each input point of `pts` to the nearest of `count` faces (face k's corners by corners(k); of
+  // two as near, the lower k): k in nearest[i], the squared distance in d2[i]. Returns the largest
+  // squared distance and adds the points' weighted squared distances to `energy`.
+  template <class CornersOf>
+  double to_nearest_faces(std::span<const std::uint32_t> pts, std::size_t count, CornersOf corners,
+                          std::vector<std::uint32_t>& nearest, std::vector<double>& d2, double& energy) const {
+    nearest.resize(pts.size());
     d2.resize(pts.size());
+    double most2 = 0;
     for (std::size_t i = 0; i < pts.size(); ++i) {
       const Vec3 p = point(pts[i]);
-      const double one = squared_distance(p, closest_point_on_triangle(p, g1[0], g1[1], g1[2]));
-      const double two = squared_distance(p, closest_point_on_triangle(p, g2[0], g2[1], g2[2]));
-      d2[i] = std::min(one, two);
-      most = std::max(most, d2[i]);
-      energy += weights_[pts[i]] * weight_scale_ * d2[i];
+      double best = HUGE_VAL;
+      for (std::size_t k = 0; k < count; ++k) {
+        const auto [a, b, c] = corners(k);
+        const double d = measure_detail::squared_distance(p, measure_detail::closest_point_on_triangle(p, a, b, c));
+        if (d < best) best = d, nearest[i] = std::uint32_t(k);
+      }
+      d2[i] = best;
+      most2 = std::max(most2, best);
+      energy += weights_[pts[i]] * weight_scale_ * best;
     }
+    return most2;
   }
 
   // Tries the flip of edge k of face f1; returns the other face of the flip, or UINT32_MAX when
@@ -337,8 +345,12 @@ class Repairer {
     std::vector<std::uint32_t>& pts = scratch_points_;
     pts.assign(points_of_[f1].begin(), points_of_[f1].end());
     pts.insert(pts.end(), points_of_[f2].begin(), points_of_[f2].end());
-    double most2 = 0, energy = s1.energy + s2.energy;
-    near_points(pts, g1, g2, scratch_d2_, most2, energy);
+    double energy = s1.energy + s2.energy;
+    const auto corners = [&](std::size_t k) {
+      const Vec3* g = k == 0 ? g1 : g2;
+      return std::array<Vec3, 3>{g[0], g[1], g[2]};
+    };
+    const double most2 = to_nearest_faces(pts, 2, corners, scratch_nearest_, scratch_d2_, energy);
     if (std::max({s1.most, s2.most, std::sqrt(most2)}) >= old_most) return UINT32_MAX;
     if (energy > old_energy * (1 + opt_.error_margin)) return UINT32_MAX;
 
@@ -350,14 +362,8 @@ class Repairer {
     score_[f1] = s1, score_[f2] = s2;
     scored_[f1] = scored_[f2] = 1;
     points_of_[f1].clear(), points_of_[f2].clear();
-    using measure_detail::closest_point_on_triangle;
-    using measure_detail::squared_distance;
-    for (std::size_t i = 0; i < pts.size(); ++i) {
-      const Vec3 p = point(pts[i]);
-      const double one = squared_distance(p, closest_point_on_triangle(p, g1[0], g1[1], g1[2]));
-      d2_[pts[i]] = scratch_d2_[i];
-      points_of_[one <= scratch_d2_[i] ? f1 : f2].push_back(pts[i]);
-    }
+    for (std::size_t i = 0; i < pts.size(); ++i)
+      d2_[pts[i]] = scratch_d2_[i], points_of_[scratch_nearest_[i] == 0 ? f1 : f2].push_back(pts[i]);
     near_most_[f1] = nearest_most(f1), near_most_[f2] = nearest_most(f2);
     return f2;
   }
@@ -402,26 +408,17 @@ class Repairer {
     pts.clear();
     for (std::uint32_t f : fan) pts.insert(pts.end(), points_of_[f].begin(), points_of_[f].end());
     x_[v] = y;
-    std::vector<std::uint32_t> nearest(pts.size());
-    scratch_d2_.resize(pts.size());
-    double most2 = 0, energy = 0;
+    double energy = 0;
     for (std::size_t i = 0; i < fan.size(); ++i) energy += scores[i].energy;
-    for (std::size_t i = 0; i < pts.size(); ++i) {
-      const Vec3 p = point(pts[i]);
-      double best = HUGE_VAL;
-      for (std::uint32_t f : fan) {
-        const std::uint32_t* t = &tri_[3 * f];
-        const double d2 = measure_detail::squared_distance(
-            p, measure_detail::closest_point_on_triangle(p, x_[t[0]], x_[t[1]], x_[t[2]]));
-        if (d2 < best) best = d2, nearest[i] = f;
-      }
-      most2 = std::max(most2, best);
-      energy += weights_[pts[i]] * weight_scale_ * best;
-      scratch_d2_[i] = best;
-    }
+    const auto corners = [&](std::size_t k) {
+      const std::uint32_t* t = &tri_[3 * fan[k]];
+      return std::array<Vec3, 3>{x_[t[0]], x_[t[1]], x_[t[2]]};
+    };
+    const double most2 = to_nearest_faces(pts, fan.size(), corners, scratch_nearest_, scratch_d2_, energy);
     if (std::sqrt(most2) >= old_most || energy > old_energy * (1 + opt_.error_margin)) return x_[v] = x, false;
     for (std::size_t i = 0; i < fan.size(); ++i) score_[fan[i]] = scores[i], scored_[fan[i]] = 1, points_of_[fan[i]].clear();
-    for (std::size_t i = 0; i < pts.size(); ++i) d2_[pts[i]] = scratch_d2_[i], points_of_[nearest[i]].push_back(pts[i]);
+    for (std::size_t i = 0; i < pts.size(); ++i)
+      d2_[pts[i]] = scratch_d2_[i], points_of_[fan[scratch_nearest_[i]]].push_back(pts[i]);
     for (std::uint32_t f : fan) near_most_[f] = nearest_most(f);
     return true;
   }
@@ -651,22 +648,11 @@ class Repairer {
       p.old_energy += score_[f].energy;
       for (std::uint32_t q : points_of_[f]) p.points.push_back(q), p.old_energy += weights_[q] * weight_scale_ * d2_[q];
     }
-    p.nearest.resize(p.points.size());
-    p.d2.resize(p.points.size());
-    double most2 = 0;
-    for (std::size_t i = 0; i < p.points.size(); ++i) {
-      const Vec3 q = point(p.points[i]);
-      double best = HUGE_VAL;
-      for (std::size_t k = 0; k < p.faces.size(); ++k) {
-        const Corners& t = p.faces[k];
-        const double d2 = measure_detail::squared_distance(
-            q, measure_detail::closest_point_on_triangle(q, at(t[0], y), at(t[1], y), at(t[2], y)));
-        if (d2 < best) best = d2, p.nearest[i] = std::uint32_t(k);
-      }
-      p.d2[i] = best;
-      most2 = std::max(most2, best);
-      p.energy += weights_[p.points[i]] * weight_scale_ * best;
-    }
+    const auto corners = [&](std::size_t k) {
+      const Corners& t = p.faces[k];
+      return std::array<Vec3, 3>{at(t[0], y), at(t[1], y), at(t[2], y)};
+    };
+    const double most2 = to_nearest_faces(p.points, p.faces.size(), corners, p.nearest, p.d2, p.energy);
     p.most = std::max(p.most, std::sqrt(most2));
     return p.most < limit;
   }
@@ -1153,6 +1139,7 @@ class Repairer {
   std::vector<double> d2_;                           // per point, its squared distance to its face
   std::vector<std::uint32_t> moved_;                 // vertices moved (ascending, once each)
   std::vector<std::uint32_t> scratch_points_, scratch_context_, scratch_near_, scratch_split_;
+  std::vector<std::uint32_t> scratch_nearest_;  // per point of a flip or move, its nearest new face
   std::vector<double> scratch_d2_;
 };
 

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "check_mesh.h"
+#include "core/same_position.h"
 #include "core/small_sort.h"
 #include "core/spatial_order.h"
 #include "qem/error.h"
@@ -16,19 +17,6 @@ namespace qem::core {
 namespace {
 
 bool degenerate(const std::uint32_t* t) { return t[0] == t[1] || t[1] == t[2] || t[0] == t[2]; }
-
-// For each of `used`, the first of `used` (in input order) at exactly the same position.
-std::vector<std::uint32_t> first_at_same_position(MeshView in, const std::vector<std::uint32_t>& used) {
-  std::vector<std::uint32_t> first(in.vertex_count(), kNoVertex), order = used;
-  const auto at = [&](std::uint32_t v) {
-    return std::array<double, 3>{in.positions[3 * std::size_t(v)], in.positions[3 * std::size_t(v) + 1],
-                                 in.positions[3 * std::size_t(v) + 2]};
-  };
-  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return at(a) < at(b); });
-  for (std::size_t i = 0; i < order.size(); ++i)
-    first[order[i]] = i > 0 && at(order[i]) == at(order[i - 1]) ? first[order[i - 1]] : order[i];
-  return first;
-}
 
 // The referenced vertices (those of a face that is not degenerate: a degenerate face carries no
 // plane and no area), in input order. Unreferenced ones take no part and leave the output.
@@ -150,7 +138,7 @@ WorkingMesh prepare_input(MeshView in, std::vector<std::uint32_t>* internal_out)
   } else {
     // With attributes, the working vertices are the distinct positions (the wedges on them are
     // the input's vertices): a seam is not a hole.
-    const std::vector<std::uint32_t> first = first_at_same_position(in, used);
+    const std::vector<std::uint32_t> first = first_at_same_position(in.positions, used, 1);
     std::vector<std::uint32_t> distinct;
     for (std::uint32_t v : used)
       if (first[v] == v) distinct.push_back(v);

@@ -15,7 +15,7 @@
 #include "core/parallel_chunks.h"
 #include "core/run.h"
 #include "partition/partition_targets.h"
-#include "partition/same_position.h"
+#include "core/same_position.h"
 #include "qem/error.h"
 #include "qem/partition.h"
 #include "refit/attribute_fit.h"
@@ -33,7 +33,7 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 
 // Connected components of the input (faces joined through shared vertices), as simplify counts
 // them on its input: union-find over the vertices (with attributes, the positions: `point`, see
-// same_position.h; empty: the vertices) of the non-degenerate faces.
+// core/same_position.h; empty: the vertices) of the non-degenerate faces.
 std::size_t count_input_components(MeshView input, const std::vector<std::uint32_t>& point) {
   analysis::DisjointSets parts(input.vertex_count());
   std::vector<std::uint8_t> used(input.vertex_count(), 0);
@@ -220,7 +220,7 @@ SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options
   // of the surface welded by position (core/working_mesh.cpp), and so are these.
   const std::vector<std::uint32_t> point = input.attributes.empty()
                                                ? std::vector<std::uint32_t>{}
-                                               : partition_detail::first_at_same_position(input, core::resolve_threads(options.threads));
+                                               : core::first_at_same_position(input, core::resolve_threads(options.threads));
   result.input_components = count_input_components(input, point);
   result.output_components = last.output_components;
   result.stop_reason = last.stop_reason;

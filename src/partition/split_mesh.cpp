@@ -10,7 +10,7 @@
 #include "core/parallel_chunks.h"
 #include "core/spatial_order.h"
 #include "partition/partition_targets.h"
-#include "partition/same_position.h"
+#include "core/same_position.h"
 #include "qem/error.h"
 #include "qem/partition.h"
 
@@ -116,7 +116,7 @@ std::vector<MeshPart> split_mesh(MeshView input, const SimplifyOptions& options,
   // same position) has no vertex index that two parts share, and found by index neither wedge
   // would be locked, each part would move its own, and the seam would open into a crack.
   const std::vector<std::uint32_t> point =
-      input.attributes.empty() ? std::vector<std::uint32_t>{} : partition_detail::first_at_same_position(input, threads);
+      input.attributes.empty() ? std::vector<std::uint32_t>{} : core::first_at_same_position(input, threads);
   const std::vector<std::uint64_t> code = centroid_codes(input, point, threads);
 
   // The cut: P-quantiles of the codes, taken from a sample of every k-th face (deterministic), so
