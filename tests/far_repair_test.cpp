@@ -354,6 +354,48 @@ TEST(FarRepair, ABorderBulgeGetsABorderVertexFromAStraightBorder) {
   expect_relocated(input, test::grid(8));
 }
 
+// A small part kept as one face, as a loose piece of a scan becomes: triangle A, B, C 0.01 above
+// the square, over an input patch (the same triangle, divided in 4 a side) that dips toward the
+// square along AB. The patch's points near AB are nearer the square's faces than the lone face, so
+// the lone face has none of the input's border points of AB among its own.
+TEST(FarRepair, ALoneFaceOverADippingPartGetsABorderVertexFromItsPart) {
+  constexpr int n = 4;
+  const Vec3 a{0.40, 0.40, 0.01}, b{0.48, 0.40, 0.01}, c{0.44, 0.46, 0.01};
+  Mesh patch;
+  std::vector<std::vector<std::uint32_t>> at(n + 1, std::vector<std::uint32_t>(n + 1));
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; i + j <= n; ++j) {
+      const double la = double(n - i - j) / n, lb = double(i) / n, lc = double(j) / n;
+      const Vec3 p = a * la + b * lb + c * lc;
+      at[i][j] = std::uint32_t(patch.vertex_count());
+      patch.positions.insert(patch.positions.end(), {p.x, p.y, 0.01 * (1 - 0.95 * 4 * la * lb)});
+    }
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; i + j < n; ++j) {
+      patch.indices.insert(patch.indices.end(), {at[i][j], at[i + 1][j], at[i][j + 1]});
+      if (i + j + 1 < n) patch.indices.insert(patch.indices.end(), {at[i + 1][j], at[i + 1][j + 1], at[i][j + 1]});
+    }
+  const Mesh input = test::concatenated(test::grid(64), patch);
+  Mesh lone;
+  lone.positions = {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z};
+  lone.indices = {0, 1, 2};
+  const Mesh approx = test::concatenated(test::grid(8), lone);
+  const core::SurfaceDistance surface(corners_of(input));
+  Mesh without = approx, with = approx;
+  EXPECT_TRUE(relocate(without, input, 0).relocations.empty());
+  const core::FarRepairResult r = relocate(with, input, 8);
+  ASSERT_GE(r.relocations.size(), 1u);
+  EXPECT_EQ(with.face_count(), approx.face_count());
+  EXPECT_LT(largest_distance(with, surface), 0.8 * largest_distance(without, surface));
+  EXPECT_EQ(test::validity_problem(with), "");
+  EXPECT_EQ(folded_edges(with), 0u);
+  // The new vertex is the patch's border vertex at the middle of AB, where the patch dips most.
+  const double* p = &with.positions[3 * std::size_t(r.relocations.front().removed)];
+  EXPECT_DOUBLE_EQ(p[0], 0.44);
+  EXPECT_DOUBLE_EQ(p[1], 0.40);
+  EXPECT_NEAR(p[2], 0.0005, 1e-12);
+}
+
 // height_field(n, f) cut along x = 0.5: the faces right of the cut use copies of the vertices on
 // it (a crack the mesh never welded).
 Mesh cracked(int n, double (*f)(double, double)) {

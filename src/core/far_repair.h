@@ -27,7 +27,10 @@
 //   - the split: the far place's edge (or face) divides at the point nearest the farthest input
 //     point, or nearest the input to the farthest sample (each face's largest sample climbed to
 //     its peak first: a grid misses the peak between its points); the new vertex on the input.
-//     A border edge divides at an input border vertex, so the border stays on the input's. At a
+//     A border edge divides at an input border vertex, so the border stays on the input's: one of
+//     the input points nearest the faces round the edge, or, when none of those will do (a small
+//     part kept as one face, whose input points went to nearer faces of other parts), the input
+//     border vertex nearest the far place; the nearest whose faces turn nothing over. At a
 //     crack (two coincident border edges, the sides of a seam the input never welded) both sides
 //     divide together, a vertex more (`add_vertices`); where the sides already part, one alone.
 //   - the collapse: an interior vertex whose removal moves the surface least (its distance to its
@@ -38,7 +41,9 @@
 // Made only where the largest distance falls (the split's faces below the farthest, the
 // collapse's below half of it, input samples between the input's vertices included), the link
 // condition holds and no face folds; together they may raise E by at most `relocation_budget`.
-// Farthest place first; a place no relocation mends is passed over, up to 8 in a row. Not on
+// Farthest place first (border faces from 0.4 of the largest scored first: there a face's
+// centroid and edge midpoints can miss its peak by a factor); a place no relocation mends is
+// passed over, up to 8 in a row. Not on
 // meshes with attributes, materials or vertex properties, whose new vertex would need values.
 //
 #pragma once
