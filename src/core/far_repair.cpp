@@ -75,7 +75,7 @@ class Repairer {
     caller_held_ = held_;
     alike_.assign(n, UINT32_MAX);
     // Vertices at one place: the sides of a seam or crack the input never welded.
-    const std::vector<std::uint32_t> first = first_at_same_position(MeshView(approx), 1);
+    const std::vector<std::uint32_t> first = first_at_same_position(MeshView(approx), resolve_threads(options.threads));
     for (std::uint32_t v = 0; v < n; ++v) {
       if (first[v] == v) continue;
       if (alike_[first[v]] == UINT32_MAX) {
@@ -847,8 +847,6 @@ class Repairer {
       }
       if (best == UINT32_MAX) return false;
       s.point = best, s.y = point(best), s.border = true, s.at_point = true, s.crack = false;
-      s.faces = {{ea, kNew, ec}, {kNew, eb, ec}};
-      s.parent = {f, f};
       if (f2 != UINT32_MAX) {
         // The other side's face, split the same way at the same place (the twin of the new vertex).
         const std::uint32_t* o = &tri_[3 * f2];
