@@ -31,6 +31,11 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
   sub->add_option("--greedy-below", a.greedy_below,
                   "With --scheme passes, finish in the greedy order below this many faces (0 = never)")
       ->capture_default_str();
+  sub->add_option("--forget", a.forget,
+                  "Renew every quadric from the current faces each time the faces fall by this factor (0 = never, "
+                  "GH97's quadrics; off with --max-error and with attributes)")
+      ->check(CLI::Range(0.0, 0.999999))
+      ->capture_default_str();
   sub->add_option("--threads", a.threads, "Threads for the passes: re-costing pairs, and making contractions region by region (0 = all; same result)")
       ->capture_default_str();
   sub->add_option("--boundary-weight", a.boundary_weight,
@@ -152,6 +157,7 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
   opt.inversion = parsed<InversionPolicy>("--inversion", a.inversion);
   opt.scheme = parsed<Scheme>("--scheme", a.scheme);
   opt.greedy_below_faces = a.greedy_below;
+  opt.forget = a.forget;
   opt.threads = a.threads;
   opt.boundary_weight = a.boundary_weight;
   opt.max_normal_turn_degrees = a.max_turn;

@@ -12,6 +12,10 @@
 
 namespace qem::cli {
 
+/// The command line forgets (SimplifyOptions::forget) where the library keeps GH97's quadrics:
+/// measured on the benchmark meshes (docs/benchmarks.md, "Forgetting").
+inline constexpr double kDefaultForget = 0.85;
+
 struct AlgorithmArgs {
   double threshold = 0, threshold_rel = 0;
   std::string weighting = to_string(SimplifyOptions{}.weighting);
@@ -19,6 +23,7 @@ struct AlgorithmArgs {
   std::string inversion = to_string(SimplifyOptions{}.inversion);
   std::string scheme = to_string(SimplifyOptions{}.scheme);
   std::size_t greedy_below = SimplifyOptions{}.greedy_below_faces;
+  double forget = kDefaultForget;  // --forget F (0 = GH97's remembering quadrics)
   unsigned threads = 0;
   double boundary_weight = SimplifyOptions{}.boundary_weight;
   double max_turn = SimplifyOptions{}.max_normal_turn_degrees;

@@ -230,7 +230,7 @@ TEST(FacesZero, CommandLineReadsZeroAsFarAsTheChecksAllow) {
   for (const char* stop : {"--faces 0", "--ratio 0", "--vertices 0"}) {
     SCOPED_TRACE(stop);
     ASSERT_EQ(
-        test::run_qem_quietly("simplify " + in + " " + out + " " + std::string(stop) + " --no-refit --force"),
+        test::run_qem_quietly("simplify " + in + " " + out + " " + std::string(stop) + " --no-refit --forget 0 --force"),
         0);
     SimplifyOptions o;
     o.as_far_as_possible = true;

@@ -115,6 +115,7 @@ std::vector<Config> configs(std::size_t faces) {
   add("passes/record", fixed, true);
   add("greedy/record", [&](SimplifyOptions& o) { fixed(o), o.scheme = Scheme::Greedy; }, true);
   add("passes/no-tail", [&](SimplifyOptions& o) { fixed(o), o.greedy_below_faces = 0; });
+  add("passes/forget", [&](SimplifyOptions& o) { fixed(o), o.forget = 0.85, o.greedy_below_faces = 4000; }, true);
   add("passes/lock-border", [&](SimplifyOptions& o) { fixed(o), o.lock_border = true; });
   add("passes/penalize", [&](SimplifyOptions& o) { fixed(o), o.inversion = InversionPolicy::Penalize; });
   add("passes/uniform-endpoints", [&](SimplifyOptions& o) {

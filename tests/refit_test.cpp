@@ -509,13 +509,20 @@ TEST(Refit, CliDefaultIsALightRefitWithOptimalPlacementOnly) {
   const std::string fitted = made("default.obj", "");
   EXPECT_FALSE(fitted.empty());
   EXPECT_TRUE(fitted == made("light.obj", "--refit-rounds 2 --refit-sample 8"));
-  const std::string plain = made("plain.obj", "--no-refit");
+  const std::string plain = made("plain.obj", "--no-refit --forget 0");
   EXPECT_NE(fitted, plain);
-  const SimplifyResult gh97 = [&] {
+  const auto library = [&](double forget) {
     SimplifyOptions o;
     o.target_faces = 600;
+    o.forget = forget;
     return simplify(load_mesh(in), o);
-  }();
+  };
+  const SimplifyResult gh97 = library(0);
+  const std::string unfitted = made("forget.obj", "--no-refit");
+  EXPECT_TRUE(unfitted == [&] {
+    save_mesh(dir + "/forget_library.obj", library(0.85).mesh);
+    return slurp(dir + "/forget_library.obj");
+  }()) << "--no-refit differs from the library with the command line's forgetting";
   EXPECT_TRUE(plain == [&] {
     save_mesh(dir + "/library.obj", gh97.mesh);
     return slurp(dir + "/library.obj");
@@ -534,7 +541,7 @@ TEST(Refit, CliDefaultIsALightRefitWithOptimalPlacementOnly) {
   EXPECT_NE(made("ends_fit.obj", "--placement endpoints --refit-sample 2"),
             made("ends2.obj", "--placement endpoints"));
   // A record replays the contractions only, so --record turns the default refit off.
-  EXPECT_TRUE(made("rec.obj", "--record " + dir + "/run.qrec") == plain);
+  EXPECT_TRUE(made("rec.obj", "--record " + dir + "/run.qrec") == unfitted);
   // The LOD chain refits its levels the same way.
   ASSERT_EQ(run("lod " + in + " " + dir + "/lod --faces 600 --format obj"), 0);
   EXPECT_TRUE(fitted == slurp(dir + "/lod/in_lod0.obj")) << "lod level differs from simplify";

@@ -179,6 +179,20 @@ struct SimplifyOptions {
   /// heap is then small enough to stay in cache, and the last contractions shape a coarse result
   /// the most (0 = passes to the end).
   std::size_t greedy_below_faces = 20000;
+  /// Forgetting (geometry without attributes, no max_error): each time the faces have fallen by
+  /// this factor since the last time (at the start of a pass, or at once in the greedy order),
+  /// every vertex's quadric is made again from its current faces and border edges (as at the
+  /// start: GH97 §5-6, HG99 §2) and every pair is costed afresh. GH97's quadrics remember every
+  /// plane a vertex ever stood for, so late contractions are ranked by the distance to long-gone
+  /// faces; renewed quadrics rank them by what they do to the current surface, as Lindstrom-Turk's
+  /// memoryless cost does, which lowers the mean error at the same face count (docs/benchmarks.md,
+  /// "Forgetting"). Not below 700 faces, where the mesh's own faces no longer stand for the
+  /// surface and the memory keeps its shape. 0 = GH97 as published (never); in [0, 1); the
+  /// command line's default is 0.85. Off under max_error (the contraction error bounds the
+  /// distance to the input only with whole quadrics) and with attributes (their wedge quadrics
+  /// remember). The schedule follows the face count, never the target, so a contraction record
+  /// still replays to a direct run's mesh.
+  double forget = 0;
   /// Threads for the parts that split without changing the result (0 = all hardware threads).
   unsigned threads = 0;
   /// After the last contraction, refit the vertices to the input surface with the faces fixed
@@ -250,7 +264,10 @@ struct SimplifyResult {
   /// Connected components (vertex-connected, of the welded working mesh) of the input and of the
   /// output, and how many the prune rule removed (SimplifyOptions::prune_size).
   std::size_t input_components = 0, output_components = 0, pruned_components = 0;
-  double max_error = 0;             ///< largest contraction error performed (distance units)
+  /// Largest contraction error performed (distance units). With forgetting (SimplifyOptions::
+  /// forget) each error is measured against the quadrics as last renewed, that is from the surface
+  /// of then, not from the input (output_to_input_distance and qem::measure give that).
+  double max_error = 0;
   double max_error_relative = 0;    ///< the same over the bounding-box diagonal
   StopReason stop_reason = StopReason::TargetReached;
   std::string stop_detail;          ///< human-readable explanation of the stop

@@ -149,6 +149,7 @@ def simplify(
     max_turn: float = ...,
     allow_non_manifold: bool = ...,
     scheme: Literal["greedy", "passes"] = ...,
+    forget: float = ...,
     refit: _Refit = ...,
     threads: int = ...,
     keep_components: bool = ...,

@@ -56,7 +56,8 @@ def test_mapping(small_torus):
     """Provenance: maps agree with each other and with the faces; an output vertex lies at its
     source (never contracted) or within the run's error of the planes of the vertices merged into it."""
     v, f = small_torus
-    r = qem.simplify(v, f, target_faces=400, weighting="uniform", refit="none", return_mapping=True)
+    # forget=0: the bound below is GH97's, of quadrics that remember every input plane.
+    r = qem.simplify(v, f, target_faces=400, weighting="uniform", refit="none", forget=0, return_mapping=True)
     to_out = r.output_vertex_of_input
     assert to_out.shape == (len(v),) and to_out.dtype == np.int32
     assert r.vertex_source.shape == (len(r.vertices),) and r.face_source.shape == (len(r.faces),)
@@ -222,3 +223,17 @@ def test_far_repair_follows_the_refit(small_torus):
     assert alone.edge_flips + alone.vertex_moves > 0
     with pytest.raises(ValueError, match="far_repair"):
         qem.simplify(*small_torus, target_faces=200, record=True, far_repair=True)
+
+
+def test_forget_follows_the_command_line(small_torus):
+    # On by default (0.85, as the command line); 0 keeps GH97's remembering quadrics (the library's
+    # default); a factor outside [0, 1) is refused by name.
+    v, f = small_torus
+    default = qem.simplify(v, f, target_faces=1000, refit="none")
+    explicit = qem.simplify(v, f, target_faces=1000, refit="none", forget=0.85)
+    remember = qem.simplify(v, f, target_faces=1000, refit="none", forget=0)
+    assert default.vertices.tobytes() == explicit.vertices.tobytes()
+    assert default.vertices.tobytes() != remember.vertices.tobytes()
+    for bad in (1.0, -0.5, True, "0.5"):
+        with pytest.raises(ValueError, match="forget"):
+            qem.simplify(v, f, target_faces=1000, forget=bad)

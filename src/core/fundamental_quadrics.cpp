@@ -1,38 +1,48 @@
 #include "core/fundamental_quadrics.h"
 
+#include <algorithm>
 #include <cmath>
+
+#include "core/parallel_chunks.h"
 
 namespace qem::core {
 
-std::vector<Quadric> face_quadrics(const WorkingMesh& m, Weighting weighting) {
-  std::vector<Quadric> quadric(m.pos.size());
-  for (std::uint32_t f = 0; f < m.face_source.size(); ++f) {
-    const std::uint32_t* t = m.face(f);
-    Vec3 n = cross(m.pos[t[1]] - m.pos[t[0]], m.pos[t[2]] - m.pos[t[0]]);
-    const double len = length(n);
-    if (!(len > 0)) continue;  // zero-area face: no plane (GH97 §5 needs a unit normal)
-    n = n * (1.0 / len);
-    const double d = -dot(n, m.pos[t[0]]);
-    switch (weighting) {
-      case Weighting::Area: {  // HG99 §2
-        const Quadric q = Quadric::plane(n, d, len / 2);
-        for (int k = 0; k < 3; ++k) quadric[t[k]] += q;
-        break;
-      }
-      case Weighting::Uniform: {  // GH97 §5
-        const Quadric q = Quadric::plane(n, d, 1);
-        for (int k = 0; k < 3; ++k) quadric[t[k]] += q;
-        break;
-      }
-      case Weighting::Angle:  // each corner weighs its plane by its own angle
-        for (int k = 0; k < 3; ++k) {
-          const Vec3 e1 = m.pos[t[(k + 1) % 3]] - m.pos[t[k]], e2 = m.pos[t[(k + 2) % 3]] - m.pos[t[k]];
-          const double angle = std::atan2(length(cross(e1, e2)), dot(e1, e2));
-          quadric[t[k]] += Quadric::plane(n, d, angle);
-        }
-        break;
-    }
+namespace {
+
+// Face f's plane quadric as its corner k adds it (only angle weighting depends on the corner).
+Quadric plane_of_face(const WorkingMesh& m, std::uint32_t f, int k, Weighting weighting) {
+  const std::uint32_t* t = m.face(f);
+  Vec3 n = cross(m.pos[t[1]] - m.pos[t[0]], m.pos[t[2]] - m.pos[t[0]]);
+  const double len = length(n);
+  if (!(len > 0)) return Quadric{};  // zero-area face: no plane (GH97 §5 needs a unit normal)
+  n = n * (1.0 / len);
+  const double d = -dot(n, m.pos[t[0]]);
+  switch (weighting) {
+    case Weighting::Area: return Quadric::plane(n, d, len / 2);  // HG99 §2
+    case Weighting::Uniform: return Quadric::plane(n, d, 1);     // GH97 §5
+    case Weighting::Angle: break;
   }
+  const Vec3 e1 = m.pos[t[(k + 1) % 3]] - m.pos[t[k]], e2 = m.pos[t[(k + 2) % 3]] - m.pos[t[k]];
+  return Quadric::plane(n, d, std::atan2(length(cross(e1, e2)), dot(e1, e2)));
+}
+
+}  // namespace
+
+std::vector<Quadric> face_quadrics(const WorkingMesh& m, Weighting weighting, unsigned threads) {
+  std::vector<Quadric> quadric(m.pos.size());
+  // Per vertex over its face list (in face order), so every sum is made in the same order for
+  // any thread count; each face's plane is computed at each of its corners.
+  for_chunks(m.pos.size(), std::size_t(1) << 13, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
+    for (std::size_t v = begin; v < end; ++v) {
+      Quadric q{};
+      for (std::uint32_t f : m.vertex_faces[v]) {
+        if (!m.face_alive[f]) continue;  // the greedy order's lists keep dead faces
+        const std::uint32_t* t = m.face(f);
+        q += plane_of_face(m, f, t[0] == v ? 0 : t[1] == v ? 1 : 2, weighting);
+      }
+      quadric[v] = q;
+    }
+  });
   return quadric;
 }
 
@@ -58,6 +68,13 @@ void add_boundary_planes(WorkingMesh& m, const std::vector<Edge>& edges, double 
     quadric[e.lo] += q;
     quadric[e.hi] += q;
   }
+}
+
+void renew_quadrics(WorkingMesh& m, Weighting weighting, double boundary_weight, unsigned threads,
+                    std::vector<Quadric>& quadric) {
+  quadric = face_quadrics(m, weighting, threads);
+  if (std::find(m.boundary.begin(), m.boundary.end(), std::uint8_t(1)) == m.boundary.end()) return;  // closed
+  add_boundary_planes(m, unique_edges(m.tri, m.vertex_faces, m.vertex_count()), boundary_weight, weighting, quadric);
 }
 
 }  // namespace qem::core

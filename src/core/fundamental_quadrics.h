@@ -13,8 +13,8 @@ namespace qem::core {
 
 /// Per vertex, the sum of the plane quadrics K_p of its faces, weighted by area (HG99 §2: the
 /// quadric integrates squared distance over the surface), uniformly (GH97 §5) or by corner angle.
-/// Zero-area faces have no plane and add nothing.
-std::vector<Quadric> face_quadrics(const WorkingMesh& mesh, Weighting weighting);
+/// Zero-area faces have no plane and add nothing. Reads the live faces through mesh.vertex_faces.
+std::vector<Quadric> face_quadrics(const WorkingMesh& mesh, Weighting weighting, unsigned threads);
 
 /// GH97 §6: marks the ends of every border edge (`edges`: unique_edges, with face counts) and, when
 /// `weight` > 0, adds to both ends the plane through the edge perpendicular to its face, weighted
@@ -22,5 +22,10 @@ std::vector<Quadric> face_quadrics(const WorkingMesh& mesh, Weighting weighting)
 /// at every resolution and scale), else by weight.
 void add_boundary_planes(WorkingMesh& mesh, const std::vector<Edge>& edges, double weight, Weighting weighting,
                          std::vector<Quadric>& quadrics);
+
+/// Forgetting (SimplifyOptions::forget): every quadric made again from the current live faces and
+/// border edges, as at the start (the face lists must be current).
+void renew_quadrics(WorkingMesh& mesh, Weighting weighting, double boundary_weight, unsigned threads,
+                    std::vector<Quadric>& quadrics);
 
 }  // namespace qem::core

@@ -1,6 +1,7 @@
 #include "core/order_greedy.h"
 
 #include "core/contraction.h"
+#include "core/fundamental_quadrics.h"
 #include "core/indexed_heap.h"
 
 namespace qem::core {
@@ -11,7 +12,8 @@ namespace {
 // may be lower than the pair's current cost: a cost that rises (as it nearly always does after a
 // contraction, since quadrics only grow) is not sifted down the heap; the pair is re-keyed when it
 // reaches the top. Keys are lower bounds and the popped pair's key is verified current, so the
-// order is exactly GH97's at a fraction of the heap work.
+// order is exactly GH97's at a fraction of the heap work. (Forgetting renews the quadrics: then
+// every key is made again.)
 struct GreedyLists {
   Context& c;
   IndexedHeap& heap;
@@ -43,22 +45,25 @@ struct GreedyLists {
 
 }  // namespace
 
-void run_greedy(Context& c, const std::vector<std::uint8_t>* stale) {
+void run_greedy(Context& c, const std::vector<std::uint8_t>* stale, double forget_at) {
   PairSet& ps = c.pairs;
   IndexedHeap heap;
-  heap.reset(ps.pairs.size());
-  if (!stale) ps.cost.assign(ps.pairs.size(), 0);
-  for (std::uint32_t p = 0; p < ps.pairs.size(); ++p) {
-    if (ps.pairs[p].state != kCandidate) continue;
-    if (stale && !(*stale)[p]) {  // pair_cost would give the same key (rounded to float already)
-      heap.push_unordered(p, ps.cost[p]);
-      continue;
+  const auto fill_heap = [&](const std::vector<std::uint8_t>* stale) {
+    heap.reset(ps.pairs.size());
+    if (!stale) ps.cost.assign(ps.pairs.size(), 0);
+    for (std::uint32_t p = 0; p < ps.pairs.size(); ++p) {
+      if (ps.pairs[p].state != kCandidate) continue;
+      if (stale && !(*stale)[p]) {  // pair_cost would give the same key (rounded to float already)
+        heap.push_unordered(p, ps.cost[p]);
+        continue;
+      }
+      double cost;
+      if (pair_cost(c, p, cost)) heap.push_unordered(p, cost), ps.cost[p] = float(cost);
+      else refuse(c, p);
     }
-    double cost;
-    if (pair_cost(c, p, cost)) heap.push_unordered(p, cost), ps.cost[p] = float(cost);
-    else refuse(c, p);
-  }
-  heap.heapify();
+    heap.heapify();
+  };
+  fill_heap(stale);
 
   GreedyLists lists{c, heap};
   while (!c.done()) {
@@ -67,6 +72,12 @@ void run_greedy(Context& c, const std::vector<std::uint8_t>* stale) {
       return;
     }
     if (!c.report_progress()) return;
+    if (c.settings.forget_due(c.mesh.faces_alive, forget_at)) {
+      // The renewed quadrics are smaller, so every key is made again: exact, not lower bounds.
+      c.mesh.rebuild_face_lists();  // live faces only: the border edges are counted from them
+      renew_quadrics(c.mesh, c.settings.weighting, c.settings.boundary_weight, c.settings.threads, c.quadric);
+      fill_heap(nullptr);
+    }
     const std::uint32_t top = heap.top();
     if (ps.cost[top] > heap.top_key()) {  // stale key: re-key and look again
       heap.update(top, ps.cost[top]);

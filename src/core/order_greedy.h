@@ -12,6 +12,7 @@ namespace qem::core {
 /// Contracts until the settings' stop criteria are met or nothing is left; the vertex lists must
 /// be exact when it starts (it keeps them exact). `stale` (may be null: every cost is computed)
 /// marks the pairs whose cost must be computed; the others' `pairs.cost` is taken as current.
-void run_greedy(Context& c, const std::vector<std::uint8_t>* stale = nullptr);
+/// `forget_at`: the face count of the next renewal of the quadrics (Settings::forget_due).
+void run_greedy(Context& c, const std::vector<std::uint8_t>* stale, double forget_at);
 
 }  // namespace qem::core

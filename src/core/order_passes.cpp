@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "core/cost_model.h"
+#include "core/fundamental_quadrics.h"
 #include "core/order_greedy.h"
 #include "core/parallel_chunks.h"
 #include "core/radix_sort.h"
@@ -104,6 +105,7 @@ void run_passes(Context& c, const std::function<void(const Context&, const PassS
   s.touched_in_pass.assign(c.mesh.vertex_count(), 0);
   Regions regions;
   std::vector<std::uint32_t> order, scratch, selected;
+  s.forget_at = c.settings.forget * double(c.mesh.faces_alive);
   for (std::uint32_t pass = 1; !c.done(); ++pass) {
     if (pass > 1) {
       // The lists as the last pass left them (see merged_from), rebuilt with live items only,
@@ -113,13 +115,17 @@ void run_passes(Context& c, const std::function<void(const Context&, const PassS
                    [&] { c.mesh.rebuild_face_lists(); });
     }
     s.merged_from.assign(c.mesh.vertex_count(), kNoVertex);
+    if (c.settings.forget_due(c.mesh.faces_alive, s.forget_at)) {  // the lists were just rebuilt
+      renew_quadrics(c.mesh, c.settings.weighting, c.settings.boundary_weight, c.settings.threads, c.quadric);
+      s.dirty.assign(c.pairs.pairs.size(), 1);
+    }
     if (c.mesh.faces_alive <= c.settings.greedy_below_faces) {
       // The lists were just rebuilt: exact, as the greedy order needs them. A candidate not marked
       // dirty was costed after its ends last changed, and its cost depends on nothing else (the
       // two quadrics, positions and lock flags) unless inversions are penalised (its neighbours)
       // or it carries wedges (the seams around it): then every cost is computed afresh.
       const bool reuse = c.settings.inversion != InversionPolicy::Penalize && !c.wedges;
-      run_greedy(c, reuse ? &s.dirty : nullptr);
+      run_greedy(c, reuse ? &s.dirty : nullptr, s.forget_at);
       if (after_band) after_band(c, PassState{});
       return;
     }

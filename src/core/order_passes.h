@@ -22,6 +22,9 @@ struct PassState {
   /// The pass in which each vertex was last chosen: each vertex contracts at most once a pass, so
   /// every other cost ranked in the pass stays exact.
   std::vector<std::uint32_t> touched_in_pass;
+  /// Forgetting (SimplifyOptions::forget): the quadrics are renewed at the first pass that starts
+  /// with at most this many faces.
+  double forget_at = 0;
 };
 
 /// How a pass sees the lists and costs (see contraction.h).

@@ -69,7 +69,9 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   if (wedges && options.lock_seams) lock_seam_vertices(*wedges, mesh);
   result.input_faces = mesh.faces_alive, result.input_vertices = mesh.vertices_alive;
   result.dropped_degenerate_faces = mesh.dropped_degenerate, result.dropped_duplicate_faces = mesh.dropped_duplicate;
-  const Settings settings = resolve(options, mesh);  // targets from the input, before any pruning
+  Settings resolved = resolve(options, mesh);  // targets from the input, before any pruning
+  if (wedges) resolved.forget = 0;  // the wedges' attribute quadrics remember (SimplifyOptions::forget)
+  const Settings& settings = resolved;
   // Without pruning, the component guard (made below, on the same faces) counts the input's
   // components; otherwise they are counted here, before the pruning.
   const bool guard_counts = settings.keep_components && settings.prune_size == 0;
@@ -106,7 +108,7 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   mesh.rebuild_face_lists();
   std::vector<Edge> edges;
   side_by_side(  // GH97 §5 (HG99 §2) and the edges of §3.2: independent, so side by side
-      settings.threads, [&] { quadric = face_quadrics(mesh, settings.weighting); },
+      settings.threads, [&] { quadric = face_quadrics(mesh, settings.weighting, 1); },
       [&] { edges = unique_edges(mesh.tri, mesh.vertex_faces, mesh.vertex_count()); });
   add_boundary_planes(mesh, edges, settings.boundary_weight, settings.weighting, quadric);  // GH97 §6
   if (settings.exact_border) mark_border_corners(mesh, edges);
@@ -122,7 +124,7 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   if (settings.scheme == Scheme::Passes) {
     run_passes(c, hooks.after_band);
   } else {
-    run_greedy(c);
+    run_greedy(c, nullptr, settings.forget * double(mesh.faces_alive));
     if (hooks.after_band) hooks.after_band(c, PassState{});
   }
   if (hooks.observer && result.stop_reason != StopReason::Cancelled) hooks.observer->on_progress(1.0);

@@ -26,6 +26,7 @@ void validate(const SimplifyOptions& o) {
   if (!(o.threshold >= 0)) throw Error("threshold must not be negative");
   if (!(o.boundary_weight >= 0)) throw Error("boundary weight must not be negative");
   if (!(o.prune_size >= 0) || std::isinf(o.prune_size)) throw Error("prune size must be a finite distance >= 0");
+  if (!(o.forget >= 0 && o.forget < 1)) throw Error("the forgetting factor must be in [0, 1) (0: never)");
 }
 
 Settings resolve(const SimplifyOptions& o, const WorkingMesh& mesh) {
@@ -54,6 +55,9 @@ Settings resolve(const SimplifyOptions& o, const WorkingMesh& mesh) {
   s.preserve_topology = o.preserve_topology;
   s.scheme = o.scheme;
   s.greedy_below_faces = o.greedy_below_faces;
+  // Renewed quadrics measure the distance to the current surface, not to the input: an error
+  // limit needs the whole quadrics (GH97 §4's bound).
+  s.forget = std::isfinite(o.max_error) ? 0 : o.forget;
   s.threads = resolve_threads(o.threads);
   s.keep_components = o.keep_components;
   s.prune_size = o.prune_size_is_relative ? o.prune_size : o.prune_size / mesh.frame.scale;

@@ -10,6 +10,12 @@
 
 namespace qem::core {
 
+/// Forgetting (SimplifyOptions::forget) stops below this many faces: a coarser mesh's own faces no
+/// longer stand for the surface, and GH97's remembering quadrics keep its overall shape (measured
+/// on the benchmark meshes at 100 faces with floors of 0, 300, 700, 1000 and 2000:
+/// docs/benchmarks.md, "Forgetting").
+inline constexpr double kForgetFloorFaces = 700;
+
 struct Settings {
   // --- stop criteria (the first reached wins) ---
   std::size_t target_faces = 0, target_vertices = 0;
@@ -27,9 +33,19 @@ struct Settings {
   bool preserve_topology = true;
   Scheme scheme = Scheme::Passes;
   std::size_t greedy_below_faces = 0;
+  double forget = 0;          ///< SimplifyOptions::forget, 0 where it does not apply
   unsigned threads = 1;       ///< resolved: at least 1
   bool keep_components = true;
   double prune_size = 0;      ///< in the working frame (0: no pruning)
+
+  /// Forgetting's schedule, on the face count alone (never the target, so every target sees one
+  /// sequence of contractions): whether the quadrics are due for renewal with `faces` left; if so,
+  /// `at` moves on to the next count.
+  bool forget_due(std::size_t faces, double& at) const {
+    if (!(forget > 0) || double(faces) > at || double(faces) < kForgetFloorFaces) return false;
+    while (double(faces) <= at) at *= forget;
+    return true;
+  }
 
   bool reached(const WorkingMesh& m) const {
     return m.faces_alive <= target_faces || m.vertices_alive <= target_vertices;
