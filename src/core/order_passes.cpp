@@ -105,7 +105,7 @@ void run_passes(Context& c, const std::function<void(const Context&, const PassS
   s.touched_in_pass.assign(c.mesh.vertex_count(), 0);
   Regions regions;
   std::vector<std::uint32_t> order, scratch, selected;
-  s.forget_at = c.settings.forget * double(c.mesh.faces_alive);
+  s.forget_at = c.settings.first_forget_at(c.mesh.faces_alive);
   for (std::uint32_t pass = 1; !c.done(); ++pass) {
     if (pass > 1) {
       // The lists as the last pass left them (see merged_from), rebuilt with live items only,

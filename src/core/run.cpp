@@ -69,9 +69,7 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   if (wedges && options.lock_seams) lock_seam_vertices(*wedges, mesh);
   result.input_faces = mesh.faces_alive, result.input_vertices = mesh.vertices_alive;
   result.dropped_degenerate_faces = mesh.dropped_degenerate, result.dropped_duplicate_faces = mesh.dropped_duplicate;
-  Settings resolved = resolve(options, mesh);  // targets from the input, before any pruning
-  if (wedges) resolved.forget = 0;  // the wedges' attribute quadrics remember (SimplifyOptions::forget)
-  const Settings& settings = resolved;
+  const Settings settings = resolve(options, mesh, wedges.has_value());  // targets from the input, before pruning
   // Without pruning, the component guard (made below, on the same faces) counts the input's
   // components; otherwise they are counted here, before the pruning.
   const bool guard_counts = settings.keep_components && settings.prune_size == 0;
@@ -124,7 +122,7 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   if (settings.scheme == Scheme::Passes) {
     run_passes(c, hooks.after_band);
   } else {
-    run_greedy(c, nullptr, settings.forget * double(mesh.faces_alive));
+    run_greedy(c, nullptr, settings.first_forget_at(mesh.faces_alive));
     if (hooks.after_band) hooks.after_band(c, PassState{});
   }
   if (hooks.observer && result.stop_reason != StopReason::Cancelled) hooks.observer->on_progress(1.0);

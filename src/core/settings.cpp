@@ -29,7 +29,7 @@ void validate(const SimplifyOptions& o) {
   if (!(o.forget >= 0 && o.forget < 1)) throw Error("the forgetting factor must be in [0, 1) (0: never)");
 }
 
-Settings resolve(const SimplifyOptions& o, const WorkingMesh& mesh) {
+Settings resolve(const SimplifyOptions& o, const WorkingMesh& mesh, bool attributes) {
   validate(o);
   Settings s;
   bool any = false;
@@ -56,8 +56,9 @@ Settings resolve(const SimplifyOptions& o, const WorkingMesh& mesh) {
   s.scheme = o.scheme;
   s.greedy_below_faces = o.greedy_below_faces;
   // Renewed quadrics measure the distance to the current surface, not to the input: an error
-  // limit needs the whole quadrics (GH97 §4's bound).
-  s.forget = std::isfinite(o.max_error) ? 0 : o.forget;
+  // limit needs the whole quadrics (GH97 §4's bound). The wedges' attribute quadrics are not
+  // renewed, so with attributes every quadric remembers.
+  s.forget = std::isfinite(o.max_error) || attributes ? 0 : o.forget;
   s.threads = resolve_threads(o.threads);
   s.keep_components = o.keep_components;
   s.prune_size = o.prune_size_is_relative ? o.prune_size : o.prune_size / mesh.frame.scale;

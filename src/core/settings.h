@@ -46,6 +46,8 @@ struct Settings {
     while (double(faces) <= at) at *= forget;
     return true;
   }
+  /// The face count of the first renewal in a run that starts with `faces`.
+  double first_forget_at(std::size_t faces) const { return forget * double(faces); }
 
   bool reached(const WorkingMesh& m) const {
     return m.faces_alive <= target_faces || m.vertices_alive <= target_vertices;
@@ -57,8 +59,8 @@ struct Settings {
 void validate(const SimplifyOptions& options);
 
 /// The validated options in the frame of `mesh` (targets from its face count after dropping
-/// degenerate and duplicate faces).
-Settings resolve(const SimplifyOptions& options, const WorkingMesh& mesh);
+/// degenerate and duplicate faces); `attributes`: the run carries wedges (Hoppe 1999).
+Settings resolve(const SimplifyOptions& options, const WorkingMesh& mesh, bool attributes);
 
 /// The human-readable reason a run stopped.
 std::string stop_detail(StopReason reason, const SimplifyResult& totals, bool lock_border);
