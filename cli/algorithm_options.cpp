@@ -33,9 +33,12 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
       ->capture_default_str();
   sub->add_option("--forget", a.forget,
                   "Renew every quadric from the current faces each time the faces fall by this factor (0 = never, "
-                  "GH97's quadrics; off with --max-error and with attributes)")
+                  "GH97's quadrics; off with --max-error, and with attributes unless --forget-attributes)")
       ->check(CLI::Range(0.0, 0.999999))
       ->capture_default_str();
+  sub->add_flag("--forget-attributes", a.forget_attributes,
+                "With attributes, forget too: renew the wedges' attribute quadrics and the seam planes with the "
+                "positions' (lower geometric error on most assets; attribute errors may rise on some)");
   sub->add_option("--threads", a.threads, "Threads for the passes: re-costing pairs, and making contractions region by region (0 = all; same result)")
       ->capture_default_str();
   sub->add_option("--boundary-weight", a.boundary_weight,
@@ -158,6 +161,7 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
   opt.scheme = parsed<Scheme>("--scheme", a.scheme);
   opt.greedy_below_faces = a.greedy_below;
   opt.forget = a.forget;
+  opt.forget_attributes = a.forget_attributes;
   opt.threads = a.threads;
   opt.boundary_weight = a.boundary_weight;
   opt.max_normal_turn_degrees = a.max_turn;

@@ -24,6 +24,7 @@ struct AlgorithmArgs {
   std::string scheme = to_string(SimplifyOptions{}.scheme);
   std::size_t greedy_below = SimplifyOptions{}.greedy_below_faces;
   double forget = kDefaultForget;  // --forget F (0 = GH97's remembering quadrics)
+  bool forget_attributes = false;  // --forget-attributes
   unsigned threads = 0;
   double boundary_weight = SimplifyOptions{}.boundary_weight;
   double max_turn = SimplifyOptions{}.max_normal_turn_degrees;

@@ -225,7 +225,7 @@ def _options(*, target_faces, target_ratio, target_vertices, max_error, max_erro
              max_distance=None, max_distance_relative=None,
              threshold_relative, weighting, placement, boundary_weight, lock_border, inversion, max_turn,
              allow_non_manifold, scheme, refit, threads, record, keep_components=True, prune=None,
-             prune_relative=None, exact_border=True, forget=0.85):
+             prune_relative=None, exact_border=True, forget=0.85, forget_attributes=False):
     o = _qem.SimplifyOptions()
 
     def count(name, value):
@@ -308,6 +308,7 @@ def _options(*, target_faces, target_ratio, target_vertices, max_error, max_erro
     if isinstance(forget, bool) or not isinstance(forget, (int, float)) or not 0 <= forget < 1:
         raise ValueError(f"forget: expected a factor in [0, 1) (0 = never), got {forget!r}")
     o.forget = float(forget)
+    o.forget_attributes = bool(forget_attributes)
 
     if refit in (None, False):
         refit = "none"
@@ -346,7 +347,7 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
              threshold_relative: Optional[float] = None, weighting: str = "area", placement: str = "optimal",
              boundary_weight: float = 1.0, lock_border: bool = False, inversion: str = "forbid",
              max_turn: float = 75.0, allow_non_manifold: bool = False, scheme: str = "passes",
-             forget: float = 0.85, refit="light", threads: int = 0, keep_components: bool = True, prune: Optional[float] = None,
+             forget: float = 0.85, forget_attributes: bool = False, refit="light", threads: int = 0, keep_components: bool = True, prune: Optional[float] = None,
              prune_relative: Optional[float] = None, exact_border: bool = True, attributes: Optional[dict] = None,
              attribute_weights: Optional[dict] = None, fit_attributes: bool = False, vertex_lock=None,
              return_mapping: bool = False, far_repair: Optional[bool] = None,
@@ -385,8 +386,10 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
       scheme: "passes" (fast) or "greedy" (GH97's heap: strictly cheapest first).
       forget: each time the faces fall by this factor, every quadric is made again from the current
         faces and border edges, so later contractions are ranked by what they do to the current
-        surface (a lower mean error; not below 700 faces, not with max_error or attributes); 0 =
-        GH97's quadrics, which remember every plane.
+        surface (a lower mean error; not below 700 faces, not with max_error, with attributes only
+        with forget_attributes); 0 = GH97's quadrics, which remember every plane.
+      forget_attributes: with attributes, forget too: the attribute quadrics and seam planes are
+        renewed with the positions' (a lower E on most assets; attribute errors may rise on some).
       refit: after the last contraction move the vertices to fit the input surface, faces fixed:
         "light" (default, as the command line: 2 rounds on ~8 input vertices per output vertex, fewer
         or none at mild reductions, only with optimal placement, without record and without texture
@@ -438,7 +441,7 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
                        threshold_relative=threshold_relative, weighting=weighting, placement=placement,
                        boundary_weight=boundary_weight, lock_border=lock_border, inversion=inversion,
                        max_turn=max_turn, allow_non_manifold=allow_non_manifold, scheme=scheme, refit=refit,
-                       forget=forget, threads=threads, record=record, keep_components=keep_components, prune=prune,
+                       forget=forget, forget_attributes=forget_attributes, threads=threads, record=record, keep_components=keep_components, prune=prune,
                        prune_relative=prune_relative, exact_border=exact_border)
     # The light default follows the command line here too: not on a mesh with texture coordinates
     # or normals, where it lowers E but raises their errors a little (docs/attributes.md, "Seams,

@@ -150,6 +150,7 @@ def simplify(
     allow_non_manifold: bool = ...,
     scheme: Literal["greedy", "passes"] = ...,
     forget: float = ...,
+    forget_attributes: bool = ...,
     refit: _Refit = ...,
     threads: int = ...,
     keep_components: bool = ...,

@@ -152,6 +152,7 @@ void bind_simplify(py::module_& m) {
       .def_readwrite("preserve_topology", &SimplifyOptions::preserve_topology)
       .def_readwrite("greedy_below_faces", &SimplifyOptions::greedy_below_faces)
       .def_readwrite("forget", &SimplifyOptions::forget)
+      .def_readwrite("forget_attributes", &SimplifyOptions::forget_attributes)
       .def_readwrite("threads", &SimplifyOptions::threads)
       .def_readwrite("refit_rounds", &SimplifyOptions::refit_rounds)
       .def_readwrite("refit_points_per_vertex", &SimplifyOptions::refit_points_per_vertex)

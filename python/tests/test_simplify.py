@@ -237,3 +237,15 @@ def test_forget_follows_the_command_line(small_torus):
     for bad in (1.0, -0.5, True, "0.5"):
         with pytest.raises(ValueError, match="forget"):
             qem.simplify(v, f, target_faces=1000, forget=bad)
+
+
+def test_forget_attributes_is_asked_for(small_torus):
+    # With attributes the quadrics remember unless forget_attributes asks (the library's rule).
+    v, f = small_torus
+    normals = {"NORMAL": v / np.linalg.norm(v, axis=1)[:, None]}
+    plain = qem.simplify(v, f, target_faces=1000, refit="none", attributes=normals)
+    remember = qem.simplify(v, f, target_faces=1000, refit="none", attributes=normals, forget=0)
+    asked = qem.simplify(v, f, target_faces=1000, refit="none", attributes=normals, forget_attributes=True)
+    assert plain.vertices.tobytes() == remember.vertices.tobytes()
+    assert asked.vertices.tobytes() != plain.vertices.tobytes()
+    assert np.allclose(np.linalg.norm(asked.attributes["NORMAL"], axis=1), 1.0)

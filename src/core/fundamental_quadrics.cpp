@@ -1,6 +1,5 @@
 #include "core/fundamental_quadrics.h"
 
-#include <algorithm>
 #include <cmath>
 
 #include "core/parallel_chunks.h"
@@ -68,13 +67,6 @@ void add_boundary_planes(WorkingMesh& m, const std::vector<Edge>& edges, double 
     quadric[e.lo] += q;
     quadric[e.hi] += q;
   }
-}
-
-void renew_quadrics(WorkingMesh& m, Weighting weighting, double boundary_weight, unsigned threads,
-                    std::vector<Quadric>& quadric) {
-  quadric = face_quadrics(m, weighting, threads);
-  if (std::find(m.boundary.begin(), m.boundary.end(), std::uint8_t(1)) == m.boundary.end()) return;  // closed
-  add_boundary_planes(m, unique_edges(m.tri, m.vertex_faces, m.vertex_count()), boundary_weight, weighting, quadric);
 }
 
 }  // namespace qem::core

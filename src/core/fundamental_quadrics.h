@@ -23,9 +23,4 @@ std::vector<Quadric> face_quadrics(const WorkingMesh& mesh, Weighting weighting,
 void add_boundary_planes(WorkingMesh& mesh, const std::vector<Edge>& edges, double weight, Weighting weighting,
                          std::vector<Quadric>& quadrics);
 
-/// Forgetting (SimplifyOptions::forget): every quadric made again from the current live faces and
-/// border edges, as at the start (the face lists must be current).
-void renew_quadrics(WorkingMesh& mesh, Weighting weighting, double boundary_weight, unsigned threads,
-                    std::vector<Quadric>& quadrics);
-
 }  // namespace qem::core

@@ -1,7 +1,7 @@
 #include "core/order_greedy.h"
 
 #include "core/contraction.h"
-#include "core/fundamental_quadrics.h"
+#include "core/forgetting.h"
 #include "core/indexed_heap.h"
 
 namespace qem::core {
@@ -75,7 +75,7 @@ void run_greedy(Context& c, const std::vector<std::uint8_t>* stale, double forge
     if (c.settings.forget_due(c.mesh.faces_alive, forget_at)) {
       // The renewed quadrics are smaller, so every key is made again: exact, not lower bounds.
       c.mesh.rebuild_face_lists();  // live faces only: the border edges are counted from them
-      renew_quadrics(c.mesh, c.settings.weighting, c.settings.boundary_weight, c.settings.threads, c.quadric);
+      renew_quadrics(c);
       fill_heap(nullptr);
     }
     const std::uint32_t top = heap.top();

@@ -4,7 +4,7 @@
 #include <limits>
 
 #include "core/cost_model.h"
-#include "core/fundamental_quadrics.h"
+#include "core/forgetting.h"
 #include "core/order_greedy.h"
 #include "core/parallel_chunks.h"
 #include "core/radix_sort.h"
@@ -116,7 +116,7 @@ void run_passes(Context& c, const std::function<void(const Context&, const PassS
     }
     s.merged_from.assign(c.mesh.vertex_count(), kNoVertex);
     if (c.settings.forget_due(c.mesh.faces_alive, s.forget_at)) {  // the lists were just rebuilt
-      renew_quadrics(c.mesh, c.settings.weighting, c.settings.boundary_weight, c.settings.threads, c.quadric);
+      renew_quadrics(c);
       s.dirty.assign(c.pairs.pairs.size(), 1);
     }
     if (c.mesh.faces_alive <= c.settings.greedy_below_faces) {

@@ -110,7 +110,7 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
       [&] { edges = unique_edges(mesh.tri, mesh.vertex_faces, mesh.vertex_count()); });
   add_boundary_planes(mesh, edges, settings.boundary_weight, settings.weighting, quadric);  // GH97 §6
   if (settings.exact_border) mark_border_corners(mesh, edges);
-  if (wedges) add_seam_planes(mesh, edges, options.attribute_weights.seam, settings.weighting, quadric);
+  if (wedges) add_seam_planes(mesh, edges, settings.seam_weight, settings.weighting, quadric);
   pairs = select_pairs(mesh, std::move(edges), settings.threshold);                         // GH97 §3.2
   result.virtual_pairs = pairs.virtual_count;
   c.marks.assign(mesh.vertex_count(), 0);

@@ -56,9 +56,10 @@ Settings resolve(const SimplifyOptions& o, const WorkingMesh& mesh, bool attribu
   s.scheme = o.scheme;
   s.greedy_below_faces = o.greedy_below_faces;
   // Renewed quadrics measure the distance to the current surface, not to the input: an error
-  // limit needs the whole quadrics (GH97 §4's bound). The wedges' attribute quadrics are not
-  // renewed, so with attributes every quadric remembers.
-  s.forget = std::isfinite(o.max_error) || attributes ? 0 : o.forget;
+  // limit needs the whole quadrics (GH97 §4's bound). With attributes only when asked
+  // (SimplifyOptions::forget_attributes).
+  s.forget = std::isfinite(o.max_error) || (attributes && !o.forget_attributes) ? 0 : o.forget;
+  s.seam_weight = o.attribute_weights.seam;
   s.threads = resolve_threads(o.threads);
   s.keep_components = o.keep_components;
   s.prune_size = o.prune_size_is_relative ? o.prune_size : o.prune_size / mesh.frame.scale;

@@ -34,6 +34,7 @@ struct Settings {
   Scheme scheme = Scheme::Passes;
   std::size_t greedy_below_faces = 0;
   double forget = 0;          ///< SimplifyOptions::forget, 0 where it does not apply
+  double seam_weight = 0;     ///< AttributeWeights::seam (seam_planes.h)
   unsigned threads = 1;       ///< resolved: at least 1
   bool keep_components = true;
   double prune_size = 0;      ///< in the working frame (0: no pruning)

@@ -347,13 +347,18 @@ Wedges build_wedges(MeshView in, const std::vector<std::uint32_t>& internal, Wor
   }
   wg.corners.assign(wg.count(), 0);
   for (std::uint32_t w : m.corner_wedge) ++wg.corners[w];
-  wg.quadric.assign(wg.count() * std::size_t(wg.quadric_width), 0);
-  for (std::uint32_t f = 0; f < m.face_source.size(); ++f) {
+  wg.renew_quadrics(m);
+  return wg;
+}
+
+void Wedges::renew_quadrics(const WorkingMesh& m) {
+  quadric.assign(count() * std::size_t(quadric_width), 0);
+  for (std::uint32_t f = 0; f < m.face_alive.size(); ++f) {
+    if (!m.face_alive[f]) continue;
     const std::uint32_t* t = m.face(f);
     const Vec3 p[3] = {m.pos[t[0]], m.pos[t[1]], m.pos[t[2]]};
-    add_face(wg, p, &m.corner_wedge[3 * std::size_t(f)]);
+    add_face(*this, p, &m.corner_wedge[3 * std::size_t(f)]);
   }
-  return wg;
 }
 
 namespace {

@@ -86,6 +86,9 @@ struct Wedges {
   /// wedge of a vertex stays, so a ring is never empty), and clears `emptied`. A vertex left with
   /// one wedge is an ordinary vertex again: it may be removed and placed freely.
   void drop_unused(std::vector<std::uint32_t>& emptied);
+  /// Forgetting (SimplifyOptions::forget): every wedge's quadric made again, as build_wedges makes
+  /// it, from the live faces of `m` at their current positions and the wedges' current values.
+  void renew_quadrics(const WorkingMesh& m);
   /// Renumbering (renumber.h): working vertex v is now vertex_to[v].
   void renumber(const std::vector<std::uint32_t>& vertex_to, std::size_t count);
   /// The surviving wedge an input vertex's values went into (kNoVertex: none).
