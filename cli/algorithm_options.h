@@ -12,9 +12,6 @@
 
 namespace qem::cli {
 
-/// The command line forgets (SimplifyOptions::forget) where the library keeps GH97's quadrics:
-/// measured on the benchmark meshes (docs/benchmarks.md, "Forgetting").
-inline constexpr double kDefaultForget = 0.85;
 
 struct AlgorithmArgs {
   double threshold = 0, threshold_rel = 0;
@@ -23,7 +20,7 @@ struct AlgorithmArgs {
   std::string inversion = to_string(SimplifyOptions{}.inversion);
   std::string scheme = to_string(SimplifyOptions{}.scheme);
   std::size_t greedy_below = SimplifyOptions{}.greedy_below_faces;
-  double forget = kDefaultForget;  // --forget F (0 = GH97's remembering quadrics)
+  double forget = kRecommendedForget;  // --forget F (0 = GH97's remembering quadrics; the library's default)
   bool forget_attributes = false;  // --forget-attributes
   unsigned threads = 0;
   double boundary_weight = SimplifyOptions{}.boundary_weight;

@@ -101,6 +101,11 @@ struct AttributeWeights {
   double seam = 4.5;
 };
 
+/// The forgetting factor (SimplifyOptions::forget) the command line and the Python module use by
+/// default, where the library keeps GH97's quadrics (0): measured on the benchmark meshes
+/// (docs/benchmarks.md, "Forgetting").
+inline constexpr double kRecommendedForget = 0.85;
+
 struct SimplifyOptions {
   // --- stop criteria: any combination, the first reached wins -----------------------------------
   std::size_t target_faces = 0;     ///< stop at or below this many faces (0 = no face target)

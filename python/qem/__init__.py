@@ -42,6 +42,8 @@ __all__ = [
 
 Error = _qem.Error
 Error.__doc__ = "A failure the library reports (bad option, unreadable file, bad mesh); a ValueError."
+# The command line's forgetting factor (qem::kRecommendedForget), the default here too.
+_FORGET = _qem.RECOMMENDED_FORGET
 
 
 class Mesh:
@@ -225,7 +227,7 @@ def _options(*, target_faces, target_ratio, target_vertices, max_error, max_erro
              max_distance=None, max_distance_relative=None,
              threshold_relative, weighting, placement, boundary_weight, lock_border, inversion, max_turn,
              allow_non_manifold, scheme, refit, threads, record, keep_components=True, prune=None,
-             prune_relative=None, exact_border=True, forget=0.85, forget_attributes=False):
+             prune_relative=None, exact_border=True, forget=_FORGET, forget_attributes=False):
     o = _qem.SimplifyOptions()
 
     def count(name, value):
@@ -347,7 +349,7 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
              threshold_relative: Optional[float] = None, weighting: str = "area", placement: str = "optimal",
              boundary_weight: float = 1.0, lock_border: bool = False, inversion: str = "forbid",
              max_turn: float = 75.0, allow_non_manifold: bool = False, scheme: str = "passes",
-             forget: float = 0.85, forget_attributes: bool = False, refit="light", threads: int = 0, keep_components: bool = True, prune: Optional[float] = None,
+             forget: float = _FORGET, forget_attributes: bool = False, refit="light", threads: int = 0, keep_components: bool = True, prune: Optional[float] = None,
              prune_relative: Optional[float] = None, exact_border: bool = True, attributes: Optional[dict] = None,
              attribute_weights: Optional[dict] = None, fit_attributes: bool = False, vertex_lock=None,
              return_mapping: bool = False, far_repair: Optional[bool] = None,
@@ -611,7 +613,7 @@ def lod(vertices, faces, *, ratios=None, target_faces=None, refit="light", **opt
     defaults = dict(threshold=0.0, threshold_relative=None, weighting="area", placement="optimal",
                     boundary_weight=1.0, lock_border=False, inversion="forbid", max_turn=75.0,
                     allow_non_manifold=False, scheme="passes", threads=0, keep_components=True, prune=None,
-                    prune_relative=None, exact_border=True, forget=0.85)
+                    prune_relative=None, exact_border=True, forget=_FORGET)
     unknown = set(options) - set(defaults)
     if unknown:
         raise TypeError(f"lod() got unexpected keyword arguments: {', '.join(sorted(unknown))}")

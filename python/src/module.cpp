@@ -2,6 +2,7 @@
 // its keyword-only API and documentation; this module converts arrays and runs the library.
 #include "bindings.h"
 #include "qem/error.h"
+#include "qem/simplify.h"
 
 PYBIND11_MODULE(_qem, m) {
   namespace py = pybind11;
@@ -10,6 +11,7 @@ PYBIND11_MODULE(_qem, m) {
   // that catch bad input generally (ValueError) catch it too.
   py::register_exception<qem::Error>(m, "Error", PyExc_ValueError);
   m.attr("kUnmapped") = -1;
+  m.attr("RECOMMENDED_FORGET") = qem::kRecommendedForget;  // the defaults of qem/__init__.py
   qem::python::bind_simplify(m);
   qem::python::bind_tools(m);
 }
