@@ -12,7 +12,6 @@
 
 namespace qem::cli {
 
-
 struct AlgorithmArgs {
   double threshold = 0, threshold_rel = 0;
   std::string weighting = to_string(SimplifyOptions{}.weighting);

@@ -1,7 +1,6 @@
 #include "core/forgetting.h"
 
 #include <algorithm>
-#include <cstdlib>
 #include <vector>
 
 #include "core/fundamental_quadrics.h"
@@ -19,7 +18,7 @@ void renew_quadrics(Context& c) {
   const std::vector<Edge> edges = unique_edges(m.tri, m.vertex_faces, m.vertex_count());
   if (open) add_boundary_planes(m, edges, s.boundary_weight, s.weighting, c.quadric);
   if (!c.wedges) return;
-  if (!std::getenv("QEM_KEEP_WEDGE_Q")) c.wedges->renew_quadrics(m);
+  c.wedges->renew_quadrics(m);
   add_seam_planes(m, edges, s.seam_weight, s.weighting, c.quadric);
 }
 
