@@ -193,7 +193,7 @@ struct SimplifyOptions {
   /// memoryless cost does, which lowers the mean error at the same face count (docs/benchmarks.md,
   /// "Forgetting"). Not below 700 faces, where the mesh's own faces no longer stand for the
   /// surface and the memory keeps its shape. 0 = GH97 as published (never); in [0, 1); the
-  /// command line's default is 0.85. Off under max_error (the contraction error bounds the
+  /// command line's and Python's default is kRecommendedForget. Off under max_error (the contraction error bounds the
   /// distance to the input only with whole quadrics). The schedule follows the face count, never
   /// the target, so a contraction record still replays to a direct run's mesh.
   double forget = 0;

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/parallel_chunks.h"
+#include "core/seam_planes.h"
 
 namespace qem::core {
 
@@ -67,6 +68,12 @@ void add_boundary_planes(WorkingMesh& m, const std::vector<Edge>& edges, double 
     quadric[e.lo] += q;
     quadric[e.hi] += q;
   }
+}
+
+void add_constraint_planes(WorkingMesh& m, const std::vector<Edge>& edges, const Settings& s, bool seams,
+                           std::vector<Quadric>& quadric) {
+  add_boundary_planes(m, edges, s.boundary_weight, s.weighting, quadric);  // GH97 §6
+  if (seams) add_seam_planes(m, edges, s.seam_weight, s.weighting, quadric);
 }
 
 }  // namespace qem::core

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "core/quadric.h"
+#include "core/settings.h"
 #include "core/valid_pairs.h"
 #include "core/working_mesh.h"
 #include "qem/simplify.h"
@@ -22,5 +23,11 @@ std::vector<Quadric> face_quadrics(const WorkingMesh& mesh, Weighting weighting,
 /// at every resolution and scale), else by weight.
 void add_boundary_planes(WorkingMesh& mesh, const std::vector<Edge>& edges, double weight, Weighting weighting,
                          std::vector<Quadric>& quadrics);
+
+/// The constraint planes a run adds to the face quadrics, at the start and at each renewal
+/// (forgetting.h): the border planes (add_boundary_planes, which also marks the border) and, when
+/// the run carries wedges (`seams`), the seam planes (seam_planes.h), with the settings' weights.
+void add_constraint_planes(WorkingMesh& mesh, const std::vector<Edge>& edges, const Settings& settings, bool seams,
+                           std::vector<Quadric>& quadrics);
 
 }  // namespace qem::core

@@ -13,7 +13,6 @@
 #include "core/parallel_chunks.h"
 #include "core/settings.h"
 #include "core/valid_pairs.h"
-#include "core/seam_planes.h"
 #include "core/wedges.h"
 #include "core/working_mesh.h"
 #include "qem/error.h"
@@ -108,13 +107,12 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   side_by_side(  // GH97 §5 (HG99 §2) and the edges of §3.2: independent, so side by side
       settings.threads, [&] { quadric = face_quadrics(mesh, settings.weighting, 1); },
       [&] { edges = unique_edges(mesh.tri, mesh.vertex_faces, mesh.vertex_count()); });
-  add_boundary_planes(mesh, edges, settings.boundary_weight, settings.weighting, quadric);  // GH97 §6
-  if (settings.exact_border) mark_border_corners(mesh, edges);
-  if (wedges) add_seam_planes(mesh, edges, settings.seam_weight, settings.weighting, quadric);
+  add_constraint_planes(mesh, edges, settings, wedges.has_value(), quadric);  // GH97 §6, seams
+  if (settings.exact_border) mark_border_corners(mesh, edges);  // after: the border is marked
   pairs = select_pairs(mesh, std::move(edges), settings.threshold);                         // GH97 §3.2
   result.virtual_pairs = pairs.virtual_count;
   c.marks.assign(mesh.vertex_count(), 0);
-  std::optional<ComponentGuard> components;  // after add_boundary_planes: it tells closed from open
+  std::optional<ComponentGuard> components;  // after add_constraint_planes: it tells closed from open
   if (settings.keep_components) c.components = &components.emplace(mesh);
   if (guard_counts) result.input_components = components->initial_count();
 
