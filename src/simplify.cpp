@@ -67,11 +67,15 @@ std::vector<std::uint8_t> border_points_for(const Mesh& mesh, std::span<const st
 // the input (`positions`) as `points` and `surface`, `on_border` per point (border_points_for). A
 // relocated vertex that stands at an input vertex takes its exact coordinates (on a border: on the
 // input's border, as exact borders promise).
-core::FarRepairResult repair_mesh(Mesh& mesh, const SimplifyOptions& options, std::span<const double> positions,
+core::FarRepairResult repair_mesh(Mesh& mesh, const SimplifyOptions& options, MeshView input,
                                   std::span<const std::uint8_t> on_border, const refit_detail::FitPoints& points,
                                   const core::SurfaceDistance& surface, std::span<const std::uint8_t> held) {
+  const std::span<const double> positions = input.positions;
   core::FarRepairOptions repair_options;
   repair_options.held = held;
+  repair_options.input_attributes = input.attributes;
+  repair_options.point_source = points.source;
+  repair_options.attribute_weights = options.attribute_weights;
   repair_options.max_normal_turn_degrees = options.max_normal_turn_degrees;
   repair_options.threads = core::resolve_threads(options.threads);
   // Each relocation mends the one farthest place, until one cannot be made; a few were made on the
@@ -126,7 +130,7 @@ void refit_levels(MeshView original, std::span<ReplayLevel> levels, const Simpli
       for (std::size_t v = 0; v < held.size(); ++v)
         held[v] = std::binary_search(locked.begin(), locked.end(),
                                      std::array<double, 3>{mesh->positions[3 * v], mesh->positions[3 * v + 1], mesh->positions[3 * v + 2]});
-      repair_mesh(*mesh, options, original.positions, on_border, points, surface, held);
+      repair_mesh(*mesh, options, original, on_border, points, surface, held);
     }
 }
 
@@ -141,7 +145,7 @@ std::vector<std::uint8_t> seam_or_locked(std::span<const std::uint8_t> on_seam, 
 void repair_after_refit(SimplifyResult& result, const SimplifyOptions& options, MeshView input,
                         const refit_detail::FitPoints& points, const core::SurfaceDistance& surface,
                         std::span<const std::uint8_t> held) {
-  const core::FarRepairResult made = repair_mesh(result.mesh, options, input.positions,
+  const core::FarRepairResult made = repair_mesh(result.mesh, options, input,
                                                  border_points_for(result.mesh, input.indices, points), points, surface, held);
   result.edge_flips = made.flips;
   result.vertex_moves = made.moves;
@@ -215,11 +219,12 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
   check_options(options);
   const bool refit = options.refit_rounds > 0;
   const bool bounded = std::isfinite(options.max_distance);
-  // The attribute fit (refit/attribute_fit.h) reads the input's attributes after the run: they
-  // are not released to it then.
+  // The attribute fit (refit/attribute_fit.h) and the far-place repair (whose flips and moves must
+  // not raise the error of appearance) read the input's attributes after the run: they are not
+  // released to it then.
   const bool fit_values =
       options.fit_attributes && refit_detail::has_fitted_attributes(input.attributes, options.attribute_weights);
-  if (fit_values) consumed_attributes = nullptr;
+  if (fit_values || options.far_repair) consumed_attributes = nullptr;
   // The refit fits the input's vertices weighted by their share of the area, and its guard (and
   // the distance bound's report) measures against the input's faces: taken before the core
   // releases a consumed input's faces.
@@ -256,6 +261,8 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
   // share of the area) and faces, in the points' frame.
   refit_detail::FitPoints points;
   core::SurfaceDistance surface;
+  MeshView input_surface = input;  // the faces kept when the core consumed them
+  input_surface.indices = input_faces;
   if (refitted || repaired) {
     const unsigned threads = core::resolve_threads(options.threads);
     if (!consumed_indices) weights = refit_detail::vertex_areas(input, threads);
@@ -281,7 +288,7 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
     out.refit_rounds = fit.rounds;
   }
   if (repaired)
-    repair_after_refit(out, options, MeshView(input.positions, input_faces), points, surface, seam_or_locked(wedge_refit.on_seam, fixed, out.mesh.vertex_count()));
+    repair_after_refit(out, options, input_surface, points, surface, seam_or_locked(wedge_refit.on_seam, fixed, out.mesh.vertex_count()));
   if (fit_values && out.contractions > 0 && out.stop_reason != StopReason::Cancelled) {
     // After the refit: the values fit the final positions. Seam and locked vertices keep theirs.
     const std::vector<std::uint8_t> held = seam_or_locked(wedge_refit.on_seam, fixed, out.mesh.vertex_count());

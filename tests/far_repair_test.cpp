@@ -1,9 +1,9 @@
 // Tests of the repair of the far places after the run (core/far_repair.h,
 // SimplifyOptions::far_repair): an edge across a groove is flipped onto it, an edge that already
-// lies on the input is left, held vertices keep their edges and positions, a vertex under a
-// cut-off bump moves onto it, and on real simplifications the repair never folds a face, never
-// makes an edge non-manifold or changes the topology, moves no border vertex and does not raise
-// the largest distance to the input.
+// lies on the input is left, held vertices keep their edges and positions, no flip raises the
+// error of the attributes, a vertex under a cut-off bump moves onto it, and on real
+// simplifications the repair never folds a face, never makes an edge non-manifold or changes the
+// topology, moves no border vertex and does not raise the largest distance to the input.
 #include "core/far_repair.h"
 
 #include <gtest/gtest.h>
@@ -123,6 +123,50 @@ TEST(FarRepair, HeldVerticesAndMaterialBoundariesKeepTheirEdges) {
   Groove g;
   g.approx.face_materials = {0, 1};
   EXPECT_EQ(flip(g.approx, g.input).flips, 0u);
+}
+
+// The groove with a vertex e in the middle of its floor, and colours: the approximation's banks
+// a, b are green, its floor's ends c, d red; e is of the colour given. Before the flip e's colour
+// is read from the middle of a-b (green), after it from the middle of c-d (red).
+struct ColouredGroove : Groove {
+  explicit ColouredGroove(const std::array<double, 3>& e) {
+    input.positions.insert(input.positions.end(), {0.5, 0.5, -0.05});
+    input.indices = {0, 3, 4, 0, 4, 2, 1, 2, 4, 1, 4, 3};
+    const std::vector<double> green = {0, 1, 0}, red = {1, 0, 0};
+    VertexAttribute in{"COLOR_0", AttributeKind::Color, 3, {}}, out = in;
+    for (const std::vector<double>* c : {&green, &green, &red, &red}) out.values.insert(out.values.end(), c->begin(), c->end());
+    in.values = out.values;
+    in.values.insert(in.values.end(), e.begin(), e.end());
+    input.attributes = {in};
+    approx.attributes = {out};
+  }
+  core::FarRepairResult repair() {
+    source = {0, 1, 2, 3, 4};
+    core::FarRepairOptions o;
+    o.input_attributes = input.attributes;
+    o.point_source = source;
+    return flip(approx, input, o);
+  }
+  std::vector<std::uint32_t> source;
+};
+
+TEST(FarRepair, NoFlipRaisesTheErrorOfAppearance) {
+  // e green: the flip onto the floor would paint it red; refused, though it brings the surface
+  // onto the input.
+  ColouredGroove green({0, 1, 0});
+  EXPECT_EQ(green.repair().flips, 0u);
+  EXPECT_TRUE(has_edge(green.approx, 0, 1));
+  // e red: the flip lowers both errors; made.
+  ColouredGroove red({1, 0, 0});
+  EXPECT_EQ(red.repair().flips, 1u);
+  EXPECT_TRUE(has_edge(red.approx, 2, 3));
+  // Without the input's attributes, geometry alone judges: made.
+  ColouredGroove blind({0, 1, 0});
+  EXPECT_EQ(flip(blind.approx, blind.input).flips, 1u);
+  // A channel the metric does not weigh (skin joints) judges nothing.
+  ColouredGroove joints({0, 1, 0});
+  joints.input.attributes[0].kind = joints.approx.attributes[0].kind = AttributeKind::JointIndices;
+  EXPECT_EQ(joints.repair().flips, 1u);
 }
 
 TEST(FarRepair, NoFlipThatFoldsOrDuplicatesAnEdge) {

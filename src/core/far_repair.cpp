@@ -9,6 +9,7 @@
 #include <queue>
 #include <vector>
 
+#include "core/attribute_weight.h"
 #include "core/border_placement.h"
 #include "core/parallel_chunks.h"
 #include "core/same_position.h"
@@ -91,6 +92,13 @@ class Repairer {
       const std::uint32_t a = place[0], b = place[1];
       if (place.size() == 2 && !caller_held_[a] && !caller_held_[b]) twin_[a] = b, twin_[b] = a;
     }
+    // The channels that count in the metric, where the output carries them as the input does.
+    for (std::size_t i = 0; i < options.input_attributes.size() && i < approx.attributes.size(); ++i) {
+      const VertexAttribute &in = options.input_attributes[i], &out = approx.attributes[i];
+      const double w = attribute_weight(in.kind, options.attribute_weights);
+      if (w > 0 && in.components == out.components && !options.point_source.empty())
+        channels_.push_back({&in.values, &out.values, in.components, w * w});
+    }
     faces_at_.assign(n, {});
     for (std::uint32_t f = 0; f < face_count(); ++f)
       for (int k = 0; k < 3; ++k) faces_at_[tri_[3 * f + k]].push_back(f);
@@ -131,6 +139,27 @@ class Repairer {
  private:
   std::uint32_t face_count() const { return std::uint32_t(tri_.size() / 3); }
   Vec3 point(std::uint32_t p) const { return {points_[3 * p], points_[3 * p + 1], points_[3 * p + 2]}; }
+
+  // Point p's error of appearance against face (a, b, c): the weighted squared difference between
+  // its input vertex's values and the face's interpolated at p's closest point, times p's share of
+  // the area (in the units of the points' squared distances). 0 without attributes.
+  double value_error(std::uint32_t p, std::uint32_t a, std::uint32_t b, std::uint32_t c) const {
+    if (channels_.empty()) return 0;
+    const std::array<double, 3> w = measure_detail::closest_point_weights(point(p), x_[a], x_[b], x_[c]);
+    const std::size_t s = opt_.point_source[p];
+    double error = 0;
+    for (const Channel& ch : channels_) {
+      const double *in = &(*ch.input)[s * ch.components], *va = &(*ch.output)[a * ch.components],
+                   *vb = &(*ch.output)[b * ch.components], *vc = &(*ch.output)[c * ch.components];
+      double sum = 0;
+      for (std::uint32_t k = 0; k < ch.components; ++k) {
+        const double d = w[0] * va[k] + w[1] * vb[k] + w[2] * vc[k] - in[k];
+        sum += d * d;
+      }
+      error += ch.weight2 * sum;
+    }
+    return weights_[p] * weight_scale_ * error;
+  }
 
   // The samples of face abc, searched from input face `hint`; stops at the first sample at least
   // `limit` from the input (then `energy` is incomplete and `most` at least limit).
@@ -354,6 +383,18 @@ class Repairer {
     const double most2 = to_nearest_faces(pts, 2, corners, scratch_nearest_, scratch_d2_, energy);
     if (std::max({s1.most, s2.most, std::sqrt(most2)}) >= old_most) return UINT32_MAX;
     if (energy > old_energy * (1 + opt_.error_margin)) return UINT32_MAX;
+    if (!channels_.empty()) {
+      // The points' values, interpolated on the faces they were nearest and will be.
+      const std::uint32_t g1v[3] = {a, d, c}, g2v[3] = {b, c, d};
+      double before = 0, after = 0;
+      for (std::size_t i = 0; i < pts.size(); ++i) {
+        const std::uint32_t* t = &tri_[3 * (i < points_of_[f1].size() ? f1 : f2)];
+        before += value_error(pts[i], t[0], t[1], t[2]);
+        const std::uint32_t* g = scratch_nearest_[i] == 0 ? g1v : g2v;
+        after += value_error(pts[i], g[0], g[1], g[2]);
+      }
+      if (after > before) return UINT32_MAX;
+    }
 
     // Made: f1 becomes (a,d,c), f2 (b,c,d); b leaves f1 and d joins it, a leaves f2 and c joins it.
     tri_[3 * f1] = a, tri_[3 * f1 + 1] = d, tri_[3 * f1 + 2] = c;
@@ -407,7 +448,12 @@ class Repairer {
     // The fan's points, each to the nearest of the fan's faces after the move.
     std::vector<std::uint32_t>& pts = scratch_points_;
     pts.clear();
-    for (std::uint32_t f : fan) pts.insert(pts.end(), points_of_[f].begin(), points_of_[f].end());
+    double values_before = 0;
+    for (std::uint32_t f : fan) {
+      pts.insert(pts.end(), points_of_[f].begin(), points_of_[f].end());
+      const std::uint32_t* t = &tri_[3 * f];
+      for (std::uint32_t p : points_of_[f]) values_before += value_error(p, t[0], t[1], t[2]);
+    }
     x_[v] = y;
     double energy = 0;
     for (std::size_t i = 0; i < fan.size(); ++i) energy += scores[i].energy;
@@ -417,6 +463,14 @@ class Repairer {
     };
     const double most2 = to_nearest_faces(pts, fan.size(), corners, scratch_nearest_, scratch_d2_, energy);
     if (std::sqrt(most2) >= old_most || energy > old_energy * (1 + opt_.error_margin)) return x_[v] = x, false;
+    if (!channels_.empty()) {
+      double values_after = 0;
+      for (std::size_t i = 0; i < pts.size(); ++i) {
+        const std::uint32_t* t = &tri_[3 * fan[scratch_nearest_[i]]];
+        values_after += value_error(pts[i], t[0], t[1], t[2]);
+      }
+      if (values_after > values_before) return x_[v] = x, false;
+    }
     for (std::size_t i = 0; i < fan.size(); ++i) score_[fan[i]] = scores[i], scored_[fan[i]] = 1, points_of_[fan[i]].clear();
     for (std::size_t i = 0; i < pts.size(); ++i)
       d2_[pts[i]] = scratch_d2_[i], points_of_[fan[scratch_nearest_[i]]].push_back(pts[i]);
@@ -1178,6 +1232,13 @@ class Repairer {
   const FarRepairOptions& opt_;
   const double cos_turn_;
   const double weight_scale_;  // model area to the frame's
+  struct Channel {
+    const std::vector<double>* input;   // per input vertex
+    const std::vector<double>* output;  // per output vertex
+    std::uint32_t components;
+    double weight2;  // the metric's weight, squared
+  };
+  std::vector<Channel> channels_;                    // the attributes that judge flips and moves
   std::vector<Vec3> x_;                              // output positions in the frame
   std::vector<std::uint8_t> held_;                   // per vertex: its edges stay
   std::vector<std::uint32_t> twin_;                  // per vertex, the other vertex at its position (a pair only)

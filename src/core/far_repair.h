@@ -57,6 +57,7 @@
 #include "core/distance_bound.h"
 #include "geometry/frame.h"
 #include "qem/mesh.h"
+#include "qem/simplify.h"
 
 namespace qem::core {
 
@@ -86,6 +87,15 @@ struct FarRepairOptions {
   double relocation_budget = 0.005;
   /// Per point: 1 = on the input's border (points_on_border). Empty: no relocation at a border.
   std::span<const std::uint8_t> point_on_border;
+  /// With attributes (approx.attributes, in the order of the input's): the input's per-vertex
+  /// attributes and each point's input vertex (FitPoints::source). A flip or a move changes where
+  /// the output's values are interpolated; it is also refused where it raises its points' error
+  /// of appearance: each point's values against the output's interpolated at its closest point,
+  /// weighted as the metric weighs the channels (`attribute_weights`), by the points' areas. Empty:
+  /// geometry alone judges.
+  std::span<const VertexAttribute> input_attributes;
+  std::span<const std::uint32_t> point_source;
+  AttributeWeights attribute_weights;
   /// Whether a relocation may add a vertex: at a crack (two border edges at the same positions, the
   /// sides of a seam the input never welded), both sides split together, so the faces' count
   /// stays and the vertices' grows by one.

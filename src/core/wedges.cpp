@@ -6,6 +6,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "core/attribute_weight.h"
 #include "qem/error.h"
 
 namespace qem::core {
@@ -15,20 +16,6 @@ namespace qem::core {
 namespace {
 
 constexpr std::uint32_t kHead = 11;
-
-double weight_of(AttributeKind kind, const AttributeWeights& w) {
-  switch (kind) {
-    case AttributeKind::Normal: return w.normal;
-    case AttributeKind::TexCoord: return w.tex_coord;
-    case AttributeKind::Color: return w.color;
-    case AttributeKind::Scalar: return w.scalar;
-    case AttributeKind::JointIndices:  // ids: never interpolated
-    case AttributeKind::JointWeights:  // taken with the joints they weigh
-    case AttributeKind::Tangent:       // recomputed from the normals and UVs by renderers
-      return 0;
-  }
-  return 0;
-}
 
 // Adds, for every interpolated channel, the face's linear fit g.p + d of the corner values (g in
 // the face's plane: the gradient of the barycentric interpolation) to each corner wedge, weighted
@@ -271,7 +258,7 @@ Wedges build_wedges(MeshView in, const std::vector<std::uint32_t>& internal, Wor
   Wedges wg;
   std::uint32_t interpolated = 0;
   for (const VertexAttribute& a : in.attributes) {
-    const double weight = weight_of(a.kind, options.attribute_weights);
+    const double weight = attribute_weight(a.kind, options.attribute_weights);
     wg.channels.push_back({a.kind, wg.width, a.components, weight});
     wg.width += a.components;
     if (weight > 0) interpolated += a.components;

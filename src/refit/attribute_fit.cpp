@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/attribute_weight.h"
 #include "geometry/vec3.h"
 #include "measure/point_triangle.h"
 
@@ -14,20 +15,7 @@ namespace qem::refit_detail {
 
 namespace {
 
-bool fitted(const VertexAttribute& a, const AttributeWeights& w) {
-  switch (a.kind) {
-    case AttributeKind::Normal:
-      return w.normal > 0;
-    case AttributeKind::TexCoord:
-      return w.tex_coord > 0;
-    case AttributeKind::Color:
-      return w.color > 0;
-    case AttributeKind::Scalar:
-      return w.scalar > 0;
-    default:
-      return false;  // joints, skin weights, tangents: carried, never interpolated
-  }
-}
+bool fitted(const VertexAttribute& a, const AttributeWeights& w) { return core::attribute_weight(a.kind, w) > 0; }
 
 // Weight of the pull towards a vertex's present values, per unit of its area share: keeps the
 // system definite where no sample lands near a vertex, too small to move the others.
