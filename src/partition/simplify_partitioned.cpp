@@ -277,7 +277,7 @@ SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options
     result.refit_rms_after = fit.rms_after;
     result.refit_rounds = fit.rounds;
     if (options.far_repair)  // after the refit, against the whole input, as simplify's
-      repair_after_refit(result, options, MeshView(input.positions, input.indices), points, surface,
+      repair_after_refit(result, options, input, points, surface,
                          seam_or_locked(wedge_refit.on_seam, fixed, result.mesh.vertex_count()));
   }
   if (fit_values && result.contractions > 0) {

@@ -42,7 +42,8 @@ std::vector<std::uint8_t> seam_or_locked(std::span<const std::uint8_t> on_seam, 
 
 /// The far-place repair (core/far_repair.h) of `result` after its refit, against the input (its
 /// positions and the faces the run used) as points and surface (those of the refit), `held`
-/// vertices left as they are; counts it in `result` and carries its provenance across relocations.
+/// vertices left as they are; with the input's attributes (in `input`) no flip or move raises
+/// the error of appearance. Counts it in `result` and carries its provenance across relocations.
 void repair_after_refit(SimplifyResult& result, const SimplifyOptions& options, MeshView input,
                         const refit_detail::FitPoints& points, const core::SurfaceDistance& surface,
                         std::span<const std::uint8_t> held);
