@@ -437,6 +437,52 @@ TEST(FarRepair, ALoneFaceOverADippingPartGetsABorderVertexFromItsPart) {
   EXPECT_NEAR(p[2], 0.0005, 1e-12);
 }
 
+// A lone spike: one vertex of a fine flat grid 0.4 above the others (an outlier pixel), under the
+// diagonal of a cell of a coarse flat grid. Faces from that cell's corners up to the tip would
+// turn by 81 degrees, past the limit of 75, so no vertex stands at the tip; one goes part of the
+// way up (half: 73 degrees), which still cuts the largest distance. No vertex moves here (each
+// corner of the cell is too far from the tip to lift it without lifting flat ground).
+TEST(FarRepair, ALoneSpikeGetsAVertexPartOfTheWayUp) {
+  Mesh input = test::grid(32);
+  input.positions[3 * (10 * 33 + 10) + 2] = 0.4;  // (0.3125, 0.3125)
+  const Mesh grid = test::grid(8);
+  Mesh with = grid;
+  std::vector<std::uint32_t> source(input.vertex_count());
+  for (std::uint32_t v = 0; v < source.size(); ++v) source[v] = v;
+  const std::vector<std::uint8_t> on_border = core::points_on_border(input.indices, source);
+  core::FarRepairOptions o;
+  o.relocations = 8;
+  o.point_on_border = on_border;
+  o.move_vertices = false;
+  o.relocation_budget = 1;  // a share of the E the grid has, which is the spike's alone
+  const double before = both_ways(grid, input);
+  EXPECT_NEAR(before, 0.4, 1e-12);
+  const core::FarRepairResult r = flip(with, input, o);
+  ASSERT_GE(r.relocations.size(), 1u);
+  EXPECT_LT(both_ways(with, input), 0.8 * before);
+  EXPECT_EQ(with.face_count(), grid.face_count());
+  EXPECT_EQ(test::validity_problem(with), "");
+  EXPECT_EQ(test::boundary_edges(with), test::boundary_edges(grid));
+  // The new vertex stands over the spike's foot, below its tip, and not on the input.
+  const core::Relocation& first = r.relocations.front();
+  EXPECT_FALSE(first.at_point);
+  const double* p = &with.positions[3 * std::size_t(first.removed)];
+  EXPECT_NEAR(p[0], 0.3125, 1e-12);
+  EXPECT_NEAR(p[1], 0.3125, 1e-12);
+  EXPECT_GT(p[2], 0.05);
+  EXPECT_LT(p[2], 0.4);
+  // No face turns past the limit from the flat grid (nor, so, over: the output stays a height
+  // field), however many splits were made round the spike. (Its faces may meet at ridges as sharp
+  // as the spike's own, so folded_edges, which counts any two faces more than 90 degrees apart,
+  // does not apply.)
+  for (std::size_t f = 0; f < with.face_count(); ++f) {
+    const std::uint32_t* t = &with.indices[3 * f];
+    const auto at = [&](int k) { return Vec3{with.positions[3 * t[k]], with.positions[3 * t[k] + 1], with.positions[3 * t[k] + 2]}; };
+    const Vec3 n = normalized(cross(at(1) - at(0), at(2) - at(0)));
+    EXPECT_GE(n.z, std::cos(75 * std::numbers::pi / 180) - 1e-12) << "face " << f;
+  }
+}
+
 // height_field(n, f) cut along x = 0.5: the faces right of the cut use copies of the vertices on
 // it (a crack the mesh never welded).
 Mesh cracked(int n, double (*f)(double, double)) {

@@ -714,7 +714,9 @@ class Repairer {
     return p.most < limit;
   }
 
-  // Whether each new face of p is not degenerate and turns by at most the limit from its parent.
+  // Whether each new face of p is not degenerate and turns by at most the limit from its parent,
+  // as its parent's line was before the relocations (first_normal_): measured from the parent as
+  // it is, splits beside an earlier split's steep faces would add turn to turn, and fold.
   bool keeps_facing(const Plan& p, const Vec3& y) const {
     for (std::size_t i = 0; i < p.faces.size(); ++i) {
       const Corners& t = p.faces[i];
@@ -725,7 +727,7 @@ class Repairer {
       const double longest2 = std::max({dot(p1 - p0, p1 - p0), dot(p2 - p1, p2 - p1), dot(p0 - p2, p0 - p2)});
       if (!(dot(e, e) > 1e-18 * longest2 * longest2)) return false;
       const Vec3 m = normalized(e);
-      const Vec3 n = normalized(normal(o[0], o[1], o[2]));
+      const Vec3 n = first_normal_.empty() ? normalized(normal(o[0], o[1], o[2])) : first_normal_[p.parent[i]];
       if (dot(n, n) == 0 || dot(m, n) < cos_turn_) return false;
     }
     return true;
@@ -927,7 +929,20 @@ class Repairer {
       s.faces = {{t[0], t[1], kNew}, {t[1], t[2], kNew}, {t[2], t[0], kNew}};
       s.parent = {f, f, f};
     }
-    if (!keeps_facing(s, s.y)) return false;
+    if (!keeps_facing(s, s.y)) {
+      // A lone spike of the input (one vertex far above its neighbours, an outlier pixel of a
+      // terrain): the faces up to its tip would turn by more than the limit. Part of the way up
+      // still cuts the largest distance (by the part), as far as the limit allows.
+      if (s.border || s.crack) return false;
+      const Vec3 base = near, tip = s.y;
+      bool lifted = false;
+      for (double part : {0.75, 0.5, 0.25})
+        if (keeps_facing(s, base + (tip - base) * part)) {
+          s.y = base + (tip - base) * part, s.at_point = false, lifted = true;
+          break;
+        }
+      if (!lifted) return false;
+    }
     return score_plan(s, s.y, HUGE_VAL) && s.most < local(f) && input_stays_near(s, s.y, local(f));
   }
 
@@ -1039,8 +1054,11 @@ class Repairer {
       points_of_[f].clear();
     }
     std::vector<std::uint32_t> slot(p.faces.size());
+    std::vector<Vec3> first(p.faces.size());
+    for (std::size_t i = 0; i < p.faces.size(); ++i) first[i] = first_normal_[p.parent[i]];
     for (std::size_t i = 0; i < p.faces.size(); ++i) {
       slot[i] = i < p.old.size() ? p.old[i] : spare[i - p.old.size()];
+      first_normal_[slot[i]] = first[i];
       for (int k = 0; k < 3; ++k) {
         const std::uint32_t v = p.faces[i][k] == kNew ? w : p.faces[i][k] == kNewTwin ? twin : p.faces[i][k];
         tri_[3 * slot[i] + k] = v;
@@ -1071,6 +1089,8 @@ class Repairer {
       std::sort(flat_border.begin(), flat_border.end());
     };
     std::vector<std::uint8_t> spent(nv, 0);  // new vertices: they stay
+    first_normal_.resize(face_count());
+    for (std::uint32_t f = 0; f < face_count(); ++f) first_normal_[f] = normalized(normal(tri_[3 * f], tri_[3 * f + 1], tri_[3 * f + 2]));
     peaked_.assign(face_count(), 0);
     dead_face_.assign(face_count(), 0);
     std::size_t faces_given_up = 0, stuck = 0;
@@ -1253,6 +1273,7 @@ class Repairer {
   std::vector<std::uint32_t> rescored_;              // faces ensure_scored scored (relocate's heap takes them)
   std::vector<std::pair<double, std::uint32_t>> border_by_x_;  // the input's border points by x (plan_split)
   std::vector<std::uint8_t> peaked_;                 // per face: score_.most climbed to its peak (relocations)
+  std::vector<Vec3> first_normal_;                   // per face slot, its line's normal when the relocations began
   std::vector<double> near_;                         // per face, its centroid's and edge midpoints' largest
   std::vector<std::uint32_t> hint_;                  // per face, a face of the input near it
   double largest_ = 0;                               // the largest distance both ways, at the start (scanned)

@@ -33,6 +33,9 @@
 //     border vertex nearest the far place; the nearest whose faces turn nothing over. At a
 //     crack (two coincident border edges, the sides of a seam the input never welded) both sides
 //     divide together, a vertex more (`add_vertices`); where the sides already part, one alone.
+//     At a lone spike of the input (an outlier pixel of a terrain), where faces up to its tip
+//     would turn by more than `max_normal_turn_degrees`, the new vertex goes 3/4, 1/2 or 1/4 of
+//     the way up instead, the highest the limit allows: the largest distance still falls.
 //   - the collapse: an interior vertex whose removal moves the surface least (its distance to its
 //     ring's plane, squared, times its fan's area: the share of E it would add) goes into a
 //     neighbour; for a border split, a border vertex along its border (not a corner, as the
@@ -40,7 +43,10 @@
 //     short (at most one face in 256).
 // Made only where the largest distance falls (the split's faces below the farthest, the
 // collapse's below half of it, input samples between the input's vertices included), the link
-// condition holds and no face folds; together they may raise E by at most `relocation_budget`.
+// condition holds and no face folds: each new face within the turn limit of the face it comes
+// from, and no crease with a face round it sharper than the limit unless the one it replaces was
+// (as for flips: splits beside an earlier split's steep faces would otherwise add turn to turn);
+// together they may raise E by at most `relocation_budget`.
 // Farthest place first (border faces from 0.4 of the largest scored first: there a face's
 // centroid and edge midpoints can miss its peak by a factor); a place no relocation mends is
 // passed over, up to 8 in a row. Not on
