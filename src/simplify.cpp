@@ -59,7 +59,7 @@ namespace {
 // when `mesh` has what a relocation could not give its new vertex (no relocation runs then).
 std::vector<std::uint8_t> border_points_for(const Mesh& mesh, std::span<const std::uint32_t> faces,
                                             const refit_detail::FitPoints& points) {
-  if (!mesh.attributes.empty() || !mesh.face_materials.empty() || !mesh.vertex_properties.empty()) return {};
+  if (!mesh.vertex_properties.empty()) return {};
   return core::points_on_border(faces, points.source);
 }
 

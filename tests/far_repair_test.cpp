@@ -19,6 +19,7 @@
 #include "core/distance_bound.h"
 #include "geometry/frame.h"
 #include "mesh_checks.h"
+#include "measure/point_triangle.h"
 #include "outofcore/mesh_generator.h"
 #include "qem/simplify.h"
 #include "test_meshes.h"
@@ -435,6 +436,89 @@ TEST(FarRepair, ALoneFaceOverADippingPartGetsABorderVertexFromItsPart) {
   EXPECT_DOUBLE_EQ(p[0], 0.44);
   EXPECT_DOUBLE_EQ(p[1], 0.40);
   EXPECT_NEAR(p[2], 0.0005, 1e-12);
+}
+
+// With attributes and materials: the tent again, coloured by a linear field (red = x, green = y,
+// blue = 1/2) and of two materials (x below and above 1/2, the boundary's vertices held, as
+// simplify holds seams). The new vertex takes the values of the place it divides; each new face is
+// of its parent's material; the vertex the relocation takes away is one whose values the others
+// interpolate (in a linear field, any; not a spot of another colour).
+TEST(FarRepair, RelocationsCarryValuesAndMaterials) {
+  const auto paint = [](Mesh& m) {
+    VertexAttribute colour{"COLOR_0", AttributeKind::Color, 3, {}};
+    for (std::size_t v = 0; v < m.vertex_count(); ++v)
+      colour.values.insert(colour.values.end(), {m.positions[3 * v], m.positions[3 * v + 1], 0.5});
+    m.attributes = {colour};
+    for (std::size_t f = 0; f < m.face_count(); ++f) {
+      const std::uint32_t* t = &m.indices[3 * f];
+      const double x = (m.positions[3 * t[0]] + m.positions[3 * t[1]] + m.positions[3 * t[2]]) / 3;
+      m.face_materials.push_back(x < 0.5 ? 0 : 1);
+    }
+  };
+  Mesh input = test::height_field(64, tent), with = test::grid(8);
+  paint(input), paint(with);
+  std::vector<std::uint32_t> source(input.vertex_count());
+  for (std::uint32_t v = 0; v < source.size(); ++v) source[v] = v;
+  const std::vector<std::uint8_t> on_border = core::points_on_border(input.indices, source);
+  std::vector<std::uint8_t> held(with.vertex_count(), 0);
+  for (std::size_t v = 0; v < held.size(); ++v) held[v] = with.positions[3 * v] == 0.5;
+  core::FarRepairOptions o;
+  o.relocations = 8;
+  o.point_on_border = on_border;
+  o.held = held;
+  o.input_attributes = input.attributes;
+  o.point_source = source;
+  const double before = both_ways(with, input);
+  const core::FarRepairResult r = flip(with, input, o);
+  ASSERT_GE(r.relocations.size(), 1u);
+  EXPECT_LT(both_ways(with, input), 0.8 * before);
+  ASSERT_EQ(with.attributes.size(), 1u);
+  ASSERT_EQ(with.attributes[0].values.size(), 3 * with.vertex_count());
+  // Each vertex's colour is the field's at its foot on the faces it divided: where earlier splits
+  // tilted them over the tent, the foot is off the vertex's own (x, y) by a fraction of the tent's
+  // height (0.03); far less than the distance any vertex came from the flat (0.1 and more).
+  for (std::size_t v = 0; v < with.vertex_count(); ++v) {
+    const double* c = &with.attributes[0].values[3 * v];
+    EXPECT_NEAR(c[0], with.positions[3 * v], 0.01) << "vertex " << v;
+    EXPECT_NEAR(c[1], with.positions[3 * v + 1], 0.01) << "vertex " << v;
+    EXPECT_NEAR(c[2], 0.5, 1e-12);
+  }
+  ASSERT_EQ(with.face_materials.size(), with.face_count());
+  for (std::size_t f = 0; f < with.face_count(); ++f) {
+    const std::uint32_t* t = &with.indices[3 * f];
+    const double x = (with.positions[3 * t[0]] + with.positions[3 * t[1]] + with.positions[3 * t[2]]) / 3;
+    EXPECT_EQ(with.face_materials[f], x < 0.5 ? 0u : 1u) << "face " << f;
+  }
+  // The vertex the first relocation took away, of another colour in the output, and the input's
+  // colours those the output interpolates (so the output has them right, and without the vertex
+  // would not): it stays, and another goes.
+  Mesh spotted = test::grid(8);
+  paint(spotted);
+  const std::uint32_t spot = r.relocations.front().removed;
+  const double sx = spotted.positions[3 * spot], sy = spotted.positions[3 * spot + 1];
+  spotted.attributes[0].values[3 * spot + 2] = 1;
+  Mesh spotted_input = input;
+  for (std::size_t v = 0; v < spotted_input.vertex_count(); ++v) {
+    const double x = spotted_input.positions[3 * v], y = spotted_input.positions[3 * v + 1];
+    for (std::size_t f = 0; f < spotted.face_count(); ++f) {
+      const std::uint32_t* t = &spotted.indices[3 * f];
+      const auto at = [&](int k) { return Vec3{spotted.positions[3 * t[k]], spotted.positions[3 * t[k] + 1], 0}; };
+      const std::array<double, 3> w = measure_detail::closest_point_weights({x, y, 0}, at(0), at(1), at(2));
+      const Vec3 q = at(0) * w[0] + at(1) * w[1] + at(2) * w[2];
+      if (std::hypot(q.x - x, q.y - y) > 1e-12) continue;
+      double blue = 0;
+      for (int k = 0; k < 3; ++k) blue += w[k] * spotted.attributes[0].values[3 * t[k] + 2];
+      spotted_input.attributes[0].values[3 * v + 2] = blue;
+      break;
+    }
+  }
+  o.input_attributes = spotted_input.attributes;
+  const core::FarRepairResult s = flip(spotted, spotted_input, o);
+  ASSERT_GE(s.relocations.size(), 1u);
+  EXPECT_NE(s.relocations.front().removed, spot);
+  EXPECT_EQ(spotted.positions[3 * spot], sx);
+  EXPECT_EQ(spotted.positions[3 * spot + 1], sy);
+  EXPECT_EQ(spotted.attributes[0].values[3 * spot + 2], 1);
 }
 
 // A lone spike: one vertex of a fine flat grid 0.4 above the others (an outlier pixel), under the

@@ -118,13 +118,17 @@ class Repairer {
       if (flips == 0) break;
     }
     if (opt_.move_vertices) r.moves = move_vertices();
-    if (opt_.relocations > 0 && mesh_.attributes.empty() && mesh_.face_materials.empty() && mesh_.vertex_properties.empty())
-      r.relocations = relocate();
+    if (opt_.relocations > 0 && mesh_.vertex_properties.empty()) r.relocations = relocate();
     if (std::find(dead_face_.begin(), dead_face_.end(), 1) != dead_face_.end()) {
       std::size_t next = 0;
+      std::vector<std::uint32_t>& materials = mesh_.face_materials;
       for (std::size_t f = 0; f < face_count(); ++f)
-        if (!dead_face_[f]) std::copy_n(&tri_[3 * f], 3, &tri_[3 * next++]);
+        if (!dead_face_[f]) {
+          if (!materials.empty()) materials[next] = materials[f];
+          std::copy_n(&tri_[3 * f], 3, &tri_[3 * next++]);
+        }
       tri_.resize(3 * next);
+      if (!materials.empty()) materials.resize(next);
     }
     mesh_.indices = tri_;
     mesh_.positions.resize(3 * x_.size());
@@ -637,6 +641,12 @@ class Repairer {
     bool at_point = false;           // y is the point's place
     bool crack = false;              // a border edge and its twin: two new vertices, two faces more
     bool hold_new = false;           // the new vertex is held (it splits a held edge)
+    // The new vertex's attribute values: interpolated from these corners with these shares (the
+    // edge's ends, or the face's corners, at the new vertex's place on the divided edge or face),
+    // so that the split leaves the values along the old faces as they were; its twin's from the
+    // twin edge's ends.
+    std::array<std::uint32_t, 3> from{}, twin_from{};
+    std::array<double, 3> share{}, share_twin{};
   };
   struct Collapse : Plan {
     std::uint32_t u = 0, v = 0;  // u goes into v
@@ -943,6 +953,24 @@ class Repairer {
         }
       if (!lifted) return false;
     }
+    // The values at the new vertex's foot on the faces it divides (of an edge's two, the nearer).
+    s.from = {t[0], t[1], t[2]};
+    s.share = measure_detail::closest_point_weights(s.y, a, b, c);
+    if (s.old.size() == 2 && !s.crack) {
+      const std::uint32_t* o = &tri_[3 * g];
+      const auto on = [&](const std::uint32_t* q, const std::array<double, 3>& w) {
+        return x_[q[0]] * w[0] + x_[q[1]] * w[1] + x_[q[2]] * w[2];
+      };
+      const std::array<double, 3> w = measure_detail::closest_point_weights(s.y, x_[o[0]], x_[o[1]], x_[o[2]]);
+      if (measure_detail::squared_distance(s.y, on(o, w)) < measure_detail::squared_distance(s.y, on(t, s.share)))
+        s.from = {o[0], o[1], o[2]}, s.share = w;
+    }
+    if (s.crack) {  // the twin at the same place along the twin edge
+      const Vec3 along = x_[eb] - x_[ea];
+      const double u = std::clamp(dot(s.y - x_[ea], along) / std::max(dot(along, along), 1e-300), 0.0, 1.0);
+      s.twin_from = {twin_[ea], twin_[eb], twin_[ea]};
+      s.share_twin = {1 - u, u, 0};
+    }
     return score_plan(s, s.y, HUGE_VAL) && s.most < local(f) && input_stays_near(s, s.y, local(f));
   }
 
@@ -1021,12 +1049,57 @@ class Repairer {
       // that no part vanishes or folds onto itself.
       if (c.faces.empty() || any_face_exists(c.faces)) continue;
       if (!keeps_facing(c, {}) || !score_plan(c, {}, limit) || !input_stays_near(c, {}, limit)) continue;
+      if (!keeps_appearance(c)) continue;
       if (!found || c.energy - c.old_energy < best.energy - best.old_energy) {
         best = c, best.u = u, best.v = v;
         found = true;
       }
     }
     return found;
+  }
+
+  // Whether collapse c leaves the error of appearance of its faces' input points as it was, or
+  // lowers it (to rounding: in a patch of one colour the values interpolate to the same, but for
+  // the last bits): the vertex it takes away carries no values the others do not.
+  bool keeps_appearance(const Plan& c) const {
+    if (channels_.empty()) return true;
+    double before = 0, after = 0, weight = 0;
+    std::size_t i = 0;
+    for (std::uint32_t f : c.old)
+      for (std::uint32_t q : points_of_[f]) {
+        const std::uint32_t* t = &tri_[3 * f];
+        const Corners& g = c.faces[c.nearest[i++]];
+        before += value_error(q, t[0], t[1], t[2]);
+        after += value_error(q, g[0], g[1], g[2]);
+        weight += weights_[q] * weight_scale_;
+      }
+    return after <= before + 1e-20 * weight;
+  }
+
+  // Vertex v's attribute values (appended when v is new): those of corners `from` by `share`;
+  // normals renormalised, colours clamped, and what is never interpolated (skin joints and their
+  // weights, tangents) taken from the corner of the largest share.
+  void set_values(std::uint32_t v, const std::array<std::uint32_t, 3>& from, const std::array<double, 3>& share) {
+    const int main = int(std::max_element(share.begin(), share.end()) - share.begin());
+    for (VertexAttribute& a : mesh_.attributes) {
+      const std::size_t n = a.components;
+      if (a.values.size() < n * (std::size_t(v) + 1)) a.values.resize(n * (std::size_t(v) + 1));
+      double* out = &a.values[n * v];
+      const bool blend = a.kind == AttributeKind::Normal || a.kind == AttributeKind::TexCoord ||
+                         a.kind == AttributeKind::Color || a.kind == AttributeKind::Scalar;
+      for (std::size_t k = 0; k < n; ++k)
+        out[k] = blend ? share[0] * a.values[n * from[0] + k] + share[1] * a.values[n * from[1] + k] +
+                             share[2] * a.values[n * from[2] + k]
+                       : a.values[n * from[main] + k];
+      if (a.kind == AttributeKind::Normal) {
+        double length2 = 0;
+        for (std::size_t k = 0; k < n; ++k) length2 += out[k] * out[k];
+        if (length2 > 0)
+          for (std::size_t k = 0; k < n; ++k) out[k] /= std::sqrt(length2);
+      }
+      if (a.kind == AttributeKind::Color)
+        for (std::size_t k = 0; k < n; ++k) out[k] = std::clamp(out[k], 0.0, 1.0);
+    }
   }
 
   // Whether border vertex v may go along its border: two border edges, every edge at it with one
@@ -1056,9 +1129,14 @@ class Repairer {
     std::vector<std::uint32_t> slot(p.faces.size());
     std::vector<Vec3> first(p.faces.size());
     for (std::size_t i = 0; i < p.faces.size(); ++i) first[i] = first_normal_[p.parent[i]];
+    // Each new face is of its parent's material (read before the slots are written).
+    std::vector<std::uint32_t>& materials = mesh_.face_materials;
+    std::vector<std::uint32_t> material(materials.empty() ? 0 : p.faces.size());
+    for (std::size_t i = 0; i < material.size(); ++i) material[i] = materials[p.parent[i]];
     for (std::size_t i = 0; i < p.faces.size(); ++i) {
       slot[i] = i < p.old.size() ? p.old[i] : spare[i - p.old.size()];
       first_normal_[slot[i]] = first[i];
+      if (!material.empty()) materials[slot[i]] = material[i];
       for (int k = 0; k < 3; ++k) {
         const std::uint32_t v = p.faces[i][k] == kNew ? w : p.faces[i][k] == kNewTwin ? twin : p.faces[i][k];
         tri_[3 * slot[i] + k] = v;
@@ -1230,6 +1308,10 @@ class Repairer {
         note_moved(r.added);
       }
       apply(split, w, r.added, freed);
+      if (!mesh_.attributes.empty()) {
+        set_values(w, split.from, split.share);
+        if (r.added != UINT32_MAX) set_values(r.added, split.twin_from, split.share_twin);
+      }
       const std::size_t reused = split.faces.size() - split.old.size();
       for (std::size_t k = 0; k < reused; ++k) r.reused[k] = freed[k], r.parent[k] = split.parent[split.old.size() + k];
       if (short_one) {

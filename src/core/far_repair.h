@@ -49,8 +49,11 @@
 // together they may raise E by at most `relocation_budget`.
 // Farthest place first (border faces from 0.4 of the largest scored first: there a face's
 // centroid and edge midpoints can miss its peak by a factor); a place no relocation mends is
-// passed over, up to 8 in a row. Not on
-// meshes with attributes, materials or vertex properties, whose new vertex would need values.
+// passed over, up to 8 in a row. With attributes the new vertex takes the values at its foot on
+// the faces it divides (normals renormalised, colours clamped; skin joints from the nearest
+// corner), each new face its parent's material, and the collapse must not raise the error of
+// appearance (a vertex whose values the others do not interpolate stays). Not on meshes with
+// vertex properties, which a new vertex would need too.
 //
 #pragma once
 
