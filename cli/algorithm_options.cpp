@@ -222,9 +222,10 @@ LoadOptions to_load_options(const AlgorithmArgs& a) {
 
 // The repair finishes the refit's work (the far places its least-squares moves leave): on with it
 // unless asked otherwise, and not where the refit is left out (meshes with UVs or normals). There
-// its flips and moves keep the error of appearance at the input's vertices, but not everywhere:
-// asked for on issue 18's assets it lowered E in 14 of 48 rows (to 0.78x at most) and raised the
-// UV error in 3 by 1-3 % (docs/benchmarks.md, "Appearance attributes").
+// its flips and moves keep the error of appearance where it samples it (the input's vertices and
+// faces round each change), but not everywhere: asked for on issue 18's assets it lowered E in
+// rows of them and raised the UV or normal error of a few by 1-5 % (docs/benchmarks.md,
+// "Appearance attributes").
 bool far_repair_wanted(const AlgorithmArgs& a, const SimplifyOptions& options) {
   return a.far_repair || (options.refit_rounds > 0 && !a.no_far_repair);
 }

@@ -75,6 +75,7 @@ core::FarRepairResult repair_mesh(Mesh& mesh, const SimplifyOptions& options, Me
   repair_options.held = held;
   repair_options.input_attributes = input.attributes;
   repair_options.point_source = points.source;
+  repair_options.input_faces = input.indices;
   repair_options.attribute_weights = options.attribute_weights;
   repair_options.max_normal_turn_degrees = options.max_normal_turn_degrees;
   repair_options.threads = core::resolve_threads(options.threads);

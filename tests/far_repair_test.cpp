@@ -146,6 +146,7 @@ struct ColouredGroove : Groove {
     core::FarRepairOptions o;
     o.input_attributes = input.attributes;
     o.point_source = source;
+    o.input_faces = input.indices;
     return flip(approx, input, o);
   }
   std::vector<std::uint32_t> source;
@@ -468,6 +469,7 @@ TEST(FarRepair, RelocationsCarryValuesAndMaterials) {
   o.held = held;
   o.input_attributes = input.attributes;
   o.point_source = source;
+  o.input_faces = input.indices;
   const double before = both_ways(with, input);
   const core::FarRepairResult r = flip(with, input, o);
   ASSERT_GE(r.relocations.size(), 1u);

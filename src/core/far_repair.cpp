@@ -165,6 +165,95 @@ class Repairer {
     return weights_[p] * weight_scale_ * error;
   }
 
+  // The input's surface between its vertices, round a change: each input triangle within `radius`
+  // of `centre` gives its centroid and edge midpoints (a quarter of its area each, in the frame's
+  // units, as the points' weights) with the input's values there. The input's vertices alone miss
+  // what lies between them: a move that slides the values along a face of a coarse output.
+  struct ValueSamples {
+    std::vector<Vec3> at;
+    std::vector<double> weight, values;  // values: the channels' components per sample
+    std::vector<std::uint32_t> context;  // the faces round the change that it leaves as they are
+  };
+  // The samples round a change of faces `changed` (their slots, as they are before it).
+  void sample_values(std::span<const std::uint32_t> changed, const Vec3* also, ValueSamples& s) const {
+    s.at.clear(), s.weight.clear(), s.values.clear(), s.context.clear();
+    if (channels_.empty() || opt_.input_faces.empty()) return;
+    std::vector<std::uint32_t> corners;
+    for (std::uint32_t f : changed) corners.insert(corners.end(), &tri_[3 * f], &tri_[3 * f] + 3);
+    auto [centre, radius] = ball_of(corners);
+    if (also) radius = std::max(radius, length(*also - centre));
+    for (std::uint32_t v : corners)
+      for (std::uint32_t g : faces_at_[v])
+        if (std::find(changed.begin(), changed.end(), g) == changed.end()) s.context.push_back(g);
+    std::sort(s.context.begin(), s.context.end());
+    s.context.erase(std::unique(s.context.begin(), s.context.end()), s.context.end());
+    std::vector<std::uint32_t> near;
+    surface_.triangles_near(centre, radius, near);
+    std::sort(near.begin(), near.end());  // the sums in one order, whatever the tree's walk
+    constexpr double kAt[4][3] = {{1.0 / 3, 1.0 / 3, 1.0 / 3}, {0.5, 0.5, 0}, {0, 0.5, 0.5}, {0.5, 0, 0.5}};
+    for (std::uint32_t t : near) {
+      const double* c = surface_.triangle(t);
+      const Vec3 corner[3] = {{c[0], c[1], c[2]}, {c[3], c[4], c[5]}, {c[6], c[7], c[8]}};
+      const double area = 0.5 * length(cross(corner[1] - corner[0], corner[2] - corner[0]));
+      const std::uint32_t* v = &opt_.input_faces[3 * std::size_t(t)];
+      for (const auto& w : kAt) {
+        const Vec3 q = corner[0] * w[0] + corner[1] * w[1] + corner[2] * w[2];
+        if (measure_detail::squared_distance(q, centre) > radius * radius) continue;
+        s.at.push_back(q), s.weight.push_back(0.25 * area);
+        for (const Channel& ch : channels_)
+          for (std::uint32_t k = 0; k < ch.components; ++k) {
+            double x = 0;
+            for (int i = 0; i < 3; ++i) x += w[i] * (*ch.input)[std::size_t(v[i]) * ch.components + k];
+            s.values.push_back(x);
+          }
+      }
+    }
+  }
+  // The samples' error of appearance against the nearest of `count` faces (`corners(k)`: its three
+  // vertices) and the faces round them (s.context: a sample nearer one of those is theirs, as in
+  // the measure, which asks the whole output), their values interpolated at its closest point.
+  template <class CornersOf>
+  double samples_value_error(const ValueSamples& s, std::size_t count, CornersOf corners) const {
+    double total = 0;
+    std::size_t at = 0;
+    for (std::size_t i = 0; i < s.at.size(); ++i) {
+      std::array<std::uint32_t, 3> best{};
+      double best_d2 = HUGE_VAL;
+      for (std::size_t k = 0; k < count + s.context.size(); ++k) {
+        const std::array<std::uint32_t, 3> t =
+            k < count ? corners(k)
+                      : std::array<std::uint32_t, 3>{tri_[3 * s.context[k - count]], tri_[3 * s.context[k - count] + 1],
+                                                     tri_[3 * s.context[k - count] + 2]};
+        const double d2 = measure_detail::squared_distance(
+            s.at[i], measure_detail::closest_point_on_triangle(s.at[i], x_[t[0]], x_[t[1]], x_[t[2]]));
+        if (d2 < best_d2) best_d2 = d2, best = t;
+      }
+      const std::array<double, 3> w = measure_detail::closest_point_weights(s.at[i], x_[best[0]], x_[best[1]], x_[best[2]]);
+      double error = 0;
+      for (const Channel& ch : channels_) {
+        double sum = 0;
+        for (std::uint32_t k = 0; k < ch.components; ++k, ++at) {
+          const double d = w[0] * (*ch.output)[std::size_t(best[0]) * ch.components + k] +
+                           w[1] * (*ch.output)[std::size_t(best[1]) * ch.components + k] +
+                           w[2] * (*ch.output)[std::size_t(best[2]) * ch.components + k] - s.values[at];
+          sum += d * d;
+        }
+        error += ch.weight2 * sum;
+      }
+      total += s.weight[i] * error;
+    }
+    return total;
+  }
+  // The ball round a set of vertices (their mean, and the largest distance to it).
+  std::pair<Vec3, double> ball_of(std::span<const std::uint32_t> vertices) const {
+    Vec3 centre{0, 0, 0};
+    for (std::uint32_t v : vertices) centre = centre + x_[v];
+    centre = centre * (1.0 / double(vertices.size()));
+    double radius = 0;
+    for (std::uint32_t v : vertices) radius = std::max(radius, length(x_[v] - centre));
+    return {centre, radius};
+  }
+
   // The samples of face abc, searched from input face `hint`; stops at the first sample at least
   // `limit` from the input (then `energy` is incomplete and `most` at least limit).
   FaceScore score(const Vec3& a, const Vec3& b, const Vec3& c, std::uint32_t hint,
@@ -397,6 +486,17 @@ class Repairer {
         const std::uint32_t* g = scratch_nearest_[i] == 0 ? g1v : g2v;
         after += value_error(pts[i], g[0], g[1], g[2]);
       }
+      // And between them.
+      const std::uint32_t changed[2] = {f1, f2};
+      sample_values(changed, nullptr, scratch_samples_);
+      before += samples_value_error(scratch_samples_, 2, [&](std::size_t k) {
+        const std::uint32_t* t = &tri_[3 * (k == 0 ? f1 : f2)];
+        return std::array<std::uint32_t, 3>{t[0], t[1], t[2]};
+      });
+      after += samples_value_error(scratch_samples_, 2, [&](std::size_t k) {
+        const std::uint32_t* g = k == 0 ? g1v : g2v;
+        return std::array<std::uint32_t, 3>{g[0], g[1], g[2]};
+      });
       if (after > before) return UINT32_MAX;
     }
 
@@ -453,10 +553,19 @@ class Repairer {
     std::vector<std::uint32_t>& pts = scratch_points_;
     pts.clear();
     double values_before = 0;
+    const auto fan_face = [&](std::size_t k) {
+      const std::uint32_t* t = &tri_[3 * fan[k]];
+      return std::array<std::uint32_t, 3>{t[0], t[1], t[2]};
+    };
     for (std::uint32_t f : fan) {
       pts.insert(pts.end(), points_of_[f].begin(), points_of_[f].end());
       const std::uint32_t* t = &tri_[3 * f];
       for (std::uint32_t p : points_of_[f]) values_before += value_error(p, t[0], t[1], t[2]);
+    }
+    if (!channels_.empty()) {
+      // And between them, round the fan where it is and where it goes.
+      sample_values(fan, &y, scratch_samples_);
+      values_before += samples_value_error(scratch_samples_, fan.size(), fan_face);
     }
     x_[v] = y;
     double energy = 0;
@@ -468,7 +577,7 @@ class Repairer {
     const double most2 = to_nearest_faces(pts, fan.size(), corners, scratch_nearest_, scratch_d2_, energy);
     if (std::sqrt(most2) >= old_most || energy > old_energy * (1 + opt_.error_margin)) return x_[v] = x, false;
     if (!channels_.empty()) {
-      double values_after = 0;
+      double values_after = samples_value_error(scratch_samples_, fan.size(), fan_face);
       for (std::size_t i = 0; i < pts.size(); ++i) {
         const std::uint32_t* t = &tri_[3 * fan[scratch_nearest_[i]]];
         values_after += value_error(pts[i], t[0], t[1], t[2]);
@@ -1061,7 +1170,7 @@ class Repairer {
   // Whether collapse c leaves the error of appearance of its faces' input points as it was, or
   // lowers it (to rounding: in a patch of one colour the values interpolate to the same, but for
   // the last bits): the vertex it takes away carries no values the others do not.
-  bool keeps_appearance(const Plan& c) const {
+  bool keeps_appearance(const Plan& c) {
     if (channels_.empty()) return true;
     double before = 0, after = 0, weight = 0;
     std::size_t i = 0;
@@ -1073,6 +1182,13 @@ class Repairer {
         after += value_error(q, g[0], g[1], g[2]);
         weight += weights_[q] * weight_scale_;
       }
+    sample_values(c.old, nullptr, scratch_samples_);
+    before += samples_value_error(scratch_samples_, c.old.size(), [&](std::size_t k) {
+      const std::uint32_t* t = &tri_[3 * c.old[k]];
+      return std::array<std::uint32_t, 3>{t[0], t[1], t[2]};
+    });
+    after += samples_value_error(scratch_samples_, c.faces.size(), [&](std::size_t k) { return c.faces[k]; });
+    for (double w : scratch_samples_.weight) weight += w;
     return after <= before + 1e-20 * weight;
   }
 
@@ -1341,6 +1457,7 @@ class Repairer {
     double weight2;  // the metric's weight, squared
   };
   std::vector<Channel> channels_;                    // the attributes that judge flips and moves
+  ValueSamples scratch_samples_;                     // the input's surface round a change (sample_values)
   std::vector<Vec3> x_;                              // output positions in the frame
   std::vector<std::uint8_t> held_;                   // per vertex: its edges stay
   std::vector<std::uint32_t> twin_;                  // per vertex, the other vertex at its position (a pair only)

@@ -104,6 +104,9 @@ struct FarRepairOptions {
   /// geometry alone judges.
   std::span<const VertexAttribute> input_attributes;
   std::span<const std::uint32_t> point_source;
+  /// The input's faces (3 per face, those of `surface`, in its order): with them the error of
+  /// appearance is also sampled on the input's faces between its vertices. Empty: vertices only.
+  std::span<const std::uint32_t> input_faces;
   AttributeWeights attribute_weights;
   /// Whether a relocation may add a vertex: at a crack (two border edges at the same positions, the
   /// sides of a seam the input never welded), both sides split together, so the faces' count
