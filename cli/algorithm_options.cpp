@@ -224,8 +224,8 @@ LoadOptions to_load_options(const AlgorithmArgs& a) {
 // unless asked otherwise, and not where the refit is left out (meshes with UVs or normals). There
 // its flips and moves keep the error of appearance where it samples it (the input's vertices and
 // faces round each change), but not everywhere: asked for on issue 18's assets it lowered E in
-// rows of them and raised the UV or normal error of a few by 1-5 % (docs/benchmarks.md,
-// "Appearance attributes").
+// about a third of the rows and raised the UV or normal error of four by 1-5 %
+// (docs/benchmarks.md, "Appearance attributes").
 bool far_repair_wanted(const AlgorithmArgs& a, const SimplifyOptions& options) {
   return a.far_repair || (options.refit_rounds > 0 && !a.no_far_repair);
 }

@@ -44,9 +44,9 @@
 // Made only where the largest distance falls (the split's faces below the farthest, the
 // collapse's below half of it, input samples between the input's vertices included), the link
 // condition holds and no face folds: each new face within the turn limit of the face it comes
-// from, and no crease with a face round it sharper than the limit unless the one it replaces was
-// (as for flips: splits beside an earlier split's steep faces would otherwise add turn to turn);
-// together they may raise E by at most `relocation_budget`.
+// from as that face's line was before the relocations (measured from the face as it is, splits
+// beside an earlier split's steep faces would add turn to turn, and fold); together they may
+// raise E by at most `relocation_budget`.
 // Farthest place first (border faces from 0.4 of the largest scored first: there a face's
 // centroid and edge midpoints can miss its peak by a factor); a place no relocation mends is
 // passed over, up to 8 in a row. With attributes the new vertex takes the values at its foot on
@@ -97,11 +97,11 @@ struct FarRepairOptions {
   /// Per point: 1 = on the input's border (points_on_border). Empty: no relocation at a border.
   std::span<const std::uint8_t> point_on_border;
   /// With attributes (approx.attributes, in the order of the input's): the input's per-vertex
-  /// attributes and each point's input vertex (FitPoints::source). A flip or a move changes where
-  /// the output's values are interpolated; it is also refused where it raises its points' error
-  /// of appearance: each point's values against the output's interpolated at its closest point,
-  /// weighted as the metric weighs the channels (`attribute_weights`), by the points' areas. Empty:
-  /// geometry alone judges.
+  /// attributes and each point's input vertex (FitPoints::source). A flip, a move or a
+  /// relocation's collapse changes where the output's values are interpolated; it is also refused
+  /// where it raises the error of appearance round it: each point's values against the output's
+  /// interpolated at its closest point, weighted as the metric weighs the channels
+  /// (`attribute_weights`), by the points' areas. Empty: geometry alone judges.
   std::span<const VertexAttribute> input_attributes;
   std::span<const std::uint32_t> point_source;
   /// The input's faces (3 per face, those of `surface`, in its order): with them the error of
