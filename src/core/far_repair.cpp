@@ -96,8 +96,10 @@ class Repairer {
     for (std::size_t i = 0; i < options.input_attributes.size() && i < approx.attributes.size(); ++i) {
       const VertexAttribute &in = options.input_attributes[i], &out = approx.attributes[i];
       const double w = attribute_weight(in.kind, options.attribute_weights);
-      if (w > 0 && in.components == out.components && !options.point_source.empty())
-        channels_.push_back({&in.values, &out.values, in.components, w * w});
+      if (w > 0 && in.components == out.components && !options.point_source.empty()) {
+        channels_.push_back({&in.values, &out.values, in.components, value_width_, w * w});
+        value_width_ += in.components;
+      }
     }
     faces_at_.assign(n, {});
     for (std::uint32_t f = 0; f < face_count(); ++f)
@@ -143,26 +145,34 @@ class Repairer {
  private:
   std::uint32_t face_count() const { return std::uint32_t(tri_.size() / 3); }
   Vec3 point(std::uint32_t p) const { return {points_[3 * p], points_[3 * p + 1], points_[3 * p + 2]}; }
+  std::array<std::uint32_t, 3> face(std::uint32_t f) const { return {tri_[3 * f], tri_[3 * f + 1], tri_[3 * f + 2]}; }
 
   // Point p's error of appearance against face (a, b, c): the weighted squared difference between
   // its input vertex's values and the face's interpolated at p's closest point, times p's share of
   // the area (in the units of the points' squared distances). 0 without attributes.
-  double value_error(std::uint32_t p, std::uint32_t a, std::uint32_t b, std::uint32_t c) const {
+  double value_error(std::uint32_t p, const std::array<std::uint32_t, 3>& t) const {
     if (channels_.empty()) return 0;
-    const std::array<double, 3> w = measure_detail::closest_point_weights(point(p), x_[a], x_[b], x_[c]);
+    const std::array<double, 3> w = measure_detail::closest_point_weights(point(p), x_[t[0]], x_[t[1]], x_[t[2]]);
     const std::size_t s = opt_.point_source[p];
+    return weights_[p] * weight_scale_ *
+           values_gap(t, w, [&](const Channel& ch, std::uint32_t k) { return (*ch.input)[s * ch.components + k]; });
+  }
+  // The weighted squared gap between the output's values on face t, interpolated by w, and
+  // `target(channel, component)`, the channels weighted as in the metric.
+  template <class Target>
+  double values_gap(const std::array<std::uint32_t, 3>& t, const std::array<double, 3>& w, Target target) const {
     double error = 0;
     for (const Channel& ch : channels_) {
-      const double *in = &(*ch.input)[s * ch.components], *va = &(*ch.output)[a * ch.components],
-                   *vb = &(*ch.output)[b * ch.components], *vc = &(*ch.output)[c * ch.components];
+      const std::vector<double>& out = *ch.output;
+      const std::size_t n = ch.components;
       double sum = 0;
-      for (std::uint32_t k = 0; k < ch.components; ++k) {
-        const double d = w[0] * va[k] + w[1] * vb[k] + w[2] * vc[k] - in[k];
+      for (std::uint32_t k = 0; k < n; ++k) {
+        const double d = w[0] * out[t[0] * n + k] + w[1] * out[t[1] * n + k] + w[2] * out[t[2] * n + k] - target(ch, k);
         sum += d * d;
       }
       error += ch.weight2 * sum;
     }
-    return weights_[p] * weight_scale_ * error;
+    return error;
   }
 
   // The input's surface between its vertices, round a change: each input triangle within `radius`
@@ -215,7 +225,6 @@ class Repairer {
   template <class CornersOf>
   double samples_value_error(const ValueSamples& s, std::size_t count, CornersOf corners) const {
     double total = 0;
-    std::size_t at = 0;
     for (std::size_t i = 0; i < s.at.size(); ++i) {
       std::array<std::uint32_t, 3> best{};
       double best_d2 = HUGE_VAL;
@@ -229,20 +238,20 @@ class Repairer {
         if (d2 < best_d2) best_d2 = d2, best = t;
       }
       const std::array<double, 3> w = measure_detail::closest_point_weights(s.at[i], x_[best[0]], x_[best[1]], x_[best[2]]);
-      double error = 0;
-      for (const Channel& ch : channels_) {
-        double sum = 0;
-        for (std::uint32_t k = 0; k < ch.components; ++k, ++at) {
-          const double d = w[0] * (*ch.output)[std::size_t(best[0]) * ch.components + k] +
-                           w[1] * (*ch.output)[std::size_t(best[1]) * ch.components + k] +
-                           w[2] * (*ch.output)[std::size_t(best[2]) * ch.components + k] - s.values[at];
-          sum += d * d;
-        }
-        error += ch.weight2 * sum;
-      }
-      total += s.weight[i] * error;
+      const double* values = &s.values[i * value_width_];
+      total += s.weight[i] * values_gap(best, w, [&](const Channel& ch, std::uint32_t k) { return values[ch.first + k]; });
     }
     return total;
+  }
+  // The error of appearance round a change, before or after it: points `pts`, point i on face
+  // corners(on[i]), and samples s, each on the nearest of the `count` faces corners(k) and of
+  // s.context.
+  template <class CornersOf>
+  double appearance_error(std::span<const std::uint32_t> pts, std::span<const std::uint32_t> on, const ValueSamples& s,
+                          std::size_t count, CornersOf corners) const {
+    double total = 0;
+    for (std::size_t i = 0; i < pts.size(); ++i) total += value_error(pts[i], corners(on[i]));
+    return total + samples_value_error(s, count, corners);
   }
   // The ball round a set of vertices (their mean, and the largest distance to it).
   std::pair<Vec3, double> ball_of(std::span<const std::uint32_t> vertices) const {
@@ -477,25 +486,15 @@ class Repairer {
     if (std::max({s1.most, s2.most, std::sqrt(most2)}) >= old_most) return UINT32_MAX;
     if (energy > old_energy * (1 + opt_.error_margin)) return UINT32_MAX;
     if (!channels_.empty()) {
-      // The points' values, interpolated on the faces they were nearest and will be.
-      const std::uint32_t g1v[3] = {a, d, c}, g2v[3] = {b, c, d};
-      double before = 0, after = 0;
-      for (std::size_t i = 0; i < pts.size(); ++i) {
-        const std::uint32_t* t = &tri_[3 * (i < points_of_[f1].size() ? f1 : f2)];
-        before += value_error(pts[i], t[0], t[1], t[2]);
-        const std::uint32_t* g = scratch_nearest_[i] == 0 ? g1v : g2v;
-        after += value_error(pts[i], g[0], g[1], g[2]);
-      }
-      // And between them.
+      // The values at the points and between them, on the faces as they are and as they would be.
       const std::uint32_t changed[2] = {f1, f2};
       sample_values(changed, nullptr, scratch_samples_);
-      before += samples_value_error(scratch_samples_, 2, [&](std::size_t k) {
-        const std::uint32_t* t = &tri_[3 * (k == 0 ? f1 : f2)];
-        return std::array<std::uint32_t, 3>{t[0], t[1], t[2]};
-      });
-      after += samples_value_error(scratch_samples_, 2, [&](std::size_t k) {
-        const std::uint32_t* g = k == 0 ? g1v : g2v;
-        return std::array<std::uint32_t, 3>{g[0], g[1], g[2]};
+      std::vector<std::uint32_t>& on = scratch_on_;
+      on.assign(pts.size(), 1);
+      std::fill_n(on.begin(), points_of_[f1].size(), 0);
+      const double before = appearance_error(pts, on, scratch_samples_, 2, [&](std::size_t k) { return face(k == 0 ? f1 : f2); });
+      const double after = appearance_error(pts, scratch_nearest_, scratch_samples_, 2, [&](std::size_t k) {
+        return k == 0 ? Corners{a, d, c} : Corners{b, c, d};
       });
       if (after > before) return UINT32_MAX;
     }
@@ -551,21 +550,18 @@ class Repairer {
     }
     // The fan's points, each to the nearest of the fan's faces after the move.
     std::vector<std::uint32_t>& pts = scratch_points_;
-    pts.clear();
-    double values_before = 0;
-    const auto fan_face = [&](std::size_t k) {
-      const std::uint32_t* t = &tri_[3 * fan[k]];
-      return std::array<std::uint32_t, 3>{t[0], t[1], t[2]};
-    };
-    for (std::uint32_t f : fan) {
-      pts.insert(pts.end(), points_of_[f].begin(), points_of_[f].end());
-      const std::uint32_t* t = &tri_[3 * f];
-      for (std::uint32_t p : points_of_[f]) values_before += value_error(p, t[0], t[1], t[2]);
+    std::vector<std::uint32_t>& on = scratch_on_;  // each point's face (its index in the fan)
+    pts.clear(), on.clear();
+    for (std::size_t k = 0; k < fan.size(); ++k) {
+      pts.insert(pts.end(), points_of_[fan[k]].begin(), points_of_[fan[k]].end());
+      on.resize(pts.size(), std::uint32_t(k));
     }
+    // The values at the points and between them, round the fan where it is and where it goes.
+    const auto fan_face = [&](std::size_t k) { return face(fan[k]); };
+    double values_before = 0;
     if (!channels_.empty()) {
-      // And between them, round the fan where it is and where it goes.
       sample_values(fan, &y, scratch_samples_);
-      values_before += samples_value_error(scratch_samples_, fan.size(), fan_face);
+      values_before = appearance_error(pts, on, scratch_samples_, fan.size(), fan_face);
     }
     x_[v] = y;
     double energy = 0;
@@ -576,14 +572,9 @@ class Repairer {
     };
     const double most2 = to_nearest_faces(pts, fan.size(), corners, scratch_nearest_, scratch_d2_, energy);
     if (std::sqrt(most2) >= old_most || energy > old_energy * (1 + opt_.error_margin)) return x_[v] = x, false;
-    if (!channels_.empty()) {
-      double values_after = samples_value_error(scratch_samples_, fan.size(), fan_face);
-      for (std::size_t i = 0; i < pts.size(); ++i) {
-        const std::uint32_t* t = &tri_[3 * fan[scratch_nearest_[i]]];
-        values_after += value_error(pts[i], t[0], t[1], t[2]);
-      }
-      if (values_after > values_before) return x_[v] = x, false;
-    }
+    if (!channels_.empty() &&
+        appearance_error(pts, scratch_nearest_, scratch_samples_, fan.size(), fan_face) > values_before)
+      return x_[v] = x, false;
     for (std::size_t i = 0; i < fan.size(); ++i) score_[fan[i]] = scores[i], scored_[fan[i]] = 1, points_of_[fan[i]].clear();
     for (std::size_t i = 0; i < pts.size(); ++i)
       d2_[pts[i]] = scratch_d2_[i], points_of_[fan[scratch_nearest_[i]]].push_back(pts[i]);
@@ -839,14 +830,13 @@ class Repairer {
   bool keeps_facing(const Plan& p, const Vec3& y) const {
     for (std::size_t i = 0; i < p.faces.size(); ++i) {
       const Corners& t = p.faces[i];
-      const std::uint32_t* o = &tri_[3 * p.parent[i]];
       const Vec3 p0 = at(t[0], y), p1 = at(t[1], y), p2 = at(t[2], y);
       const Vec3 e = cross(p1 - p0, p2 - p0);
       // Degenerate to rounding (a corner on the line of the other two): its normal means nothing.
       const double longest2 = std::max({dot(p1 - p0, p1 - p0), dot(p2 - p1, p2 - p1), dot(p0 - p2, p0 - p2)});
       if (!(dot(e, e) > 1e-18 * longest2 * longest2)) return false;
       const Vec3 m = normalized(e);
-      const Vec3 n = first_normal_.empty() ? normalized(normal(o[0], o[1], o[2])) : first_normal_[p.parent[i]];
+      const Vec3& n = first_normal_[p.parent[i]];
       if (dot(n, n) == 0 || dot(m, n) < cos_turn_) return false;
     }
     return true;
@@ -1128,7 +1118,7 @@ class Repairer {
       if (dot(in, out) < std::cos(kCornerDegrees * std::numbers::pi / 180)) return false;
     }
     const std::size_t dying = border ? 1 : 2;
-    bool found = false;
+    bool found = false, sampled = false;
     Collapse c;
     for (std::uint32_t v : targets) {
       // The faces of edge uv die; their third corners must be the only common neighbours of u and
@@ -1158,7 +1148,9 @@ class Repairer {
       // that no part vanishes or folds onto itself.
       if (c.faces.empty() || any_face_exists(c.faces)) continue;
       if (!keeps_facing(c, {}) || !score_plan(c, {}, limit) || !input_stays_near(c, {}, limit)) continue;
-      if (!keeps_appearance(c)) continue;
+      // (u's faces, and so the samples round them, are the same whichever v it goes into.)
+      if (!sampled) sample_values(c.old, nullptr, scratch_samples_), sampled = true;
+      if (!keeps_appearance(c, scratch_samples_)) continue;
       if (!found || c.energy - c.old_energy < best.energy - best.old_energy) {
         best = c, best.u = u, best.v = v;
         found = true;
@@ -1167,28 +1159,20 @@ class Repairer {
     return found;
   }
 
-  // Whether collapse c leaves the error of appearance of its faces' input points as it was, or
-  // lowers it (to rounding: in a patch of one colour the values interpolate to the same, but for
-  // the last bits): the vertex it takes away carries no values the others do not.
-  bool keeps_appearance(const Plan& c) {
+  // Whether collapse c (scored: its points and their new faces) leaves the error of appearance of
+  // its points and of the samples s round it (sample_values of c.old) as it was, or lowers it (to
+  // rounding: in a patch of one colour the values interpolate to the same, but for the last bits):
+  // the vertex it takes away carries no values the others do not.
+  bool keeps_appearance(const Plan& c, const ValueSamples& s) {
     if (channels_.empty()) return true;
-    double before = 0, after = 0, weight = 0;
-    std::size_t i = 0;
-    for (std::uint32_t f : c.old)
-      for (std::uint32_t q : points_of_[f]) {
-        const std::uint32_t* t = &tri_[3 * f];
-        const Corners& g = c.faces[c.nearest[i++]];
-        before += value_error(q, t[0], t[1], t[2]);
-        after += value_error(q, g[0], g[1], g[2]);
-        weight += weights_[q] * weight_scale_;
-      }
-    sample_values(c.old, nullptr, scratch_samples_);
-    before += samples_value_error(scratch_samples_, c.old.size(), [&](std::size_t k) {
-      const std::uint32_t* t = &tri_[3 * c.old[k]];
-      return std::array<std::uint32_t, 3>{t[0], t[1], t[2]};
-    });
-    after += samples_value_error(scratch_samples_, c.faces.size(), [&](std::size_t k) { return c.faces[k]; });
-    for (double w : scratch_samples_.weight) weight += w;
+    std::vector<std::uint32_t>& on = scratch_on_;  // each point's old face (c.points lists them face by face)
+    on.clear();
+    for (std::size_t k = 0; k < c.old.size(); ++k) on.resize(on.size() + points_of_[c.old[k]].size(), std::uint32_t(k));
+    const double before = appearance_error(c.points, on, s, c.old.size(), [&](std::size_t k) { return face(c.old[k]); });
+    const double after = appearance_error(c.points, c.nearest, s, c.faces.size(), [&](std::size_t k) { return c.faces[k]; });
+    double weight = 0;
+    for (std::uint32_t q : c.points) weight += weights_[q] * weight_scale_;
+    for (double w : s.weight) weight += w;
     return after <= before + 1e-20 * weight;
   }
 
@@ -1454,10 +1438,13 @@ class Repairer {
     const std::vector<double>* input;   // per input vertex
     const std::vector<double>* output;  // per output vertex
     std::uint32_t components;
-    double weight2;  // the metric's weight, squared
+    std::uint32_t first;  // its first component among a sample's values (ValueSamples::values)
+    double weight2;       // the metric's weight, squared
   };
   std::vector<Channel> channels_;                    // the attributes that judge flips and moves
+  std::uint32_t value_width_ = 0;                    // their components, all together
   ValueSamples scratch_samples_;                     // the input's surface round a change (sample_values)
+  std::vector<std::uint32_t> scratch_on_;            // per point of a change, its face before it
   std::vector<Vec3> x_;                              // output positions in the frame
   std::vector<std::uint8_t> held_;                   // per vertex: its edges stay
   std::vector<std::uint32_t> twin_;                  // per vertex, the other vertex at its position (a pair only)
