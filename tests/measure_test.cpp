@@ -86,6 +86,35 @@ TEST(Measure, BvhMatchesBruteForce) {
   }
 }
 
+// The tree's boxes are floats rounded outward: far from the origin, where a float cannot hold the
+// corners (1e7 + 1e-3 steps: floats are 1 apart there), a box rounded to nearest would lie inside
+// the triangles and prune the closest one. The answers stay the brute force's, the triangle too.
+TEST(Measure, BvhFloatBoxesKeepExactAnswersFarFromTheOrigin) {
+  std::vector<double> corners;
+  measure_detail::Rng rng(3);
+  const double base = 1e7;
+  for (int i = 0; i < 2000; ++i) {
+    const double x = base + 1e-3 * (i % 50), y = base + 1e-3 * (i / 50), z = base + 1e-4 * rng.uniform();
+    corners.insert(corners.end(), {x, y, z, x + 1e-3, y, z + 1e-5, x, y + 1e-3, z - 1e-5});
+  }
+  const measure_detail::TriangleBvh bvh(corners);
+  for (int i = 0; i < 1000; ++i) {
+    const double p[3] = {base + 0.05 * rng.uniform(), base + 0.04 * rng.uniform(), base + 1e-4 * (rng.uniform() - 0.5)};
+    double best = INFINITY;
+    std::uint32_t best_t = UINT32_MAX;
+    for (std::uint32_t t = 0; t < corners.size() / 9; ++t) {
+      const double* c = &corners[9 * t];
+      const Vec3 q = closest_point_on_triangle({p[0], p[1], p[2]}, {c[0], c[1], c[2]}, {c[3], c[4], c[5]},
+                                               {c[6], c[7], c[8]});
+      const double d2 = measure_detail::squared_distance({p[0], p[1], p[2]}, q);
+      if (d2 < best) best = d2, best_t = t;
+    }
+    const auto hit = bvh.closest(p);
+    ASSERT_EQ(hit.d2, best) << "query " << i;
+    ASSERT_EQ(hit.triangle, best_t) << "query " << i;
+  }
+}
+
 // The build runs in fixed chunks on the threads (65,536 triangles a chunk): a tree built on one,
 // two or three threads over more than one chunk is the same tree, with the brute force's answers.
 TEST(Measure, BvhBuiltOnThreadsIsTheSameTree) {

@@ -11,7 +11,7 @@
 
 namespace qem::core {
 
-std::vector<Edge> unique_edges(const std::vector<std::uint32_t>& triangles, const VertexLists& vertex_faces,
+std::vector<Edge> unique_edges(std::span<const std::uint32_t> triangles, const VertexLists& vertex_faces,
                                std::size_t vertex_count) {
   std::vector<Edge> edges;
   // 3F/2 edges on a closed manifold, more with borders (up to 3F): the bound is reserved, since a

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "core/quadric.h"
@@ -17,7 +18,7 @@ struct Edge {
 
 /// The unique edges of a triangle list (3 indices per face), sorted by (lo, hi), found through the
 /// per-vertex face lists (no global sort, no 64-bit key array: this runs on million-face meshes).
-std::vector<Edge> unique_edges(const std::vector<std::uint32_t>& triangles, const VertexLists& vertex_faces,
+std::vector<Edge> unique_edges(std::span<const std::uint32_t> triangles, const VertexLists& vertex_faces,
                                std::size_t vertex_count);
 
 /// How many of its nearest vertices within t each vertex pairs with (see close_pairs).

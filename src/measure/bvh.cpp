@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 
 #include "core/parallel_chunks.h"
 #include "core/radix_sort.h"
@@ -30,14 +31,26 @@ struct Bounds {
 };
 
 // Squared distance from p to an axis-aligned box (0 inside).
-inline double box_d2(const double* p, const double* lo, const double* hi) {
+inline double box_d2(const double* p, const float* lo, const float* hi) {
   double d2 = 0;
   for (int k = 0; k < 3; ++k) {
-    const double d = std::max(std::max(lo[k] - p[k], p[k] - hi[k]), 0.0);
+    const double d = std::max(std::max(double(lo[k]) - p[k], p[k] - double(hi[k])), 0.0);
     d2 += d * d;
   }
   return d2;
 }
+
+// The float at or below x, and at or above it (outside float's range: the largest float or the
+// infinity on that side; the conversion itself is only made within the range).
+inline float float_below(double x) {
+  constexpr float kMax = std::numeric_limits<float>::max(), kInf = std::numeric_limits<float>::infinity();
+  if (std::isnan(x)) return std::numeric_limits<float>::quiet_NaN();
+  if (x >= double(kMax)) return kMax;
+  if (x < -double(kMax)) return -kInf;
+  const float f = float(x);
+  return double(f) > x ? std::nextafter(f, -kInf) : f;
+}
+inline float float_above(double x) { return -float_below(-x); }
 
 }  // namespace
 
@@ -101,8 +114,9 @@ TriangleBvh::TriangleBvh(std::span<const double> corners, unsigned threads) {
 
   // Top down: a range splits where its codes' highest differing bit turns on (a spatial median,
   // as in an octree); a range of equal codes splits in half. The depth stays below 30 + log2(n).
-  nodes_.reserve(2 * std::size_t(n) / kLeaf + 1);
+  nodes_.reserve(2 * std::size_t(n) / kLeaf + 2);
   nodes_.push_back({});
+  nodes_.push_back({});  // slot 1, unused: pairs of children start at even slots
   struct Task {
     std::uint32_t node, begin, end;
   };
@@ -147,7 +161,7 @@ TriangleBvh::TriangleBvh(std::span<const double> corners, unsigned threads) {
   // Boxes bottom up: the leaves' from their triangles (side by side), then each inner node's from
   // its children, which come after it in the array.
   const auto set_box = [](Node& node, const Bounds& b) {
-    for (int k = 0; k < 3; ++k) node.lo[k] = b.lo[k], node.hi[k] = b.hi[k];
+    for (int k = 0; k < 3; ++k) node.lo[k] = float_below(b.lo[k]), node.hi[k] = float_above(b.hi[k]);
   };
   core::for_chunks(nodes_.size(), kChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
@@ -161,14 +175,9 @@ TriangleBvh::TriangleBvh(std::span<const double> corners, unsigned threads) {
   });
   for (std::size_t i = nodes_.size(); i-- > 0;) {
     Node& node = nodes_[i];
-    if (node.count > 0) continue;
-    Bounds b;
-    for (std::uint32_t c = node.first; c < node.first + 2; ++c) {
-      const Node& child = nodes_[c];
-      for (int k = 0; k < 3; ++k)
-        b.lo[k] = std::min(b.lo[k], child.lo[k]), b.hi[k] = std::max(b.hi[k], child.hi[k]);
-    }
-    set_box(node, b);
+    if (node.count > 0 || i == 1) continue;
+    const Node &l = nodes_[node.first], &r = nodes_[node.first + 1];
+    for (int k = 0; k < 3; ++k) node.lo[k] = std::min(l.lo[k], r.lo[k]), node.hi[k] = std::max(l.hi[k], r.hi[k]);
   }
 }
 

@@ -61,11 +61,17 @@ class TriangleBvh {
   bool empty() const { return ids_.empty(); }
 
  private:
+  // The box in floats, rounded outward: a search prunes by the box's distance, which may only be
+  // smaller than the true one, so the answers are those of double boxes, from half the memory.
+  // Two children (32 bytes each) are read together: slot 1 of nodes_ is left empty, so that every
+  // pair starts at an even slot, one 64-byte line where the array is so aligned (the executable's
+  // large arrays are: cli/huge_pages.cpp).
   struct Node {
-    double lo[3], hi[3];
+    float lo[3], hi[3];
     std::uint32_t first;  ///< leaf: first triangle; inner: left child (right child = first + 1)
     std::uint32_t count;  ///< triangles in a leaf; 0 for an inner node
   };
+  static_assert(sizeof(Node) == 32);
   Hit search(const double p[3], double best, std::uint32_t best_slot) const;
   double slot_d2(const double p[3], std::uint32_t slot, double point[3]) const;
 
