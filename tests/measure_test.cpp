@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/distance_bound.h"
@@ -58,16 +59,22 @@ TEST(Measure, PointTriangleRegions) {
   EXPECT_EQ(q.y, 0);
 }
 
-// The squared distance from p to the closest of the triangles (9 doubles each), testing them all.
-double brute_force_d2(const std::vector<double>& corners, const double p[3]) {
+// The closest of the triangles (9 doubles each) to p, testing them all: its squared distance and
+// index (of two as close, the lower).
+std::pair<double, std::uint32_t> brute_force_closest(const std::vector<double>& corners, const double p[3]) {
   double best = INFINITY;
+  std::uint32_t best_t = UINT32_MAX;
   for (std::size_t t = 0; t < corners.size() / 9; ++t) {
     const double* c = &corners[9 * t];
     const Vec3 q =
         closest_point_on_triangle({p[0], p[1], p[2]}, {c[0], c[1], c[2]}, {c[3], c[4], c[5]}, {c[6], c[7], c[8]});
-    best = std::min(best, measure_detail::squared_distance({p[0], p[1], p[2]}, q));
+    const double d2 = measure_detail::squared_distance({p[0], p[1], p[2]}, q);
+    if (d2 < best) best = d2, best_t = std::uint32_t(t);
   }
-  return best;
+  return {best, best_t};
+}
+double brute_force_d2(const std::vector<double>& corners, const double p[3]) {
+  return brute_force_closest(corners, p).first;
 }
 
 TEST(Measure, BvhMatchesBruteForce) {
@@ -100,15 +107,7 @@ TEST(Measure, BvhFloatBoxesKeepExactAnswersFarFromTheOrigin) {
   const measure_detail::TriangleBvh bvh(corners);
   for (int i = 0; i < 1000; ++i) {
     const double p[3] = {base + 0.05 * rng.uniform(), base + 0.04 * rng.uniform(), base + 1e-4 * (rng.uniform() - 0.5)};
-    double best = INFINITY;
-    std::uint32_t best_t = UINT32_MAX;
-    for (std::uint32_t t = 0; t < corners.size() / 9; ++t) {
-      const double* c = &corners[9 * t];
-      const Vec3 q = closest_point_on_triangle({p[0], p[1], p[2]}, {c[0], c[1], c[2]}, {c[3], c[4], c[5]},
-                                               {c[6], c[7], c[8]});
-      const double d2 = measure_detail::squared_distance({p[0], p[1], p[2]}, q);
-      if (d2 < best) best = d2, best_t = t;
-    }
+    const auto [best, best_t] = brute_force_closest(corners, p);
     const auto hit = bvh.closest(p);
     ASSERT_EQ(hit.d2, best) << "query " << i;
     ASSERT_EQ(hit.triangle, best_t) << "query " << i;
@@ -155,15 +154,7 @@ TEST(Measure, BvhStackedAndClusteredTrianglesMatchBruteForce) {
   const measure_detail::TriangleBvh bvh(corners);
   for (int i = 0; i < 500; ++i) {
     const double p[3] = {3 * rng.uniform() - 1, 3 * rng.uniform() - 1, 3 * rng.uniform() - 1};
-    double best = INFINITY;
-    std::uint32_t best_t = UINT32_MAX;
-    for (std::size_t t = 0; t < corners.size() / 9; ++t) {
-      const double* c = &corners[9 * t];
-      const Vec3 q = closest_point_on_triangle({p[0], p[1], p[2]}, {c[0], c[1], c[2]}, {c[3], c[4], c[5]},
-                                               {c[6], c[7], c[8]});
-      const double d2 = measure_detail::squared_distance({p[0], p[1], p[2]}, q);
-      if (d2 < best) best = d2, best_t = std::uint32_t(t);
-    }
+    const auto [best, best_t] = brute_force_closest(corners, p);
     std::uint32_t hint = 17;  // a stacked copy: the answer must still be the lowest index
     const auto cold = bvh.closest(p), warm = bvh.closest(p, &hint);
     ASSERT_EQ(cold.d2, best) << i;
