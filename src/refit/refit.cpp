@@ -102,11 +102,15 @@ bool barycentric(Vec3 q, Vec3 a, Vec3 b, Vec3 c, double out[3]) {
 }
 
 /// Where each point lands on the approximation.
+/// (Not zero-filled when made: each point's entries are written by the thread that projects it,
+/// so the fresh pages of a multi-million-point projection are touched on all threads.)
 struct Projection {
-  std::vector<std::uint32_t> nearest;  ///< closest face, UINT32_MAX = none (where the next round looks)
-  std::vector<std::uint32_t> face;     ///< the same face if it pulls the point (has area), else UINT32_MAX
-  std::vector<double> bary;            ///< 3 per point
-  double energy = 0;                   ///< sum of w_i * squared distance
+  template <class T>
+  using Array = std::vector<T, core::DefaultInitAllocator<T>>;
+  Array<std::uint32_t> nearest;  ///< closest face, UINT32_MAX = none (where the next round looks)
+  Array<std::uint32_t> face;     ///< the same face if it pulls the point (has area), else UINT32_MAX
+  Array<double> bary;            ///< 3 per point, read only where face is set
+  double energy = 0;             ///< sum of w_i * squared distance
 };
 
 }  // namespace
@@ -184,30 +188,32 @@ struct SparseRows {
   std::vector<double> value, diagonal;
 };
 
-/// y = a x for the three coordinates at once (x, y: 3 per vertex): each row of a read once.
-void multiply(const SparseRows& a, const std::vector<double>& x, std::vector<double>& y) {
-  const std::size_t n = a.diagonal.size();
-  for (std::size_t v = 0; v < n; ++v) {
-    double sum[3] = {0, 0, 0};
-    for (std::uint32_t e = a.start[v]; e < a.start[v + 1]; ++e) {
-      const double* xc = &x[3 * std::size_t(a.column[e])];
-      for (int k = 0; k < 3; ++k) sum[k] += a.value[e] * xc[k];
+/// y = a x for the three coordinates at once (x, y: 3 per vertex): each row of a read once, rows
+/// in fixed chunks on the threads (each row's sum is made as on one thread).
+void multiply(const SparseRows& a, const std::vector<double>& x, std::vector<double>& y, unsigned threads) {
+  core::for_chunks(a.diagonal.size(), std::size_t(1) << 14, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
+    for (std::size_t v = begin; v < end; ++v) {
+      double sum[3] = {0, 0, 0};
+      for (std::uint32_t e = a.start[v]; e < a.start[v + 1]; ++e) {
+        const double* xc = &x[3 * std::size_t(a.column[e])];
+        for (int k = 0; k < 3; ++k) sum[k] += a.value[e] * xc[k];
+      }
+      for (int k = 0; k < 3; ++k) y[3 * v + k] = sum[k];
     }
-    for (int k = 0; k < 3; ++k) y[3 * v + k] = sum[k];
-  }
+  });
 }
 
 /// Solves a x = b for the three coordinates at once, from the x given: conjugate gradients with a
 /// diagonal preconditioner, each coordinate to a residual of kTolerance |b| (then it stops
 /// moving). Eigen's solver takes one right-hand side at a time and so reads the matrix three times
 /// a step; this reads it once (docs/benchmarks.md, "Measurements behind the code").
-void conjugate_gradients(const SparseRows& a, const std::vector<double>& b, std::vector<double>& x) {
+void conjugate_gradients(const SparseRows& a, const std::vector<double>& b, std::vector<double>& x, unsigned threads) {
   constexpr double kTolerance = 1e-10;
   constexpr int kMaxSteps = 1000;
   const std::size_t n = a.diagonal.size();
   std::vector<double> r(3 * n), z(3 * n), p(3 * n), q(3 * n);
   double limit[3] = {0, 0, 0}, rz[3] = {0, 0, 0}, rr[3] = {0, 0, 0};
-  multiply(a, x, q);
+  multiply(a, x, q, threads);
   for (std::size_t v = 0; v < n; ++v)
     for (int k = 0; k < 3; ++k) {
       const std::size_t i = 3 * v + k;
@@ -221,7 +227,7 @@ void conjugate_gradients(const SparseRows& a, const std::vector<double>& b, std:
     bool moving[3], any = false;
     for (int k = 0; k < 3; ++k) any |= moving[k] = rr[k] > limit[k];
     if (!any) break;
-    multiply(a, p, q);
+    multiply(a, p, q, threads);
     double pq[3] = {0, 0, 0};
     for (std::size_t i = 0; i < 3 * n; ++i) pq[i % 3] += p[i] * q[i];
     double alpha[3];
@@ -377,15 +383,16 @@ class Refitter {
     std::vector<double> spheres;  // per face: centre and radius, to skip far faces in closest_around
     if (before || !near_vertex_.empty()) spheres = bounding_spheres(x);
     Projection p;
-    p.nearest.assign(count, UINT32_MAX);
-    p.face.assign(count, UINT32_MAX);
-    p.bary.assign(3 * count, 0.0);
-    std::vector<double> d2(count, 0.0);
+    p.nearest.resize(count);
+    p.face.resize(count);
+    p.bary.resize(3 * count);
+    Projection::Array<double> d2(count);
     core::for_chunks(count, kChunk, core::resolve_threads(opt_.threads),
                      [&](std::size_t, std::size_t begin, std::size_t end) {
                        std::uint32_t hint = UINT32_MAX;  // reset per chunk: never crosses chunks
                        for (std::size_t k = begin; k < end; ++k) {
-                         const std::uint32_t j = pts_.order[k];
+                         const std::uint32_t j = pts_.order[k];  // each point once (a permutation)
+                         p.nearest[j] = p.face[j] = UINT32_MAX, d2[j] = 0;
                          const double* q = &pts_.position[3 * j];
                          const std::uint32_t from = start(j);
                          const auto hit = from == UINT32_MAX ? tree.closest(q, &hint)
@@ -610,7 +617,7 @@ class Refitter {
         b[3 * v + k] = fixed_[v] ? x_[3 * v + k] : rhs[3 * v + k] + lambda * x_[3 * v + k];
     }
     next = x_;  // the guess: where the vertices are
-    conjugate_gradients(a, b, next);
+    conjugate_gradients(a, b, next, core::resolve_threads(opt_.threads));
     for (std::size_t v = 0; v < n; ++v)
       for (int k = 0; k < 3; ++k)
         if (fixed_[v] || !std::isfinite(next[3 * v + k])) next[3 * v + k] = x_[3 * v + k];
