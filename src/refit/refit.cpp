@@ -479,25 +479,43 @@ class Refitter {
   // (CSR in around_start_, around_faces_): what closest_around tests after f. The faces do not
   // change between rounds, so the lists are made once, not for every query.
   void make_around() {
+    // In fixed chunks of faces on the threads, each chunk's lists side by side and then copied to
+    // their place: the same lists as one pass over the faces, which on a multi-million-face output
+    // was a serial stretch (and its fresh pages) beside the parallel projections.
     const std::size_t nf = tri_.size() / 3;
-    around_start_.assign(nf + 1, 0);
-    around_faces_.clear();
-    around_faces_.reserve(12 * nf);
-    for (std::size_t f = 0; f < nf; ++f) {
-      const std::uint32_t* corners = &tri_[3 * f];
-      for (int corner = 0; corner < 3; ++corner) {
-        const std::uint32_t v = corners[corner];
-        for (std::uint32_t i = ring_start_[v]; i < ring_start_[v + 1]; ++i) {
-          const std::uint32_t g = ring_faces_[i];
-          const std::uint32_t* t = &tri_[3 * std::size_t(g)];
-          // A face around an earlier corner too is listed there.
-          const auto has = [t](std::uint32_t u) { return t[0] == u || t[1] == u || t[2] == u; };
-          if (g == f || (corner > 0 && has(corners[0])) || (corner > 1 && has(corners[1]))) continue;
-          around_faces_.push_back(g);
+    constexpr std::size_t kFaces = std::size_t(1) << 13;
+    const unsigned threads = core::resolve_threads(opt_.threads);
+    std::vector<std::vector<std::uint32_t>> part((nf + kFaces - 1) / kFaces);
+    around_start_.resize(nf + 1);
+    around_start_[0] = 0;
+    core::for_chunks(nf, kFaces, threads, [&](std::size_t chunk, std::size_t begin, std::size_t end) {
+      std::vector<std::uint32_t>& out = part[chunk];
+      out.reserve(12 * (end - begin));
+      for (std::size_t f = begin; f < end; ++f) {
+        const std::uint32_t* corners = &tri_[3 * f];
+        for (int corner = 0; corner < 3; ++corner) {
+          const std::uint32_t v = corners[corner];
+          for (std::uint32_t i = ring_start_[v]; i < ring_start_[v + 1]; ++i) {
+            const std::uint32_t g = ring_faces_[i];
+            const std::uint32_t* t = &tri_[3 * std::size_t(g)];
+            // A face around an earlier corner too is listed there.
+            const auto has = [t](std::uint32_t u) { return t[0] == u || t[1] == u || t[2] == u; };
+            if (g == f || (corner > 0 && has(corners[0])) || (corner > 1 && has(corners[1]))) continue;
+            out.push_back(g);
+          }
         }
+        around_start_[f + 1] = std::uint32_t(out.size());  // within the chunk, until offset below
       }
-      around_start_[f + 1] = std::uint32_t(around_faces_.size());
-    }
+    });
+    std::vector<std::size_t> offset(part.size() + 1, 0);
+    for (std::size_t c = 0; c < part.size(); ++c) offset[c + 1] = offset[c] + part[c].size();
+    around_faces_.resize(offset.back());
+    core::for_chunks(part.size(), 1, threads, [&](std::size_t c, std::size_t, std::size_t) {
+      std::copy(part[c].begin(), part[c].end(), around_faces_.begin() + std::ptrdiff_t(offset[c]));
+      for (std::size_t f = c * kFaces; f < std::min(nf, (c + 1) * kFaces); ++f)
+        around_start_[f + 1] += std::uint32_t(offset[c]);
+      std::vector<std::uint32_t>().swap(part[c]);
+    });
   }
 
   // The vertex given near point j, if it has a face; else UINT32_MAX.
@@ -762,7 +780,8 @@ class Refitter {
   std::vector<std::uint8_t> fixed_;
   std::vector<std::uint32_t> ring_start_, ring_faces_;  // faces around each vertex
   std::vector<std::uint32_t> ring_slot_;  // per corner of a face: its place in its vertex's ring
-  std::vector<std::uint32_t> around_start_, around_faces_;  // per face: the faces around its corners
+  std::vector<std::uint32_t> around_start_;  // per face: the faces around its corners (CSR)
+  std::vector<std::uint32_t, core::DefaultInitAllocator<std::uint32_t>> around_faces_;
   bool ready_ = false;
 };
 
