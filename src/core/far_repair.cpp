@@ -14,7 +14,6 @@
 #include "core/parallel_chunks.h"
 #include "core/same_position.h"
 #include "core/valid_pairs.h"
-#include "core/vertex_lists.h"
 #include "measure/bvh.h"
 #include "measure/point_triangle.h"
 
@@ -313,9 +312,9 @@ class Repairer {
   // distance of its centroid and edge midpoints (the middle of an edge across a groove is where
   // it is farthest from it) to the input (near_), and the largest of those and of the input
   // points' distances (largest_). The exact samples of a face are taken when a flip needs them.
-  // An edge's midpoint is searched for once, by the lowest face that has the edge (either way
-  // round: its coordinates are the same from both ends), and read by the others: on a closed mesh
-  // 2.5 searches a face instead of 4, for the same distances.
+  // An interior edge's midpoint is searched for once, by the lower of its two faces (across(): its
+  // coordinates are the same from both ends), and read by the other: on a closed mesh 2.5
+  // searches a face instead of 4, for the same distances.
   void scan_faces() {
     const std::size_t nf = face_count();
     near_.assign(nf, 0);
@@ -323,7 +322,7 @@ class Repairer {
     scored_.assign(nf, 0);
     score_.assign(nf, {});
     std::vector<std::uint32_t> owner(3 * nf);  // per face edge (3 f + k: t[k] to t[k + 1]): the slot that searches
-    std::vector<double> middle(3 * nf, 0.0);   // per searching slot: its midpoint's distance
+    std::vector<double> middle(3 * nf);        // per searching slot: its midpoint's distance
     for_chunks(nf, kChunk, resolve_threads(opt_.threads), [&](std::size_t, std::size_t begin, std::size_t end) {
       std::uint32_t hint = UINT32_MAX;
       for (std::size_t f = begin; f < end; ++f) {
@@ -331,17 +330,11 @@ class Repairer {
         const Vec3 &a = x_[t[0]], &b = x_[t[1]], &c = x_[t[2]];
         near_[f] = surface_.distance((1.0 / 3) * (a + b + c), &hint);
         for (int k = 0; k < 3; ++k) {
-          const std::uint32_t u = t[k], w = t[(k + 1) % 3];
+          const std::uint32_t u = t[k], w = t[(k + 1) % 3], g = across(std::uint32_t(f), u, w);
           std::uint32_t slot = std::uint32_t(3 * f + k);
-          for (std::uint32_t g : faces_at_[u]) {
-            if (3 * g + 2 >= slot) continue;  // not lower than the lowest so far
-            const std::uint32_t* s = &tri_[3 * g];
+          if (g < f)  // the edge runs from w to u in g
             for (int j = 0; j < 3; ++j)
-              if ((s[j] == u && s[(j + 1) % 3] == w) || (s[j] == w && s[(j + 1) % 3] == u)) {
-                slot = std::min(slot, std::uint32_t(3 * g + j));
-                break;
-              }
-          }
+              if (tri_[3 * g + j] == w && tri_[3 * g + (j + 1) % 3] == u) slot = std::uint32_t(3 * g + j);
           owner[3 * f + k] = slot;
           if (slot == 3 * f + k) middle[slot] = surface_.distance(0.5 * (x_[u] + x_[w]), &hint);
         }
@@ -1503,12 +1496,8 @@ std::vector<std::uint8_t> points_on_border(std::span<const std::uint32_t> indice
   const std::span<const std::uint32_t> faces = indices.first(indices.size() - indices.size() % 3);
   std::size_t vertex_count = 0;
   for (std::uint32_t v : faces) vertex_count = std::max<std::size_t>(vertex_count, std::size_t(v) + 1);
-  VertexLists faces_at;
-  faces_at.rebuild(vertex_count, [&](auto emit) {
-    for (std::size_t c = 0; c < faces.size(); ++c) emit(faces[c], std::uint32_t(c / 3));
-  });
   std::vector<std::uint8_t> border(vertex_count, 0);
-  for (const Edge& e : unique_edges(faces, faces_at, vertex_count))
+  for (const Edge& e : unique_edges(faces, vertex_count))
     if (e.faces == 1) border[e.lo] = border[e.hi] = 1;
   std::vector<std::uint8_t> on(point_source.size(), 0);
   for (std::size_t p = 0; p < point_source.size(); ++p)

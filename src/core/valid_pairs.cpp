@@ -41,6 +41,14 @@ std::vector<Edge> unique_edges(std::span<const std::uint32_t> triangles, const V
   return edges;
 }
 
+std::vector<Edge> unique_edges(std::span<const std::uint32_t> triangles, std::size_t vertex_count) {
+  VertexLists faces;
+  faces.rebuild(vertex_count, [&](auto emit) {
+    for (std::size_t c = 0; c < triangles.size(); ++c) emit(triangles[c], std::uint32_t(c / 3));
+  });
+  return unique_edges(triangles, faces, vertex_count);
+}
+
 namespace {
 // nanoflann's view of the candidate points.
 struct PointCloud {

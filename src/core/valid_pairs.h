@@ -20,6 +20,8 @@ struct Edge {
 /// per-vertex face lists (no global sort, no 64-bit key array: this runs on million-face meshes).
 std::vector<Edge> unique_edges(std::span<const std::uint32_t> triangles, const VertexLists& vertex_faces,
                                std::size_t vertex_count);
+/// The same from the triangle list alone (its face lists made here), for callers that have none.
+std::vector<Edge> unique_edges(std::span<const std::uint32_t> triangles, std::size_t vertex_count);
 
 /// How many of its nearest vertices within t each vertex pairs with (see close_pairs).
 inline constexpr std::size_t kMaxThresholdPairsPerVertex = 8;

@@ -353,11 +353,7 @@ class Refitter {
   // Border vertices: on an edge that only one face has (or more than two), found as the simplifier finds them
   // (core::unique_edges), so that --lock-border holds the same vertices in both.
   void mark_border() {
-    core::VertexLists faces;
-    faces.rebuild(fixed_.size(), [&](auto emit) {
-      for (std::size_t c = 0; c < tri_.size(); ++c) emit(tri_[c], std::uint32_t(c / 3));
-    });
-    for (const core::Edge& e : core::unique_edges(tri_, faces, fixed_.size()))
+    for (const core::Edge& e : core::unique_edges(tri_, fixed_.size()))
       if (e.faces != 2) fixed_[e.lo] = fixed_[e.hi] = 1;  // non-manifold edges too: where sheets meet
   }
 
