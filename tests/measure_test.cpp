@@ -136,6 +136,26 @@ TEST(Measure, BvhBuiltOnThreadsIsTheSameTree) {
   }
 }
 
+// A tree whose corners come from a function (TriangleBvh's second form: the refit's surface maps
+// them into its frame as it builds) is the tree of the same corners given as an array.
+TEST(Measure, BvhFromACornerFunctionIsTheSameTree) {
+  const Mesh sphere = test::icosphere(6);
+  const measure_detail::Surface s = measure_detail::make_surface(sphere, "sphere");
+  const measure_detail::TriangleBvh from_array(s.corners, 2);
+  const measure_detail::TriangleBvh from_function(
+      s.corners.size() / 9, [&](std::uint32_t t, double* out) { std::copy_n(&s.corners[9 * std::size_t(t)], 9, out); }, 2);
+  ASSERT_EQ(from_function.node_count(), from_array.node_count());
+  ASSERT_EQ(from_function.triangle_count(), from_array.triangle_count());
+  for (std::uint32_t t = 0; t < from_array.triangle_count(); t += 997)
+    ASSERT_TRUE(std::equal(from_array.triangle(t), from_array.triangle(t) + 9, from_function.triangle(t)));
+  measure_detail::Rng rng(5);
+  for (int i = 0; i < 200; ++i) {
+    const double p[3] = {3 * rng.uniform() - 1.5, 3 * rng.uniform() - 1.5, 3 * rng.uniform() - 1.5};
+    const auto a = from_array.closest(p), b = from_function.closest(p);
+    ASSERT_TRUE(bit_equal(a.d2, b.d2) && a.triangle == b.triangle) << "query " << i;
+  }
+}
+
 // The Morton-ordered build splits a range of equal codes in half: many triangles with one centre
 // (stacked copies), a dense cluster beside a far triangle, and exact ties all give the brute
 // force's answer, ties to the lowest index.

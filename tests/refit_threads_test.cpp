@@ -10,7 +10,9 @@
 #include <random>
 #include <vector>
 
+#include "core/distance_bound.h"
 #include "core/spatial_order.h"
+#include "geometry/frame.h"
 #include "geometry/vec3.h"
 #include "refit/refit_points.h"
 #include "test_meshes.h"
@@ -110,6 +112,38 @@ TEST(RefitThreads, MortonOrderIsTheSameOnAnyThreads) {
   std::vector<std::uint8_t> seen(p.size(), 0);
   for (std::uint32_t i : one) seen[i]++;
   EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), std::ptrdiff_t(p.size()));
+}
+
+// The input's surface in the refit's frame: each vertex's start face is the lowest face that has
+// it, found in vertex ranges on the threads (faces shuffled: each range meets its vertices all
+// through the face list), and the tree holds each face's corners mapped into the frame, as a tree
+// built from an array of them would.
+TEST(RefitThreads, SurfaceInFrameIsTheSameOnAnyThreads) {
+  const Mesh m = shuffled_bumpy_sphere();
+  const Frame frame{{0.1, -0.2, 0.3}, 2.5};
+  std::vector<std::uint32_t> lowest(m.vertex_count(), UINT32_MAX);
+  for (std::size_t c = 0; c < m.indices.size(); ++c) lowest[m.indices[c]] = std::min<std::uint32_t>(lowest[m.indices[c]], std::uint32_t(c / 3));
+  std::vector<double> corners(3 * m.indices.size());
+  for (std::size_t c = 0; c < m.indices.size(); ++c) {
+    const double* p = &m.positions[3 * std::size_t(m.indices[c])];
+    const Vec3 q = frame.to_frame({p[0], p[1], p[2]});
+    corners[3 * c] = q.x, corners[3 * c + 1] = q.y, corners[3 * c + 2] = q.z;
+  }
+  const core::SurfaceDistance from_array(corners);
+  for (unsigned threads : {1u, 2u, 3u}) {
+    const core::SurfaceDistance surface = refit_detail::surface_in_frame(m.positions, m.indices, frame, threads);
+    std::size_t wrong_start = 0, wrong_corners = 0;
+    for (std::uint32_t v = 0; v < m.vertex_count(); ++v) wrong_start += surface.face_at(v) != lowest[v];
+    for (std::uint32_t t = 0; t < m.face_count(); ++t)
+      wrong_corners += !std::equal(surface.triangle(t), surface.triangle(t) + 9, &corners[9 * std::size_t(t)]);
+    EXPECT_EQ(wrong_start, 0u) << threads << " threads";
+    EXPECT_EQ(wrong_corners, 0u) << threads << " threads";
+    for (const Vec3& p : {Vec3{0.3, 0.1, -0.2}, Vec3{-0.05, 0.2, 0.1}, Vec3{0.4, -0.4, 0.0}}) {
+      std::uint32_t a = UINT32_MAX, b = UINT32_MAX;
+      EXPECT_EQ(surface.distance(p, &a), from_array.distance(p, &b)) << threads << " threads";
+      EXPECT_EQ(a, b) << threads << " threads";
+    }
+  }
 }
 
 }  // namespace

@@ -17,10 +17,12 @@
 
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <utility>
 #include <span>
 #include <vector>
 
+#include "core/default_init_allocator.h"
 #include "core/working_mesh.h"
 #include "geometry/vec3.h"
 #include "measure/bvh.h"
@@ -35,10 +37,14 @@ class SurfaceDistance {
   /// `corners`: 9 doubles per triangle of the surface (a.xyz b.xyz c.xyz); its tree is built on up
   /// to `threads` threads (the same tree on any number).
   explicit SurfaceDistance(std::span<const double> corners, unsigned threads = 1) : tree_(corners, threads) {}
-  /// With, for each vertex of the surface's mesh, one triangle that has it (UINT32_MAX: none): a
-  /// start for searches from points known to lie near a vertex (face_at).
-  SurfaceDistance(std::span<const double> corners, std::vector<std::uint32_t> face_at_vertex, unsigned threads = 1)
-      : tree_(corners, threads), face_at_vertex_(std::move(face_at_vertex)) {}
+  /// Per vertex of the surface's mesh, one triangle that has it (UINT32_MAX: none): a start for
+  /// searches from points known to lie near a vertex (face_at).
+  using FaceAtVertex = std::vector<std::uint32_t, DefaultInitAllocator<std::uint32_t>>;
+  /// With a face at each vertex; triangle t's corners written by `corners_of(t, out)`
+  /// (TriangleBvh's second form).
+  SurfaceDistance(std::size_t count, const std::function<void(std::uint32_t, double*)>& corners_of,
+                  FaceAtVertex face_at_vertex, unsigned threads = 1)
+      : tree_(count, corners_of, threads), face_at_vertex_(std::move(face_at_vertex)) {}
   bool empty() const { return tree_.empty(); }
   /// A triangle that has vertex v, or UINT32_MAX (unknown).
   std::uint32_t face_at(std::uint32_t v) const {
@@ -90,7 +96,7 @@ class SurfaceDistance {
   bool piece_within(const Vec3& a, const Vec3& b, const Vec3& c, double d, int depth, std::uint32_t parent) const;
 
   measure_detail::TriangleBvh tree_;
-  std::vector<std::uint32_t> face_at_vertex_;
+  FaceAtVertex face_at_vertex_;
 };
 
 /// The corners of the live faces of `mesh` (9 doubles per face), for a SurfaceDistance.

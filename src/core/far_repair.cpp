@@ -1269,14 +1269,21 @@ class Repairer {
     // The interior vertices that may go, flattest first.
     // (Listed when the first split is found: most runs have a far place no split mends.)
     std::vector<std::pair<double, std::uint32_t>> flat, flat_border;
+    // (Each vertex's kind and cost on the threads, then listed in vertex order: the same lists.)
     const auto list_removable = [&] {
-      for (std::uint32_t v = 0; v < nv; ++v) {
-        if (held(v) || faces_at_[v].empty()) continue;
-        if (interior(v))
-          flat.push_back({removal_cost(v), v});
-        else if (!opt_.point_on_border.empty() && border_removable(v))
-          flat_border.push_back({border_removal_cost(v), v});
-      }
+      std::vector<std::uint8_t> kind(nv, 0);  // 1: interior, 2: a border vertex that may go
+      std::vector<double> cost(nv);
+      for_chunks(nv, kChunk, resolve_threads(opt_.threads), [&](std::size_t, std::size_t begin, std::size_t end) {
+        for (std::uint32_t v = std::uint32_t(begin); v < end; ++v) {
+          if (held(v) || faces_at_[v].empty()) continue;
+          if (interior(v))
+            kind[v] = 1, cost[v] = removal_cost(v);
+          else if (!opt_.point_on_border.empty() && border_removable(v))
+            kind[v] = 2, cost[v] = border_removal_cost(v);
+        }
+      });
+      for (std::uint32_t v = 0; v < nv; ++v)
+        if (kind[v] != 0) (kind[v] == 1 ? flat : flat_border).push_back({cost[v], v});
       std::sort(flat.begin(), flat.end());
       std::sort(flat_border.begin(), flat_border.end());
     };

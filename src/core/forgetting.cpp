@@ -9,7 +9,7 @@ namespace qem::core {
 
 void renew_quadrics(Context& c) {
   WorkingMesh& m = c.mesh;
-  c.quadric = face_quadrics(m, c.settings.weighting, c.settings.threads);
+  face_quadrics(m, c.settings.weighting, c.settings.threads, c.quadric);
   if (c.wedges) c.wedges->renew_quadrics(m);
   const bool open = std::find(m.boundary.begin(), m.boundary.end(), std::uint8_t(1)) != m.boundary.end();
   if (!open && !c.wedges) return;  // closed, no seams: no edge planes, no edges needed

@@ -28,8 +28,8 @@ Quadric plane_of_face(const WorkingMesh& m, std::uint32_t f, int k, Weighting we
 
 }  // namespace
 
-std::vector<Quadric> face_quadrics(const WorkingMesh& m, Weighting weighting, unsigned threads) {
-  std::vector<Quadric> quadric(m.pos.size());
+void face_quadrics(const WorkingMesh& m, Weighting weighting, unsigned threads, std::vector<Quadric>& quadric) {
+  quadric.resize(m.pos.size());
   // Per vertex over its face list (in face order), so every sum is made in the same order for
   // any thread count; each face's plane is computed at each of its corners.
   for_chunks(m.pos.size(), std::size_t(1) << 13, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
@@ -43,7 +43,6 @@ std::vector<Quadric> face_quadrics(const WorkingMesh& m, Weighting weighting, un
       quadric[v] = q;
     }
   });
-  return quadric;
 }
 
 void add_boundary_planes(WorkingMesh& m, const std::vector<Edge>& edges, double weight, Weighting weighting,

@@ -20,9 +20,10 @@ inline std::uint32_t sortable_bits(float key) {
 
 /// Sorts `ids` by the unsigned key key_of(id), stably. `scratch` is reused storage. The keys are
 /// read again in each digit pass instead of being stored beside the ids: half the memory, which
-/// matters more than the extra reads on the meshes this sorts.
-template <class KeyOf>
-void radix_sort_by_key(std::vector<std::uint32_t>& ids, std::vector<std::uint32_t>& scratch, KeyOf key_of) {
+/// matters more than the extra reads on the meshes this sorts. `Ids`: a vector of uint32 (any
+/// allocator).
+template <class Ids, class KeyOf>
+void radix_sort_by_key(Ids& ids, Ids& scratch, KeyOf key_of) {
   constexpr int kBits = 11, kBuckets = 1 << kBits, kDigits = 3;
   const std::size_t n = ids.size();
   scratch.resize(n);

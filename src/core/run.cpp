@@ -105,7 +105,7 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   mesh.rebuild_face_lists();
   std::vector<Edge> edges;
   side_by_side(  // GH97 §5 (HG99 §2) and the edges of §3.2: independent, so side by side
-      settings.threads, [&] { quadric = face_quadrics(mesh, settings.weighting, 1); },
+      settings.threads, [&] { face_quadrics(mesh, settings.weighting, 1, quadric); },
       [&] { edges = unique_edges(mesh.tri, mesh.vertex_faces, mesh.vertex_count()); });
   add_constraint_planes(mesh, edges, settings, wedges.has_value(), quadric);  // GH97 §6, seams
   if (settings.exact_border) mark_border_corners(mesh, edges);  // after: the border is marked

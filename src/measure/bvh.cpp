@@ -54,29 +54,31 @@ inline float float_above(double x) { return -float_below(-x); }
 
 }  // namespace
 
-TriangleBvh::TriangleBvh(std::span<const double> corners, unsigned threads) {
-  const std::uint32_t n = std::uint32_t(corners.size() / 9);
+template <class CornersOf>
+void TriangleBvh::build(std::size_t count, const CornersOf& corners_of, unsigned threads) {
+  const std::uint32_t n = std::uint32_t(count);
   if (n == 0) return;
   // Every step but the radix sort and the top-down split is per triangle (or per node) and runs
   // in fixed chunks on the threads: on a ten-million-face input the build was a serial stretch of
   // seconds beside parallel work. The chunks never change a result: per-chunk boxes are combined
   // by min and max, which are exact, so the tree is the same on any number of threads.
   constexpr std::size_t kChunk = std::size_t(1) << 16;
-  const auto centre_of = [&](std::uint32_t t, int k) {  // of the triangle's box, as Bounds::grow makes it
-    double lo = INFINITY, hi = -INFINITY;
-    for (int c = 0; c < 3; ++c) {
-      const double x = corners[9 * std::size_t(t) + 3 * c + k];
-      lo = std::min(lo, x), hi = std::max(hi, x);
+  const auto centre_of = [&](std::uint32_t t, double centre[3]) {  // of the triangle's box, as Bounds::grow makes it
+    double c[9];
+    corners_of(t, c);
+    for (int k = 0; k < 3; ++k) {
+      double lo = INFINITY, hi = -INFINITY;
+      for (int i = 0; i < 3; ++i) lo = std::min(lo, c[3 * i + k]), hi = std::max(hi, c[3 * i + k]);
+      centre[k] = 0.5 * (lo + hi);
     }
-    return 0.5 * (lo + hi);
   };
   // The box of the triangles' box centres: the grid of the Morton codes.
   std::vector<Bounds> chunk_centres((n + kChunk - 1) / kChunk);
   core::for_chunks(n, kChunk, threads, [&](std::size_t chunk, std::size_t begin, std::size_t end) {
     Bounds b;
     for (std::size_t t = begin; t < end; ++t) {
-      const double centre[3] = {centre_of(std::uint32_t(t), 0), centre_of(std::uint32_t(t), 1),
-                                centre_of(std::uint32_t(t), 2)};
+      double centre[3];
+      centre_of(std::uint32_t(t), centre);
       b.grow(centre);
     }
     chunk_centres[chunk] = b;
@@ -89,14 +91,15 @@ TriangleBvh::TriangleBvh(std::span<const double> corners, unsigned threads) {
       std::max({centres.hi[0] - centres.lo[0], centres.hi[1] - centres.lo[1], centres.hi[2] - centres.lo[2]});
   const double scale = extent > 0 ? double(kGrid - 1) / extent : 0;
   using Indices = std::vector<std::uint32_t, core::DefaultInitAllocator<std::uint32_t>>;
-  Indices code(n);
-  std::vector<std::uint32_t> order(n), scratch;
+  Indices code(n), order(n), scratch;
   core::for_chunks(n, kChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
     for (std::size_t t = begin; t < end; ++t) {
       std::uint32_t m = 0;
+      double centre[3];
+      centre_of(std::uint32_t(t), centre);
       for (int k = 0; k < 3; ++k) {
         // Clamped before the conversion: NaN and out-of-range doubles must never reach the cast.
-        const double c = (centre_of(std::uint32_t(t), k) - centres.lo[k]) * scale;
+        const double c = (centre[k] - centres.lo[k]) * scale;
         const std::uint64_t cell = c >= 0 ? std::uint64_t(std::min(c, double(kGrid - 1))) : 0;
         m |= std::uint32_t(core::spread_bits_3d(cell)) << k;
       }
@@ -105,7 +108,7 @@ TriangleBvh::TriangleBvh(std::span<const double> corners, unsigned threads) {
     }
   });
   core::radix_sort_by_key(order, scratch, [&](std::uint32_t t) { return code[t]; });
-  std::vector<std::uint32_t>().swap(scratch);
+  Indices().swap(scratch);
   Indices sorted_code(n);
   core::for_chunks(n, kChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) sorted_code[i] = code[order[i]];
@@ -114,9 +117,13 @@ TriangleBvh::TriangleBvh(std::span<const double> corners, unsigned threads) {
 
   // Top down: a range splits where its codes' highest differing bit turns on (a spatial median,
   // as in an octree); a range of equal codes splits in half. The depth stays below 30 + log2(n).
-  nodes_.reserve(2 * std::size_t(n) / kLeaf + 2);
-  nodes_.push_back({});
-  nodes_.push_back({});  // slot 1, unused: pairs of children start at even slots
+  // Room for the most nodes there can be: every leaf holds a triangle at least, so at most n
+  // leaves and n - 1 inner nodes, and slot 1. Pages are taken as the nodes are written (about
+  // 0.65 n of them on scanned meshes), and never copied to a larger array.
+  nodes_.resize(2 * std::size_t(n) + 1);
+  std::size_t used = 2;
+  nodes_[0] = {};
+  nodes_[1] = {};  // slot 1, unused: pairs of children start at even slots
   struct Task {
     std::uint32_t node, begin, end;
   };
@@ -139,21 +146,22 @@ TriangleBvh::TriangleBvh(std::span<const double> corners, unsigned threads) {
                                              [&](std::uint32_t c) { return (c & bit) == 0; }) -
                         sorted_code.begin());
     }
-    const std::uint32_t left = std::uint32_t(nodes_.size());
-    nodes_.push_back({});
-    nodes_.push_back({});
+    const std::uint32_t left = std::uint32_t(used);
+    nodes_[used++] = {};
+    nodes_[used++] = {};
     nodes_[task.node].first = left;
     nodes_[task.node].count = 0;
     stack.push_back({left + 1, mid, task.end});
     stack.push_back({left, task.begin, mid});
   }
+  nodes_.resize(used);
   Indices().swap(sorted_code);
   // The triangles in leaf order, so that a leaf reads contiguous memory (here, for its box, too).
   tris_.resize(9 * std::size_t(n));
   slot_of_.resize(n);
   core::for_chunks(n, kChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
-      std::copy_n(&corners[9 * std::size_t(order[i])], 9, &tris_[9 * i]);
+      corners_of(order[i], &tris_[9 * i]);
       slot_of_[order[i]] = std::uint32_t(i);
     }
   });
@@ -179,6 +187,17 @@ TriangleBvh::TriangleBvh(std::span<const double> corners, unsigned threads) {
     const Node &l = nodes_[node.first], &r = nodes_[node.first + 1];
     for (int k = 0; k < 3; ++k) node.lo[k] = std::min(l.lo[k], r.lo[k]), node.hi[k] = std::max(l.hi[k], r.hi[k]);
   }
+}
+
+TriangleBvh::TriangleBvh(std::span<const double> corners, unsigned threads) {
+  build(
+      corners.size() / 9,
+      [corners](std::uint32_t t, double* out) { std::copy_n(&corners[9 * std::size_t(t)], 9, out); }, threads);
+}
+
+TriangleBvh::TriangleBvh(std::size_t count, const std::function<void(std::uint32_t, double*)>& corners_of,
+                         unsigned threads) {
+  build(count, corners_of, threads);
 }
 
 double TriangleBvh::slot_d2(const double p[3], std::uint32_t slot, double point[3]) const {

@@ -9,6 +9,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <span>
 #include <vector>
@@ -32,6 +33,11 @@ class TriangleBvh {
   /// `corners`: 9 doubles per triangle (a.xyz b.xyz c.xyz). Built on up to `threads` threads; the
   /// tree is the same on any number.
   explicit TriangleBvh(std::span<const double> corners, unsigned threads = 1);
+  /// The same tree, triangle t's 9 coordinates written by `corners_of(t, out)` (called on the
+  /// threads, more than once per triangle: the same numbers each time). For corners that are
+  /// computed, e.g. mapped into a frame: no array of all of them beside the tree's own copy.
+  TriangleBvh(std::size_t count, const std::function<void(std::uint32_t, double*)>& corners_of,
+              unsigned threads = 1);
 
   /// The closest point of all triangles to `p` (of two as close, the one of lower index, so the
   /// answer does not depend on the tree's layout); none closer than sqrt(max_d2) -> Hit with d2 = inf.
@@ -72,13 +78,15 @@ class TriangleBvh {
     std::uint32_t count;  ///< triangles in a leaf; 0 for an inner node
   };
   static_assert(sizeof(Node) == 32);
+  template <class CornersOf>
+  void build(std::size_t count, const CornersOf& corners_of, unsigned threads);
   Hit search(const double p[3], double best, std::uint32_t best_slot) const;
   double slot_d2(const double p[3], std::uint32_t slot, double point[3]) const;
 
-  std::vector<Node> nodes_;
+  std::vector<Node, core::DefaultInitAllocator<Node>> nodes_;
   // Written whole by the build before any read: not zero-filled first.
   std::vector<double, core::DefaultInitAllocator<double>> tris_;           ///< 9 per triangle, in leaf order
-  std::vector<std::uint32_t> ids_;      ///< input index of each stored triangle
+  std::vector<std::uint32_t, core::DefaultInitAllocator<std::uint32_t>> ids_;      ///< input index of each stored triangle
   std::vector<std::uint32_t, core::DefaultInitAllocator<std::uint32_t>> slot_of_;  ///< stored position of each input triangle
 };
 

@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "check_mesh.h"
+#include "core/default_init_allocator.h"
 #include "core/parallel_chunks.h"
 #include "core/spatial_order.h"
 #include "partition/partition_targets.h"
@@ -62,17 +63,28 @@ std::uint32_t point_of(const std::vector<std::uint32_t>& point, std::uint32_t v)
 constexpr std::uint32_t kNone = 0xffffffffu;
 constexpr std::uint16_t kNoPart = 0xffff;
 constexpr std::size_t kChunk = std::size_t(1) << 16;  // faces per chunk of the parallel loops
+// Per-face and per-vertex arrays written whole on the threads: not zeroed first, so that their
+// fresh pages are touched on the threads, not in a serial stretch (as the parts' own arrays).
+template <class T>
+using Array = std::vector<T, core::DefaultInitAllocator<T>>;
+// Sets every element of `a` to `value`, on the threads.
+template <class T, class V>
+void fill_on_threads(T& a, const V& value, unsigned threads) {
+  core::for_chunks(a.size(), kChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) a[i] = value;
+  });
+}
 
 // The Morton code of each face's centroid over the input's bounding box (21 bits per axis, as the
 // core's vertex order), UINT64_MAX for a degenerate face (a repeated corner: no plane, left out as
 // the core leaves it out). `point`: each vertex's point of the surface (itself, or with attributes
 // the first vertex at its position: two wedges of one position make a face degenerate in the core;
 // empty: each vertex is its own point).
-std::vector<std::uint64_t> centroid_codes(MeshView input, const std::vector<std::uint32_t>& point, unsigned threads) {
+Array<std::uint64_t> centroid_codes(MeshView input, const std::vector<std::uint32_t>& point, unsigned threads) {
   const Box box = bounding_box(input);
   const double extent = std::max({box.hi[0] - box.lo[0], box.hi[1] - box.lo[1], box.hi[2] - box.lo[2]});
   const double scale = extent > 0 ? double((1 << 21) - 1) / extent : 0;
-  std::vector<std::uint64_t> code(input.face_count());
+  Array<std::uint64_t> code(input.face_count());
   core::for_chunks(code.size(), kChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
     for (std::size_t f = begin; f < end; ++f) {
       const std::uint32_t* t = &input.indices[3 * f];
@@ -117,7 +129,7 @@ std::vector<MeshPart> split_mesh(MeshView input, const SimplifyOptions& options,
   // would be locked, each part would move its own, and the seam would open into a crack.
   const std::vector<std::uint32_t> point =
       input.attributes.empty() ? std::vector<std::uint32_t>{} : core::first_at_same_position(input, threads);
-  const std::vector<std::uint64_t> code = centroid_codes(input, point, threads);
+  const Array<std::uint64_t> code = centroid_codes(input, point, threads);
 
   // The cut: P-quantiles of the codes, taken from a sample of every k-th face (deterministic), so
   // that no serial sort of all faces is needed; parts then hold equal face counts to within about
@@ -131,7 +143,7 @@ std::vector<MeshPart> split_mesh(MeshView input, const SimplifyOptions& options,
   std::vector<std::uint64_t> splitter;
   for (unsigned p = 1; p < part_count; ++p) splitter.push_back(sample[sample.size() * p / part_count]);
   const std::size_t chunks = (nf + kChunk - 1) / kChunk;
-  std::vector<std::uint16_t> part_of(nf);
+  Array<std::uint16_t> part_of(nf);
   std::vector<std::vector<std::uint32_t>> count(chunks, std::vector<std::uint32_t>(part_count, 0));
   core::for_chunks(nf, kChunk, threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
     for (std::size_t f = begin; f < end; ++f) {
@@ -152,7 +164,7 @@ std::vector<MeshPart> split_mesh(MeshView input, const SimplifyOptions& options,
     part_begin[p + 1] = next;
   }
   const std::size_t n = part_begin[part_count];  // the non-degenerate faces
-  std::vector<std::uint32_t> faces(n);
+  Array<std::uint32_t> faces(n);
   core::for_chunks(nf, kChunk, threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
     for (std::size_t f = begin; f < end; ++f)
       if (part_of[f] != kNoPart) faces[at[c][part_of[f]]++] = std::uint32_t(f);
@@ -162,34 +174,37 @@ std::vector<MeshPart> split_mesh(MeshView input, const SimplifyOptions& options,
   // wedge there is on the cut, in each part that has it): the first part to claim it (whichever
   // thread is first) finds no owner, any other part finds one that is not itself. Which part
   // claims first varies; whether a second one exists does not, so `shared` is deterministic.
-  std::vector<std::atomic<std::uint32_t>> owner(input.vertex_count());
-  for (auto& o : owner) o.store(kNone, std::memory_order_relaxed);
-  std::vector<std::atomic<std::uint8_t>> shared_flag(input.vertex_count());
-  for (auto& s : shared_flag) s.store(0, std::memory_order_relaxed);
+  // (Plain arrays, taken atomically where the parts meet: std::atomic elements would be zeroed by
+  // their constructors, serially.)
+  Array<std::uint32_t> owner(input.vertex_count());
+  fill_on_threads(owner, kNone, threads);
+  Array<std::uint8_t> shared_flag(input.vertex_count());
+  fill_on_threads(shared_flag, std::uint8_t(0), threads);
   core::for_chunks(part_count, 1, threads, [&](std::size_t p, std::size_t, std::size_t) {
     for (std::size_t i = part_begin[p]; i < part_begin[p + 1]; ++i)
       for (int k = 0; k < 3; ++k) {
         const std::uint32_t v = point_of(point, input.indices[3 * std::size_t(faces[i]) + k]);
         std::uint32_t expected = kNone;
-        if (!owner[v].compare_exchange_strong(expected, std::uint32_t(p), std::memory_order_relaxed) &&
+        if (!std::atomic_ref(owner[v]).compare_exchange_strong(expected, std::uint32_t(p), std::memory_order_relaxed) &&
             expected != p)
-          shared_flag[v].store(1, std::memory_order_relaxed);
+          std::atomic_ref(shared_flag[v]).store(1, std::memory_order_relaxed);
       }
   });
   std::vector<std::uint8_t> shared(input.vertex_count());
   std::size_t referenced = 0;
   for (std::size_t v = 0; v < shared.size(); ++v) {
-    shared[v] = shared_flag[point_of(point, std::uint32_t(v))].load(std::memory_order_relaxed);
-    referenced += owner[v].load(std::memory_order_relaxed) != kNone;
+    shared[v] = shared_flag[point_of(point, std::uint32_t(v))];  // after the threads: no atomics needed
+    referenced += owner[v] != kNone;
   }
-  std::vector<std::atomic<std::uint8_t>>().swap(shared_flag);
-  std::vector<std::atomic<std::uint32_t>>().swap(owner);
+  Array<std::uint8_t>().swap(shared_flag);
+  Array<std::uint32_t>().swap(owner);
 
   const partition_detail::Targets total = partition_detail::resolve_targets(options, n);
   std::vector<MeshPart> parts(part_count);
   // Part vertices numbered in order of first use along the part's faces. A vertex only one part
   // uses is numbered in one shared array (no other part writes it); a shared one in the part's map.
-  std::vector<std::uint32_t> local(input.vertex_count(), kNone);
+  Array<std::uint32_t> local(input.vertex_count());
+  fill_on_threads(local, kNone, threads);
   core::for_chunks(part_count, 1, threads, [&](std::size_t p, std::size_t, std::size_t) {
     MeshPart& part = parts[p];
     std::unordered_map<std::uint32_t, std::uint32_t> shared_local;

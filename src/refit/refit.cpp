@@ -820,20 +820,30 @@ void check_options(const RefitOptions& options) {
 
 core::SurfaceDistance surface_in_frame(std::span<const double> positions, std::span<const std::uint32_t> indices,
                                        const Frame& frame, unsigned threads) {
-  // Filled on the threads, not zeroed first: on a large input these corners are otherwise a serial
-  // stretch of fresh pages.
-  std::vector<double, core::DefaultInitAllocator<double>> corners(3 * indices.size());
-  core::for_chunks(indices.size(), kChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
-    for (std::size_t c = begin; c < end; ++c) {
-      const double* p = &positions[3 * std::size_t(indices[c])];
+  // The tree maps each corner into the frame as it stores it: no array of all the mapped corners
+  // beside the tree's own (on a large input, hundreds of MB of fresh pages written twice).
+  const auto corners_of = [&](std::uint32_t t, double* out) {
+    for (int k = 0; k < 3; ++k) {
+      const double* p = &positions[3 * std::size_t(indices[3 * std::size_t(t) + k])];
       const Vec3 q = frame.to_frame({p[0], p[1], p[2]});
-      corners[3 * c] = q.x, corners[3 * c + 1] = q.y, corners[3 * c + 2] = q.z;
+      out[3 * k] = q.x, out[3 * k + 1] = q.y, out[3 * k + 2] = q.z;
+    }
+  };
+  // Per vertex, the lowest face that has it. Each thread owns a range of vertices and reads every
+  // face in order (as vertex_areas), so the first face it sees at a vertex of its range is the
+  // lowest, on any number of threads.
+  core::SurfaceDistance::FaceAtVertex face_at(positions.size() / 3);
+  const std::size_t nv = face_at.size();
+  const std::size_t ranges = std::max<std::size_t>(1, std::min<std::size_t>(threads, nv / 65536 + 1));
+  core::for_chunks(ranges, 1, unsigned(ranges), [&](std::size_t r, std::size_t, std::size_t) {
+    const std::size_t lo = nv * r / ranges, hi = nv * (r + 1) / ranges;
+    std::fill(face_at.begin() + std::ptrdiff_t(lo), face_at.begin() + std::ptrdiff_t(hi), UINT32_MAX);
+    for (std::size_t c = 0; c < indices.size(); ++c) {
+      const std::uint32_t v = indices[c];
+      if (v >= lo && v < hi && face_at[v] == UINT32_MAX) face_at[v] = std::uint32_t(c / 3);
     }
   });
-  std::vector<std::uint32_t> face_at(positions.size() / 3, UINT32_MAX);
-  for (std::size_t c = 0; c < indices.size(); ++c)
-    if (face_at[indices[c]] == UINT32_MAX) face_at[indices[c]] = std::uint32_t(c / 3);
-  return core::SurfaceDistance(corners, std::move(face_at), threads);
+  return core::SurfaceDistance(indices.size() / 3, corners_of, std::move(face_at), threads);
 }
 
 RefitResult refit_to_points(const FitPoints& points, Mesh& approx, const RefitOptions& options,

@@ -6,6 +6,7 @@
 #include <span>
 #include <vector>
 
+#include "core/default_init_allocator.h"
 #include "core/distance_bound.h"
 #include "geometry/frame.h"
 #include "geometry/vec3.h"
@@ -30,10 +31,14 @@ struct FitPoints {
   /// One point for each run of `group` consecutive points in Morton order: the run's middle
   /// point, carrying the run's summed weight (RefitOptions::points_per_vertex). Same frame.
   FitPoints thinned(std::size_t group) const;
-  std::vector<double> position;      ///< 3 per kept point, normalised
-  std::vector<double> weight;        ///< one per kept point
+  // (Filled on the threads when made, not zeroed first: on a large input these are otherwise a
+  // serial stretch of fresh pages.)
+  template <class T>
+  using Array = std::vector<T, core::DefaultInitAllocator<T>>;
+  Array<double> position;           ///< 3 per kept point, normalised
+  Array<double> weight;             ///< one per kept point
   std::vector<std::uint32_t> order;  ///< Morton order of the kept points (warm-started queries)
-  std::vector<std::uint32_t> source;  ///< index of each kept point among the points given
+  Array<std::uint32_t> source;      ///< index of each kept point among the points given
   /// The frame of the kept points' box (geometry/frame.h), in which `position` is given: its
   /// centre and scale (the box's diagonal).
   Vec3 centre;
