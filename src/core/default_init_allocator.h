@@ -3,6 +3,7 @@
 
 #include <memory>
 #include <utility>
+#include <vector>
 
 namespace qem::core {
 
@@ -28,5 +29,9 @@ struct DefaultInitAllocator : std::allocator<T> {
     ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
   }
 };
+
+/// A vector of such elements: resize() leaves them unwritten.
+template <class T>
+using UnzeroedVector = std::vector<T, DefaultInitAllocator<T>>;
 
 }  // namespace qem::core

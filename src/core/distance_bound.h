@@ -39,7 +39,7 @@ class SurfaceDistance {
   explicit SurfaceDistance(std::span<const double> corners, unsigned threads = 1) : tree_(corners, threads) {}
   /// Per vertex of the surface's mesh, one triangle that has it (UINT32_MAX: none): a start for
   /// searches from points known to lie near a vertex (face_at).
-  using FaceAtVertex = std::vector<std::uint32_t, DefaultInitAllocator<std::uint32_t>>;
+  using FaceAtVertex = UnzeroedVector<std::uint32_t>;
   /// With a face at each vertex; triangle t's corners written by `corners_of(t, out)`
   /// (TriangleBvh's second form).
   SurfaceDistance(std::size_t count, const std::function<void(std::uint32_t, double*)>& corners_of,

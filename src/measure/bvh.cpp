@@ -90,7 +90,7 @@ void TriangleBvh::build(std::size_t count, const CornersOf& corners_of, unsigned
   const double extent =
       std::max({centres.hi[0] - centres.lo[0], centres.hi[1] - centres.lo[1], centres.hi[2] - centres.lo[2]});
   const double scale = extent > 0 ? double(kGrid - 1) / extent : 0;
-  using Indices = std::vector<std::uint32_t, core::DefaultInitAllocator<std::uint32_t>>;
+  using Indices = core::UnzeroedVector<std::uint32_t>;
   Indices code(n), order(n), scratch;
   core::for_chunks(n, kChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
     for (std::size_t t = begin; t < end; ++t) {

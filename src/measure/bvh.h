@@ -83,11 +83,11 @@ class TriangleBvh {
   Hit search(const double p[3], double best, std::uint32_t best_slot) const;
   double slot_d2(const double p[3], std::uint32_t slot, double point[3]) const;
 
-  std::vector<Node, core::DefaultInitAllocator<Node>> nodes_;
   // Written whole by the build before any read: not zero-filled first.
-  std::vector<double, core::DefaultInitAllocator<double>> tris_;           ///< 9 per triangle, in leaf order
-  std::vector<std::uint32_t, core::DefaultInitAllocator<std::uint32_t>> ids_;      ///< input index of each stored triangle
-  std::vector<std::uint32_t, core::DefaultInitAllocator<std::uint32_t>> slot_of_;  ///< stored position of each input triangle
+  core::UnzeroedVector<Node> nodes_;
+  core::UnzeroedVector<double> tris_;           ///< 9 per triangle, in leaf order
+  core::UnzeroedVector<std::uint32_t> ids_;      ///< input index of each stored triangle
+  core::UnzeroedVector<std::uint32_t> slot_of_;  ///< stored position of each input triangle
 };
 
 }  // namespace qem::measure_detail

@@ -63,10 +63,10 @@ std::uint32_t point_of(const std::vector<std::uint32_t>& point, std::uint32_t v)
 constexpr std::uint32_t kNone = 0xffffffffu;
 constexpr std::uint16_t kNoPart = 0xffff;
 constexpr std::size_t kChunk = std::size_t(1) << 16;  // faces per chunk of the parallel loops
-// Per-face and per-vertex arrays written whole on the threads: not zeroed first, so that their
-// fresh pages are touched on the threads, not in a serial stretch (as the parts' own arrays).
+// The per-face and per-vertex arrays below are written whole on the threads and not zeroed first
+// (UnzeroedVector), so that their fresh pages are touched on the threads, not in a serial stretch.
 template <class T>
-using Array = std::vector<T, core::DefaultInitAllocator<T>>;
+using Array = core::UnzeroedVector<T>;
 // Sets every element of `a` to `value`, on the threads.
 template <class T, class V>
 void fill_on_threads(T& a, const V& value, unsigned threads) {

@@ -106,7 +106,7 @@ bool barycentric(Vec3 q, Vec3 a, Vec3 b, Vec3 c, double out[3]) {
 /// so the fresh pages of a multi-million-point projection are touched on all threads.)
 struct Projection {
   template <class T>
-  using Array = std::vector<T, core::DefaultInitAllocator<T>>;
+  using Array = core::UnzeroedVector<T>;
   Array<std::uint32_t> nearest;  ///< closest face, UINT32_MAX = none (where the next round looks)
   Array<std::uint32_t> face;     ///< the same face if it pulls the point (has area), else UINT32_MAX
   Array<double> bary;            ///< 3 per point, read only where face is set
@@ -294,7 +294,7 @@ class Refitter {
       // The distances on the threads (one per input vertex, in fixed chunks), the choice in input
       // order as before: the same faces on any number of threads.
       original_face_near_.assign(approx.vertex_count(), UINT32_MAX);
-      std::vector<double, core::DefaultInitAllocator<double>> distance(near_vertex_.size());
+      core::UnzeroedVector<double> distance(near_vertex_.size());
       core::for_chunks(near_vertex_.size(), kChunk, core::resolve_threads(o.threads),
                        [&](std::size_t, std::size_t begin, std::size_t end) {
                          for (std::size_t i = begin; i < end; ++i) {
@@ -777,10 +777,20 @@ class Refitter {
   std::vector<std::uint32_t> ring_start_, ring_faces_;  // faces around each vertex
   std::vector<std::uint32_t> ring_slot_;  // per corner of a face: its place in its vertex's ring
   std::vector<std::uint32_t> around_start_;  // per face: the faces around its corners (CSR)
-  std::vector<std::uint32_t, core::DefaultInitAllocator<std::uint32_t>> around_faces_;
+  core::UnzeroedVector<std::uint32_t> around_faces_;
   bool ready_ = false;
 };
 
+// Calls fn(lo, hi) for ranges [lo, hi) of the vertices [0, nv), one range per thread (a single one
+// below 65,536 vertices a thread), side by side. A pass over every face that touches only the
+// vertices of its range gives the serial result on any number of threads.
+template <class Fn>
+void for_vertex_ranges(std::size_t nv, unsigned threads, Fn fn) {
+  const std::size_t ranges = std::max<std::size_t>(1, std::min<std::size_t>(threads, nv / 65536 + 1));
+  core::for_chunks(ranges, 1, unsigned(ranges), [&](std::size_t r, std::size_t, std::size_t) {
+    fn(nv * r / ranges, nv * (r + 1) / ranges);
+  });
+}
 }  // namespace
 
 std::vector<double> vertex_areas(MeshView mesh, unsigned threads) {
@@ -790,9 +800,7 @@ std::vector<double> vertex_areas(MeshView mesh, unsigned threads) {
   // few along the range's edges). So the result is the serial one, bit for bit.
   const std::size_t nv = mesh.vertex_count();
   std::vector<double> area(nv, 0.0);
-  const std::size_t ranges = std::max<std::size_t>(1, std::min<std::size_t>(threads, nv / 65536 + 1));
-  core::for_chunks(ranges, 1, unsigned(ranges), [&](std::size_t r, std::size_t, std::size_t) {
-    const std::uint32_t lo = std::uint32_t(nv * r / ranges), hi = std::uint32_t(nv * (r + 1) / ranges);
+  for_vertex_ranges(nv, threads, [&](std::size_t lo, std::size_t hi) {
     const auto mine = [&](std::uint32_t v) { return v >= lo && v < hi; };
     for (std::size_t f = 0; f < mesh.indices.size(); f += 3) {
       const std::uint32_t* t = &mesh.indices[f];
@@ -829,14 +837,10 @@ core::SurfaceDistance surface_in_frame(std::span<const double> positions, std::s
       out[3 * k] = q.x, out[3 * k + 1] = q.y, out[3 * k + 2] = q.z;
     }
   };
-  // Per vertex, the lowest face that has it. Each thread owns a range of vertices and reads every
-  // face in order (as vertex_areas), so the first face it sees at a vertex of its range is the
-  // lowest, on any number of threads.
+  // Per vertex, the lowest face that has it: each range's pass over the faces in order sees it
+  // first.
   core::SurfaceDistance::FaceAtVertex face_at(positions.size() / 3);
-  const std::size_t nv = face_at.size();
-  const std::size_t ranges = std::max<std::size_t>(1, std::min<std::size_t>(threads, nv / 65536 + 1));
-  core::for_chunks(ranges, 1, unsigned(ranges), [&](std::size_t r, std::size_t, std::size_t) {
-    const std::size_t lo = nv * r / ranges, hi = nv * (r + 1) / ranges;
+  for_vertex_ranges(face_at.size(), threads, [&](std::size_t lo, std::size_t hi) {
     std::fill(face_at.begin() + std::ptrdiff_t(lo), face_at.begin() + std::ptrdiff_t(hi), UINT32_MAX);
     for (std::size_t c = 0; c < indices.size(); ++c) {
       const std::uint32_t v = indices[c];

@@ -33,12 +33,10 @@ struct FitPoints {
   FitPoints thinned(std::size_t group) const;
   // (Filled on the threads when made, not zeroed first: on a large input these are otherwise a
   // serial stretch of fresh pages.)
-  template <class T>
-  using Array = std::vector<T, core::DefaultInitAllocator<T>>;
-  Array<double> position;           ///< 3 per kept point, normalised
-  Array<double> weight;             ///< one per kept point
-  std::vector<std::uint32_t> order;  ///< Morton order of the kept points (warm-started queries)
-  Array<std::uint32_t> source;      ///< index of each kept point among the points given
+  core::UnzeroedVector<double> position;       ///< 3 per kept point, normalised
+  core::UnzeroedVector<double> weight;         ///< one per kept point
+  std::vector<std::uint32_t> order;            ///< Morton order of the kept points (warm-started queries)
+  core::UnzeroedVector<std::uint32_t> source;  ///< index of each kept point among the points given
   /// The frame of the kept points' box (geometry/frame.h), in which `position` is given: its
   /// centre and scale (the box's diagonal).
   Vec3 centre;
