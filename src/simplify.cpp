@@ -20,6 +20,7 @@
 #include "refit/refit_after_simplify.h"
 #include "refit/refit_points.h"
 #include "refit_with_seams.h"
+#include "two_sided_rims.h"
 
 namespace qem {
 
@@ -216,7 +217,8 @@ double sampled_distance(std::span<const double> positions, std::span<const std::
 
 SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options, SimplifyObserver* observer,
                                   std::vector<std::uint32_t>* consumed_indices,
-                                  std::vector<VertexAttribute>* consumed_attributes) {
+                                  std::vector<VertexAttribute>* consumed_attributes,
+                                  std::vector<std::pair<std::uint32_t, std::uint32_t>>* reversed_twins) {
   check_options(options);
   const bool refit = options.refit_rounds > 0;
   const bool bounded = std::isfinite(options.max_distance);
@@ -236,6 +238,7 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
   hooks.consumed_indices = consumed_indices;
   hooks.consumed_attributes = consumed_attributes;
   hooks.map_input_vertices = refit || fit_values;
+  hooks.reversed_twins = reversed_twins;
   core::WedgeRefitData wedge_refit;  // with attributes, for the refit, the attribute fit and the repair
   const bool repair = options.far_repair;
   if ((refit || fit_values || repair) && !input.attributes.empty()) hooks.wedge_refit = &wedge_refit;
@@ -304,14 +307,56 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
   return out;
 }
 
+// The run, with the reversed twins of two-sided rims put back (SimplifyOptions::two_sided_rims,
+// two_sided_rims.h). The twins count in the targets: where they would pass one, the run is made
+// again to the target lowered by the twins of the last run (the core then keeps the input: it
+// does not consume a mesh that has twins), at most three times; a run that stopped for another
+// reason than its target is not made again (a lower target would not change it).
+SimplifyResult simplify_with_rims(MeshView input, const SimplifyOptions& options, SimplifyObserver* observer,
+                                  std::vector<std::uint32_t>* consumed_indices,
+                                  std::vector<VertexAttribute>* consumed_attributes) {
+  const bool rims = options.two_sided_rims && !(observer && observer->wants_contractions());
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> twins;  // front input face, its reversed twin
+  SimplifyOptions o = options;
+  for (int run = 0;; ++run) {
+    SimplifyResult out = simplify_and_refit(input, o, observer, consumed_indices, consumed_attributes, rims ? &twins : nullptr);
+    if (twins.empty() || out.stop_reason == StopReason::Cancelled) return out;
+    const std::vector<std::uint32_t> faces =
+        faces_on_twinned_rims(out.mesh, out.face_source, twins, core::resolve_threads(options.threads));
+    if (faces.empty()) return out;
+    std::size_t face_target = options.target_faces;
+    if (options.target_ratio > 0)
+      face_target = std::max(face_target, std::size_t(std::floor(options.target_ratio * double(out.input_faces))));
+    const std::size_t added_vertices = twin_vertices_needed(out.mesh, faces);
+    const bool over_faces = face_target > 0 && out.mesh.face_count() + faces.size() > face_target;
+    const bool over_vertices =
+        options.target_vertices > 0 && out.mesh.vertex_count() + added_vertices > options.target_vertices;
+    if ((over_faces || over_vertices) && run < 3 &&
+        (out.stop_reason == StopReason::TargetReached || out.stop_reason == StopReason::AlreadyBelowTarget)) {
+      if (over_faces) {
+        o.target_ratio = 0;
+        o.target_faces = face_target > faces.size() ? face_target - faces.size() : 0;
+        if (o.target_faces == 0) o.as_far_as_possible = true;
+      }
+      if (over_vertices) {
+        o.target_vertices = options.target_vertices > added_vertices ? options.target_vertices - added_vertices : 0;
+        if (o.target_vertices == 0) o.as_far_as_possible = true;
+      }
+      continue;
+    }
+    add_reversed_twins(out, faces, twins);
+    return out;
+  }
+}
+
 }  // namespace
 
 SimplifyResult simplify(MeshView input, const SimplifyOptions& options, SimplifyObserver* observer) {
-  return simplify_and_refit(input, options, observer, nullptr, nullptr);
+  return simplify_with_rims(input, options, observer, nullptr, nullptr);
 }
 
 SimplifyResult simplify(Mesh&& input, const SimplifyOptions& options, SimplifyObserver* observer) {
-  SimplifyResult out = simplify_and_refit(input, options, observer, &input.indices, &input.attributes);
+  SimplifyResult out = simplify_with_rims(input, options, observer, &input.indices, &input.attributes);
   out.mesh.material_names = std::move(input.material_names);
   out.mesh.material_library = std::move(input.material_library);
   return out;

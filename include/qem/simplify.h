@@ -253,6 +253,18 @@ struct SimplifyOptions {
 
   /// Fill SimplifyResult::output_vertex_of_input (one entry per input vertex).
   bool map_input_vertices = false;
+
+  /// Two-sided rims. An input that makes a sheet two-sided with a reversed copy of each face (the
+  /// same three points turning the other way) has no open edge there: welded by position, each of
+  /// the sheet's edges has a face and its twin. The run keeps one face of each such pair (a
+  /// duplicate, SimplifyResult::dropped_duplicate_faces); with this, the output face along a border
+  /// whose input face had a reversed twin gets its twin back (SimplifyResult::rim_twin_faces),
+  /// so the rim stays closed as in the input and its back side is not culled; inside a closed
+  /// two-sided surface the twins stay out. The twins count in the face target (and their vertices,
+  /// with normals, in a vertex target): where they would pass it the run is made again to a target
+  /// lowered by them. Not in a partitioned run (qem/partition.h) nor with an observer that wants
+  /// contractions (a record describes the contractions alone).
+  bool two_sided_rims = true;
 };
 
 struct SimplifyResult {
@@ -293,6 +305,10 @@ struct SimplifyResult {
   std::size_t vertex_relocations = 0;
   /// Input faces left out: degenerate (a repeated corner) and duplicates (kept once).
   std::size_t dropped_degenerate_faces = 0, dropped_duplicate_faces = 0;
+  /// With SimplifyOptions::two_sided_rims: the reversed twins put back along the rims, after the
+  /// other faces (counted in the mesh's faces; each one's face_source is the input's reversed twin
+  /// of its front face's, and with normals its new vertices' vertex_source their front vertex's).
+  std::size_t rim_twin_faces = 0;
 
   /// Provenance, so that callers can carry their own per-vertex and per-face data across: for
   /// each output vertex, the input vertex whose position it started from (the survivor of its

@@ -151,7 +151,8 @@ class SimplifyResult(Mesh):
       "input already at or below target" or "cancelled" (the CLI's --json "stop");
       stop_detail: a sentence saying why.
     contractions, input_faces, input_vertices, refit_rounds, refit_rms_before, refit_rms_after,
-      edge_flips, vertex_moves, vertex_relocations, dropped_degenerate_faces, dropped_duplicate_faces: counts as in qem::SimplifyResult.
+      edge_flips, vertex_moves, vertex_relocations, dropped_degenerate_faces, dropped_duplicate_faces,
+      rim_twin_faces: counts as in qem::SimplifyResult.
     input_components, output_components: connected components of the input and the output
       (vertex-connected); pruned_components: removed by `prune`; rejected_component: contractions
       refused because a component would have dropped below its floor (keep_components).
@@ -169,7 +170,7 @@ class SimplifyResult(Mesh):
     __slots__ = (
         "max_error", "max_error_relative", "stop_reason", "stop_detail", "contractions", "input_faces",
         "input_vertices", "refit_rounds", "refit_rms_before", "refit_rms_after", "edge_flips", "vertex_moves", "vertex_relocations", "dropped_degenerate_faces",
-        "dropped_duplicate_faces", "rejected_component", "input_components", "output_components",
+        "dropped_duplicate_faces", "rim_twin_faces", "rejected_component", "input_components", "output_components",
         "pruned_components", "output_to_input_distance", "output_to_input_distance_relative",
         "rejected_distance", "vertex_source", "face_source", "output_vertex_of_input", "record",
     )
@@ -352,7 +353,7 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
              forget: float = _FORGET, forget_attributes: bool = False, refit="light", threads: int = 0, keep_components: bool = True, prune: Optional[float] = None,
              prune_relative: Optional[float] = None, exact_border: bool = True, attributes: Optional[dict] = None,
              attribute_weights: Optional[dict] = None, fit_attributes: bool = False, vertex_lock=None,
-             return_mapping: bool = False, far_repair: Optional[bool] = None,
+             return_mapping: bool = False, far_repair: Optional[bool] = None, two_sided_rims: bool = True,
              record: bool = False, progress: Optional[Callable[[float], Optional[bool]]] = None) -> SimplifyResult:
     """Simplifies a triangle mesh by quadric-error pair contraction (Garland & Heckbert 1997).
 
@@ -401,6 +402,9 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
         flat places to far ones where that lowers the local Hausdorff distance to the input without
         raising the local error (borders stay on the input's, seams stay); None (default): with the
         refit, as the command line.
+      two_sided_rims: where the input makes a sheet two-sided by a reversed copy of each face, put
+        the copy back on the output faces along its rims, so they stay closed (qem::SimplifyOptions::
+        two_sided_rims; counted in the target); False leaves out every reversed copy.
       threads: threads for the parallel parts (0 = all cores); the result is the same for any count.
       keep_components: every connected part keeps at least one face (a closed one four); False lets
         a part contract to nothing (GH97 as published).
@@ -456,6 +460,7 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
         raise ValueError("far_repair: a record replays the contractions, and the repair changes the mesh after them, "
                          "so record=True cannot be combined with far_repair=True")
     options.far_repair = options.refit_rounds > 0 if far_repair is None else bool(far_repair)
+    options.two_sided_rims = bool(two_sided_rims)
     options.map_input_vertices = bool(return_mapping)
     options.fit_attributes = bool(fit_attributes)
     if attribute_weights is not None:

@@ -249,3 +249,31 @@ def test_forget_attributes_is_asked_for(small_torus):
     assert plain.vertices.tobytes() == remember.vertices.tobytes()
     assert asked.vertices.tobytes() != plain.vertices.tobytes()
     assert np.allclose(np.linalg.norm(asked.attributes["NORMAL"], axis=1), 1.0)
+
+
+def _open_edges(v, f):
+    """Edges (welded by position) that only one face uses."""
+    _, weld = np.unique(np.asarray(v), axis=0, return_inverse=True)
+    w = weld.reshape(-1)[np.asarray(f)]
+    e = np.sort(np.concatenate([w[:, [0, 1]], w[:, [1, 2]], w[:, [2, 0]]]), axis=1)
+    _, counts = np.unique(e, axis=0, return_counts=True)
+    return int((counts == 1).sum())
+
+
+def test_two_sided_rims():
+    # A wavy sheet made two-sided by a reversed copy of each face: its rim is closed in the input and
+    # stays closed with two_sided_rims (the default), the twins counted in the target.
+    n = 16
+    x, y = np.meshgrid(np.linspace(0, 1, n), np.linspace(0, 1, n))
+    v = np.stack([x.ravel(), y.ravel(), 0.1 * np.sin(5 * x.ravel()) * np.cos(4 * y.ravel())], axis=1)
+    i = np.arange(n * n).reshape(n, n)
+    a, b, c, d = i[:-1, :-1].ravel(), i[:-1, 1:].ravel(), i[1:, :-1].ravel(), i[1:, 1:].ravel()
+    front = np.concatenate([np.stack([a, b, d], 1), np.stack([a, d, c], 1)])
+    f = np.concatenate([front, front[:, ::-1]]).astype(np.uint32)
+    assert _open_edges(v, f) == 0
+    r = qem.simplify(v, f, target_faces=100)
+    assert r.rim_twin_faces > 0 and r.dropped_duplicate_faces == len(front)
+    assert 90 <= len(r.faces) <= 100
+    assert _open_edges(r.vertices, r.faces) == 0
+    one = qem.simplify(v, f, target_faces=100, two_sided_rims=False)
+    assert one.rim_twin_faces == 0 and _open_edges(one.vertices, one.faces) > 0

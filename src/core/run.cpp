@@ -61,7 +61,9 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   WorkingMesh mesh = prepare_input(input, &internal);  // check, drop degenerate and duplicate faces, frame
   std::optional<Wedges> wedges;  // with attributes, on the input's vertices (Hoppe 1999)
   if (!input.attributes.empty()) wedges.emplace(build_wedges(input, internal, mesh, options));
-  if (wedges && hooks.consumed_attributes)
+  const bool keep_input = hooks.reversed_twins && !mesh.reversed_twins.empty();
+  if (hooks.reversed_twins) *hooks.reversed_twins = mesh.reversed_twins;
+  if (wedges && hooks.consumed_attributes && !keep_input)
     for (VertexAttribute& a : *hooks.consumed_attributes) std::vector<double>().swap(a.values);
   std::vector<std::uint32_t>().swap(internal);
   if (!options.vertex_lock.empty()) lock_vertices(options.vertex_lock, input, wedges ? &*wedges : nullptr, mesh);
@@ -79,8 +81,10 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   if (options.map_input_vertices || hooks.map_input_vertices) map.emplace(input.vertex_count(), mesh.source_vertex);
   if (hooks.consumed_indices) {
     if (hooks.before_release) hooks.before_release(input);
-    input.indices = {};
-    std::vector<std::uint32_t>().swap(*hooks.consumed_indices);
+    if (!keep_input) {
+      input.indices = {};
+      std::vector<std::uint32_t>().swap(*hooks.consumed_indices);
+    }
   }
   if (hooks.observer) hooks.observer->on_start(mesh.face_source);
 

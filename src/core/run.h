@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <utility>
 #include <vector>
 
 #include "core/wedges.h"
@@ -24,6 +25,9 @@ struct RunHooks {
   std::vector<VertexAttribute>* consumed_attributes = nullptr;
   /// Called with the input just before its indices are released (what needs the input's faces).
   std::function<void(MeshView)> before_release;
+  /// Filled with WorkingMesh::reversed_twins. When there are any, the caller's index array and
+  /// attributes are kept (not consumed): it may run again, to a target lowered by the twins it adds.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>>* reversed_twins = nullptr;
   /// Fill SimplifyResult::output_vertex_of_input even when the options do not ask for it.
   bool map_input_vertices = false;
   /// With attributes: filled with what the refit needs of each output vertex (wedges.h).

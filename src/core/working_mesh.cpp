@@ -94,6 +94,15 @@ void add_faces(MeshView in, const std::vector<std::uint32_t>& internal, bool wel
   auto lowest_corner = [&](std::size_t f) {  // sorted_corners(f)[0], without the sort
     return std::min({internal[in.indices[3 * f]], internal[in.indices[3 * f + 1]], internal[in.indices[3 * f + 2]]});
   };
+  // Two faces on the same three vertices: whether they turn opposite ways round them.
+  auto reversed = [&](std::size_t f, std::size_t g) {
+    const std::uint32_t* a = &in.indices[3 * f];
+    const std::uint32_t* b = &in.indices[3 * g];
+    const std::uint32_t a0 = internal[a[0]], a1 = internal[a[1]];
+    for (int c = 0; c < 3; ++c)  // b's corner on a's first vertex: a's second follows it in the same turn
+      if (internal[b[c]] == a0) return internal[b[(c + 1) % 3]] != a1;
+    return false;
+  };
   std::vector<std::uint32_t> bucket_start(n + 1, 0);
   for (std::size_t f = 0; f < nf; ++f)
     if (!collapsed(f)) ++bucket_start[lowest_corner(f) + 1];
@@ -113,16 +122,22 @@ void add_faces(MeshView in, const std::vector<std::uint32_t>& internal, bool wel
       bucket.push_back({sorted_corners(bucketed[k]), bucketed[k]});
     // The pairs differ in their face, so any sort gives this one order.
     sort_small(bucket.begin(), bucket.end(), std::less<>());
+    std::size_t kept = 0;  // the face of bucket[kept] is kept for the run of duplicates after it
     for (std::size_t k = 0; k < bucket.size(); ++k) {
-      if (k > 0 && bucket[k].first == bucket[k - 1].first) {
+      if (k > 0 && bucket[k].first == bucket[kept].first) {
         ++m.dropped_duplicate;
+        if (reversed(bucket[k].second, bucket[kept].second) &&
+            (m.reversed_twins.empty() || m.reversed_twins.back().first != bucket[kept].second))
+          m.reversed_twins.push_back({bucket[kept].second, bucket[k].second});
         continue;
       }
+      kept = k;
       const std::uint32_t f = bucket[k].second;
       for (int c = 0; c < 3; ++c) m.tri.push_back(internal[in.indices[3 * std::size_t(f) + c]]);
       m.face_source.push_back(f);
     }
   }
+  std::sort(m.reversed_twins.begin(), m.reversed_twins.end());
 }
 
 }  // namespace

@@ -48,6 +48,10 @@ struct WorkingMesh {
 
   std::size_t faces_alive = 0, vertices_alive = 0;
   std::size_t dropped_degenerate = 0, dropped_duplicate = 0;  ///< input faces left out
+  /// Each input face kept that had a duplicate of the opposite orientation dropped (a two-sided
+  /// sheet's faces, a flap), with the first such duplicate, in increasing order of the kept face:
+  /// qem/simplify.h, two_sided_rims.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> reversed_twins;
 
   std::size_t vertex_count() const { return pos.size(); }
   const std::uint32_t* face(std::uint32_t f) const { return &tri[3 * std::size_t(f)]; }
