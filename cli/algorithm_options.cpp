@@ -128,11 +128,15 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
                 "seams and locked vertices stay (docs/benchmarks.md, \"Far places\"). On by default with "
                 "the refit; this turns it on without it");
   sub->add_flag("--no-far-repair", a.no_far_repair, "No repair of the far places after the run (see --far-repair)");
-  sub->add_flag("--one-sided", a.one_sided,
-                "Leave out every reversed twin of a face (a two-sided sheet made of a face and its copy turning "
-                "the other way). By default they are left out inside closed surfaces but put back on the output "
-                "faces along a rim whose input faces had them, so the rim stays closed and two-sided as in the "
-                "input (counted in the target; docs/attributes.md, \"Two-sided rims\")");
+  sub->add_option("--two-sided", a.two_sided,
+                  "Sheets made two-sided by a reversed copy of each face (the same three points turning the other "
+                  "way): one side is simplified, and then the copies come back on the output faces along the "
+                  "sheet's rims (rims: the rim stays closed as in the input, the back left to a two-sided "
+                  "material), on every output face whose input face had one (all: both sides, for renderers "
+                  "that cull back faces), or on none (none). Counted in the target (docs/attributes.md, "
+                  "\"Two-sided sheets\")")
+      ->check(CLI::IsMember(option_names<TwoSided>()))
+      ->capture_default_str();
   sub->add_flag("--attribute-fit", a.attribute_fit,
                 "With attributes, after the run fit each vertex's values (off the seams) by least squares to "
                 "the input's attributes at the output's points closest to the input's faces, instead of "
@@ -214,7 +218,7 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
   }
   if (a.far_repair && a.no_far_repair) throw Error("--far-repair cannot be combined with --no-far-repair");
   opt.far_repair = far_repair_wanted(a, opt);
-  opt.two_sided_rims = !a.one_sided;
+  opt.two_sided = parsed<TwoSided>("--two-sided", a.two_sided);
   return opt;
 }
 

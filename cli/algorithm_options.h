@@ -38,7 +38,7 @@ struct AlgorithmArgs {
   bool attribute_fit = false;  // --attribute-fit: values fitted to the input after the run
   bool far_repair = false;     // --far-repair: the far places repaired even without the refit
   bool no_far_repair = false;  // --no-far-repair: not even with the refit
-  bool one_sided = false;      // --one-sided: no reversed twins put back along two-sided rims
+  std::string two_sided = to_string(SimplifyOptions{}.two_sided);  // --two-sided rims|all|none
   std::vector<std::string> attribute_weights;  // --attribute-weight KIND=W, ...
   std::string seams = "strict";                // --seams strict|permissive
   std::vector<std::string> lock;               // --lock seams,borders

@@ -209,17 +209,22 @@ int run_simplify(const SimplifyArgs& a) {
   const double cpu0 = process_cpu_seconds();
   Watcher watcher(show_progress, !a.record.empty());
   const std::size_t in_faces = mesh.face_count();
-  const unsigned parts = choose_parts(a.partition, mesh, opt, !a.record.empty());
+  const unsigned asked_parts = choose_parts(a.partition, mesh, opt, !a.record.empty());
   PartitionReport partition_report;
   // Without a record the input's faces are not needed afterwards: let the simplifier free them.
-  SimplifyResult r = parts > 1            ? run_partitioned(mesh, opt, parts, show_progress, &partition_report)
+  SimplifyResult r = asked_parts > 1      ? run_partitioned(mesh, opt, asked_parts, show_progress, &partition_report)
                      : a.record.empty() ? simplify(std::move(mesh), opt, &watcher)
                                         : simplify(mesh, opt, &watcher);
+  // A partitioned run may have run whole (a two-sided sheet's duplicates: qem/partition.h).
+  const unsigned parts = asked_parts > 1 ? partition_report.parts : 1;
+  if (asked_parts > 1 && parts == 1 && !a.quiet)
+    std::fprintf(stderr, "qem: duplicate faces (two-sided sheets: --two-sided) need the whole mesh in one run, "
+                         "made instead of the parts\n");
   // The partitioned run reads a view of the mesh, which has no material names: they stay the input's.
-  if (parts > 1) r.mesh.material_names = mesh.material_names, r.mesh.material_library = mesh.material_library;
+  if (asked_parts > 1) r.mesh.material_names = mesh.material_names, r.mesh.material_library = mesh.material_library;
   const double simplify_s = t_simplify.seconds();
   const double simplify_cpu_s = process_cpu_seconds() - cpu0;
-  if (show_progress && parts <= 1) std::fprintf(stderr, "\n");
+  if (show_progress && asked_parts <= 1) std::fprintf(stderr, "\n");
 
   Stopwatch t_write;
   SaveOptions save;
@@ -241,7 +246,7 @@ int run_simplify(const SimplifyArgs& a) {
         "\"rejected_topology\":%zu,\"rejected_inversion\":%zu,\"rejected_error\":%zu,\"rejected_component\":%zu,"
         "\"rejected_distance\":%zu,\"output_to_input_distance\":%s,"
         "\"in_components\":%zu,\"out_components\":%zu,\"pruned_components\":%zu,\"refit_rounds\":%zu,"
-        "\"refit_rms_before\":%s,\"refit_rms_after\":%s,\"edge_flips\":%zu,\"vertex_moves\":%zu,\"vertex_relocations\":%zu,\"dropped_degenerate\":%zu,\"dropped_duplicate\":%zu,\"rim_twin_faces\":%zu,"
+        "\"refit_rms_before\":%s,\"refit_rms_after\":%s,\"edge_flips\":%zu,\"vertex_moves\":%zu,\"vertex_relocations\":%zu,\"dropped_degenerate\":%zu,\"dropped_duplicate\":%zu,\"twin_faces\":%zu,"
         "\"parts\":%u,\"split_s\":%s,\"parts_s\":%s,\"final_pass_s\":%s,\"parts_cpu_s\":%s,\"busiest_thread_cpu_s\":%s,\"stop\":\"%s\"}\n",
         in_faces, a.faces.value_or(0), r.mesh.face_count(), r.mesh.vertex_count(), json_number(load_s).c_str(),
         json_number(simplify_s).c_str(), json_number(simplify_cpu_s).c_str(), json_number(write_s).c_str(),
@@ -251,7 +256,7 @@ int run_simplify(const SimplifyArgs& a) {
         r.rejected_distance, json_number(r.output_to_input_distance).c_str(),
         r.input_components, r.output_components, r.pruned_components, r.refit_rounds,
         json_number(r.refit_rms_before).c_str(), json_number(r.refit_rms_after).c_str(), r.edge_flips, r.vertex_moves, r.vertex_relocations,
-        r.dropped_degenerate_faces, r.dropped_duplicate_faces, r.rim_twin_faces, parts,
+        r.dropped_degenerate_faces, r.dropped_duplicate_faces, r.twin_faces, parts,
         json_number(partition_report.split_seconds).c_str(), json_number(partition_report.parts_seconds).c_str(),
         json_number(partition_report.final_seconds).c_str(), json_number(partition_report.parts_cpu_seconds).c_str(),
         json_number(partition_report.busiest_thread_cpu_seconds).c_str(), to_string(r.stop_reason));
@@ -272,9 +277,9 @@ int run_simplify(const SimplifyArgs& a) {
   if (!a.quiet && r.dropped_degenerate_faces + r.dropped_duplicate_faces > 0)
     std::fprintf(stderr, "qem: left out %zu degenerate and %zu duplicate input faces\n",
                  r.dropped_degenerate_faces, r.dropped_duplicate_faces);
-  if (!a.quiet && r.rim_twin_faces > 0)
-    std::fprintf(stderr, "qem: put back the reversed twins of %zu faces along two-sided rims (--one-sided: none)\n",
-                 r.rim_twin_faces);
+  if (!a.quiet && r.twin_faces > 0)
+    std::fprintf(stderr, "qem: put back the reversed twins of %zu faces of two-sided sheets (--two-sided %s)\n",
+                 r.twin_faces, a.algorithm.two_sided.c_str());
   if (!a.quiet && std::isfinite(opt.max_distance)) {
     // The bound as the user gave it: a relative bound is compared with the distance over the diagonal.
     char relative[64] = "";

@@ -28,6 +28,7 @@ constexpr Named<Scheme> kScheme[] = {{Scheme::Greedy, "greedy"}, {Scheme::Passes
 constexpr Named<InversionPolicy> kInversion[] = {{InversionPolicy::Forbid, "forbid"},
                                                  {InversionPolicy::Penalize, "penalize"},
                                                  {InversionPolicy::Ignore, "off"}};
+constexpr Named<TwoSided> kTwoSided[] = {{TwoSided::Rims, "rims"}, {TwoSided::All, "all"}, {TwoSided::None, "none"}};
 // Stop reasons are reported, never parsed: their names are phrases.
 constexpr Named<StopReason> kStopReason[] = {
     {StopReason::TargetReached, "target reached"},
@@ -41,6 +42,7 @@ std::span<const Named<Weighting>> table(Weighting) { return kWeighting; }
 std::span<const Named<Placement>> table(Placement) { return kPlacement; }
 std::span<const Named<Scheme>> table(Scheme) { return kScheme; }
 std::span<const Named<InversionPolicy>> table(InversionPolicy) { return kInversion; }
+std::span<const Named<TwoSided>> table(TwoSided) { return kTwoSided; }
 std::span<const Named<StopReason>> table(StopReason) { return kStopReason; }
 
 template <class Enum>
@@ -67,11 +69,13 @@ const char* to_string(Weighting w) { return name_of(w); }
 const char* to_string(Placement p) { return name_of(p); }
 const char* to_string(Scheme s) { return name_of(s); }
 const char* to_string(InversionPolicy policy) { return name_of(policy); }
+const char* to_string(TwoSided t) { return name_of(t); }
 
 bool from_string(const std::string& name, Weighting& out) { return value_of(name, out); }
 bool from_string(const std::string& name, Placement& out) { return value_of(name, out); }
 bool from_string(const std::string& name, Scheme& out) { return value_of(name, out); }
 bool from_string(const std::string& name, InversionPolicy& out) { return value_of(name, out); }
+bool from_string(const std::string& name, TwoSided& out) { return value_of(name, out); }
 
 template <class Enum>
 std::vector<std::string> option_names() {
@@ -83,5 +87,6 @@ template std::vector<std::string> option_names<Weighting>();
 template std::vector<std::string> option_names<Placement>();
 template std::vector<std::string> option_names<Scheme>();
 template std::vector<std::string> option_names<InversionPolicy>();
+template std::vector<std::string> option_names<TwoSided>();
 
 }  // namespace qem

@@ -20,7 +20,7 @@
 #include "refit/refit_after_simplify.h"
 #include "refit/refit_points.h"
 #include "refit_with_seams.h"
-#include "two_sided_rims.h"
+#include "two_sided.h"
 
 namespace qem {
 
@@ -307,26 +307,39 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
   return out;
 }
 
-// The run, with the reversed twins of two-sided rims put back (SimplifyOptions::two_sided_rims,
-// two_sided_rims.h). The twins count in the targets: where they would pass one, the run is made
-// again to the target lowered by the twins of the last run (the core then keeps the input: it
-// does not consume a mesh that has twins), at most three times; a run that stopped for another
-// reason than its target is not made again (a lower target would not change it).
-SimplifyResult simplify_with_rims(MeshView input, const SimplifyOptions& options, SimplifyObserver* observer,
+// The run, with the reversed twins of two-sided sheets put back (SimplifyOptions::two_sided,
+// two_sided.h). The twins count in the targets: where they would pass one, the run is made again
+// to a lower target (the core then keeps the input: it does not consume a mesh that has twins), at
+// most three times; a run that stopped for another reason than its target is not made again (a
+// lower target would not change it). The rims' twins are about as many at any nearby target (the
+// rim's length), so the target falls by their number; all twins are a share of the output, so it
+// falls to that share.
+SimplifyResult simplify_two_sided(MeshView input, const SimplifyOptions& options, SimplifyObserver* observer,
                                   std::vector<std::uint32_t>* consumed_indices,
                                   std::vector<VertexAttribute>* consumed_attributes) {
-  const bool rims = options.two_sided_rims && !(observer && observer->wants_contractions());
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> twins;  // front input face, its reversed twin
+  const bool wanted = options.two_sided != TwoSided::None && !(observer && observer->wants_contractions());
+  const bool all = options.two_sided == TwoSided::All;
+  std::vector<TwinFaces> twins;  // front input face, its reversed twin
   SimplifyOptions o = options;
+  // The target for the fronts, when `have` of them would be joined by `added` twins.
+  const auto lowered = [all](std::size_t target, std::size_t have, std::size_t added) -> std::size_t {
+    if (all) return std::size_t(std::floor(double(target) * double(have) / double(have + added)));
+    return target > added ? target - added : 0;
+  };
   for (int run = 0;; ++run) {
-    SimplifyResult out = simplify_and_refit(input, o, observer, consumed_indices, consumed_attributes, rims ? &twins : nullptr);
+    SimplifyResult out =
+        simplify_and_refit(input, o, observer, consumed_indices, consumed_attributes, wanted ? &twins : nullptr);
     if (twins.empty() || out.stop_reason == StopReason::Cancelled) return out;
     const std::vector<std::uint32_t> faces =
-        faces_on_twinned_rims(out.mesh, out.face_source, twins, core::resolve_threads(options.threads));
+        all ? faces_with_twins(out.face_source, twins)
+            : faces_on_twinned_rims(out.mesh, out.face_source, twins, core::resolve_threads(options.threads));
     if (faces.empty()) return out;
+    // A ratio is of the faces simplified, and with both sides kept, of their twins too (the output
+    // of a sheet that is two-sided throughout is then that ratio of its input, both sides).
+    const std::size_t ratio_of = out.input_faces + (all ? twins.size() : 0);
     std::size_t face_target = options.target_faces;
     if (options.target_ratio > 0)
-      face_target = std::max(face_target, std::size_t(std::floor(options.target_ratio * double(out.input_faces))));
+      face_target = std::max(face_target, std::size_t(std::floor(options.target_ratio * double(ratio_of))));
     const std::size_t added_vertices = twin_vertices_needed(out.mesh, faces);
     const bool over_faces = face_target > 0 && out.mesh.face_count() + faces.size() > face_target;
     const bool over_vertices =
@@ -335,11 +348,11 @@ SimplifyResult simplify_with_rims(MeshView input, const SimplifyOptions& options
         (out.stop_reason == StopReason::TargetReached || out.stop_reason == StopReason::AlreadyBelowTarget)) {
       if (over_faces) {
         o.target_ratio = 0;
-        o.target_faces = face_target > faces.size() ? face_target - faces.size() : 0;
+        o.target_faces = lowered(face_target, out.mesh.face_count(), faces.size());
         if (o.target_faces == 0) o.as_far_as_possible = true;
       }
       if (over_vertices) {
-        o.target_vertices = options.target_vertices > added_vertices ? options.target_vertices - added_vertices : 0;
+        o.target_vertices = lowered(options.target_vertices, out.mesh.vertex_count(), added_vertices);
         if (o.target_vertices == 0) o.as_far_as_possible = true;
       }
       continue;
@@ -352,11 +365,11 @@ SimplifyResult simplify_with_rims(MeshView input, const SimplifyOptions& options
 }  // namespace
 
 SimplifyResult simplify(MeshView input, const SimplifyOptions& options, SimplifyObserver* observer) {
-  return simplify_with_rims(input, options, observer, nullptr, nullptr);
+  return simplify_two_sided(input, options, observer, nullptr, nullptr);
 }
 
 SimplifyResult simplify(Mesh&& input, const SimplifyOptions& options, SimplifyObserver* observer) {
-  SimplifyResult out = simplify_with_rims(input, options, observer, &input.indices, &input.attributes);
+  SimplifyResult out = simplify_two_sided(input, options, observer, &input.indices, &input.attributes);
   out.mesh.material_names = std::move(input.material_names);
   out.mesh.material_library = std::move(input.material_library);
   return out;

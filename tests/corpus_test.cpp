@@ -67,7 +67,7 @@ TEST_P(Corpus, SimplifiesCleanlyAtEveryTarget) {
     });
     SimplifyResult r = simplify(in, o, &time_limit);
     ASSERT_NE(r.stop_reason, StopReason::Cancelled) << "took longer than " << kSecondsPerRun << " s";
-    EXPECT_EQ(test::validity_problem(r.mesh, r.rim_twin_faces), "");
+    EXPECT_EQ(test::validity_problem(r.mesh, r.twin_faces), "");
     const std::size_t target = c.faces > 0 ? c.faces : std::size_t(c.ratio * double(r.input_faces));
     if (r.stop_reason == StopReason::TargetReached || r.stop_reason == StopReason::AlreadyBelowTarget) {
       EXPECT_LE(r.mesh.face_count(), std::max(target, r.input_faces <= target ? r.input_faces : target));

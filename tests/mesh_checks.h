@@ -14,7 +14,7 @@ namespace qem::test {
 
 /// Empty if `m` is a valid indexed triangle mesh: finite coordinates, indices in range, no face
 /// with a repeated corner, no two faces on the same three vertices but for its last `twin_faces`
-/// (SimplifyResult::rim_twin_faces), each the reverse of an earlier face. Otherwise what is wrong.
+/// (SimplifyResult::twin_faces), each the reverse of an earlier face. Otherwise what is wrong.
 inline std::string validity_problem(const Mesh& m, std::size_t twin_faces = 0) {
   for (double x : m.positions)
     if (!std::isfinite(x)) return "non-finite coordinate";

@@ -293,7 +293,7 @@ TEST(Seams, ADoubleSidedSheetKeepsItsRimAndOpensNoCrack) {
   // side), so qem measure and attr_metric.py count no open edge in it. qem drops each reversed
   // copy as a duplicate, so the sheet's rim is a border of what it simplifies: under exact borders
   // (the default) that border stays on the input's rim, and the reversed copies of the output faces
-  // along it are put back (SimplifyOptions::two_sided_rims), so no edge is open. With one side
+  // along it are put back (SimplifyOptions::two_sided), so no edge is open. With one side
   // only, the rim is open, and no edge may open anywhere else.
   Mesh in = chart_grid(12, 4);
   const std::uint32_t front_vertices = std::uint32_t(in.vertex_count()), front_faces = std::uint32_t(in.face_count());
@@ -309,14 +309,14 @@ TEST(Seams, ADoubleSidedSheetKeepsItsRimAndOpensNoCrack) {
   for (double ratio : {0.5, 0.1, 0.01}) {
     SCOPED_TRACE("ratio " + std::to_string(ratio));
     o.target_ratio = ratio;
-    o.two_sided_rims = true;
+    o.two_sided = TwoSided::Rims;
     const SimplifyResult two = simplify(in, o);
     EXPECT_EQ(two.input_faces, front_faces) << "the reversed copies are dropped as duplicates";
-    EXPECT_GT(two.rim_twin_faces, 0u);
+    EXPECT_GT(two.twin_faces, 0u);
     EXPECT_EQ(open_edges_welded(two.mesh), 0u) << "the rim's reversed copies are back: nothing open";
-    o.two_sided_rims = false;
+    o.two_sided = TwoSided::None;
     const SimplifyResult r = simplify(in, o);
-    EXPECT_EQ(r.rim_twin_faces, 0u);
+    EXPECT_EQ(r.twin_faces, 0u);
     EXPECT_GT(open_edges_welded(r.mesh), 0u) << "the rim is open once one side is dropped";
     // Each open edge joins two points of the rim (the unit square's outline; an edge may cut a
     // corner the run removed at its size): an open edge with an end inside would be a crack.

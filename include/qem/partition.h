@@ -98,7 +98,9 @@ std::string partition_refusal(MeshView input, const SimplifyOptions& options);
 
 /// Simplifies `input` in `partition.parts` parts (see the top of this file) to the target of
 /// `options`; `options.threads` threads (0 = all). Throws qem::Error when partition_refusal is not
-/// empty, on invalid options or input, and on a cancel. With one part it is simplify().
+/// empty, on invalid options or input, and on a cancel. With one part it is simplify(). When the
+/// parts dropped duplicate faces and options.two_sided is not None, the result is simplify()'s
+/// too (report->parts 1): a two-sided sheet's twins are put back by the whole run only.
 SimplifyResult simplify_partitioned(MeshView input, const SimplifyOptions& options,
                                     const PartitionOptions& partition = {}, PartitionReport* report = nullptr);
 

@@ -41,6 +41,13 @@ enum class Scheme {
 /// What happens to a contraction that would flip a neighbouring face (GH97 §6).
 enum class InversionPolicy { Forbid, Penalize, Ignore };
 
+/// What becomes of the reversed copies that make a sheet two-sided (SimplifyOptions::two_sided).
+enum class TwoSided {
+  Rims,  ///< the twins of the output faces along a rim come back: the rim stays closed, as in the input
+  All,   ///< every output face whose input face had a twin gets it back: both sides stay, culled or not
+  None,  ///< every twin stays out: one side
+};
+
 /// Why simplification stopped.
 enum class StopReason {
   TargetReached,    ///< a face / vertex count target was met
@@ -55,14 +62,16 @@ const char* to_string(Placement p);
 const char* to_string(Scheme s);
 // The names above and below come from one table per enum (src/option_names.cpp).
 const char* to_string(InversionPolicy policy);
+const char* to_string(TwoSided t);
 /// The value called `name` (a to_string name, which is also the command line's: "area", "off"):
 /// true and `out` set, or false and `out` unchanged if no value has that name.
 bool from_string(const std::string& name, Weighting& out);
 bool from_string(const std::string& name, Placement& out);
 bool from_string(const std::string& name, Scheme& out);
 bool from_string(const std::string& name, InversionPolicy& out);
-/// The names of all values of an option enum (Weighting, Placement, Scheme, InversionPolicy; no
-/// other is defined), in declaration order: the choices a front end offers.
+bool from_string(const std::string& name, TwoSided& out);
+/// The names of all values of an option enum (Weighting, Placement, Scheme, InversionPolicy,
+/// TwoSided; no other is defined), in declaration order: the choices a front end offers.
 template <class Enum>
 std::vector<std::string> option_names();
 
@@ -254,17 +263,17 @@ struct SimplifyOptions {
   /// Fill SimplifyResult::output_vertex_of_input (one entry per input vertex).
   bool map_input_vertices = false;
 
-  /// Two-sided rims. An input that makes a sheet two-sided with a reversed copy of each face (the
+  /// Two-sided sheets. An input that makes a sheet two-sided with a reversed copy of each face (the
   /// same three points turning the other way) has no open edge there: welded by position, each of
-  /// the sheet's edges has a face and its twin. The run keeps one face of each such pair (a
-  /// duplicate, SimplifyResult::dropped_duplicate_faces); with this, the output face along a border
-  /// whose input face had a reversed twin gets its twin back (SimplifyResult::rim_twin_faces),
-  /// so the rim stays closed as in the input and its back side is not culled; inside a closed
-  /// two-sided surface the twins stay out. The twins count in the face target (and their vertices,
-  /// with normals, in a vertex target): where they would pass it the run is made again to a target
-  /// lowered by them. Not in a partitioned run (qem/partition.h) nor with an observer that wants
+  /// the sheet's edges has a face and its twin. The run simplifies one face of each such pair (a
+  /// duplicate, SimplifyResult::dropped_duplicate_faces); this says which output faces whose input
+  /// face had a reversed twin get their twin back (SimplifyResult::twin_faces). The twins count in
+  /// the face target (and their vertices, with normals, in a vertex target): where they would pass
+  /// it the run is made again to a lower target. With All, target_ratio is of the input's faces
+  /// with their twins (both sides; else of the faces simplified). A partitioned run whose parts
+  /// find duplicate faces runs whole instead (qem/partition.h). Not with an observer that wants
   /// contractions (a record describes the contractions alone).
-  bool two_sided_rims = true;
+  TwoSided two_sided = TwoSided::Rims;
 };
 
 struct SimplifyResult {
@@ -305,10 +314,10 @@ struct SimplifyResult {
   std::size_t vertex_relocations = 0;
   /// Input faces left out: degenerate (a repeated corner) and duplicates (kept once).
   std::size_t dropped_degenerate_faces = 0, dropped_duplicate_faces = 0;
-  /// With SimplifyOptions::two_sided_rims: the reversed twins put back along the rims, after the
-  /// other faces (counted in the mesh's faces; each one's face_source is the input's reversed twin
-  /// of its front face's, and with normals its new vertices' vertex_source their front vertex's).
-  std::size_t rim_twin_faces = 0;
+  /// With SimplifyOptions::two_sided: the reversed twins put back, after the other faces (counted
+  /// in the mesh's faces; each one's face_source is the input's reversed twin of its front face's,
+  /// and with normals its new vertices' vertex_source their front vertex's).
+  std::size_t twin_faces = 0;
 
   /// Provenance, so that callers can carry their own per-vertex and per-face data across: for
   /// each output vertex, the input vertex whose position it started from (the survivor of its

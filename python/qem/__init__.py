@@ -152,7 +152,7 @@ class SimplifyResult(Mesh):
       stop_detail: a sentence saying why.
     contractions, input_faces, input_vertices, refit_rounds, refit_rms_before, refit_rms_after,
       edge_flips, vertex_moves, vertex_relocations, dropped_degenerate_faces, dropped_duplicate_faces,
-      rim_twin_faces: counts as in qem::SimplifyResult.
+      twin_faces: counts as in qem::SimplifyResult.
     input_components, output_components: connected components of the input and the output
       (vertex-connected); pruned_components: removed by `prune`; rejected_component: contractions
       refused because a component would have dropped below its floor (keep_components).
@@ -170,7 +170,7 @@ class SimplifyResult(Mesh):
     __slots__ = (
         "max_error", "max_error_relative", "stop_reason", "stop_detail", "contractions", "input_faces",
         "input_vertices", "refit_rounds", "refit_rms_before", "refit_rms_after", "edge_flips", "vertex_moves", "vertex_relocations", "dropped_degenerate_faces",
-        "dropped_duplicate_faces", "rim_twin_faces", "rejected_component", "input_components", "output_components",
+        "dropped_duplicate_faces", "twin_faces", "rejected_component", "input_components", "output_components",
         "pruned_components", "output_to_input_distance", "output_to_input_distance_relative",
         "rejected_distance", "vertex_source", "face_source", "output_vertex_of_input", "record",
     )
@@ -181,14 +181,15 @@ class SimplifyResult(Mesh):
 
 
 def option_names(option: str) -> list:
-    """The accepted values of `weighting`, `placement`, `scheme` or `inversion`."""
+    """The accepted values of `weighting`, `placement`, `scheme`, `inversion` or `two_sided`."""
     if option not in _OPTION_NAMES:
-        raise ValueError(f"option: expected weighting, placement, scheme or inversion, got {option!r}")
+        raise ValueError(f"option: expected weighting, placement, scheme, inversion or two_sided, got {option!r}")
     return list(_OPTION_NAMES[option])
 
 
 # The library's names (src/option_names.cpp): one list, written once.
-_OPTION_NAMES = {option: tuple(_qem.option_names(option)) for option in ("weighting", "placement", "scheme", "inversion")}
+_OPTION_NAMES = {option: tuple(_qem.option_names(option)) for option in ("weighting", "placement", "scheme", "inversion",
+                                                                             "two_sided")}
 
 # The command line's default refit (cli/algorithm_options.h): two rounds, about 8 input vertices
 # per output vertex, fewer at mild reductions (SimplifyOptions::refit_by_reduction), made only
@@ -353,7 +354,7 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
              forget: float = _FORGET, forget_attributes: bool = False, refit="light", threads: int = 0, keep_components: bool = True, prune: Optional[float] = None,
              prune_relative: Optional[float] = None, exact_border: bool = True, attributes: Optional[dict] = None,
              attribute_weights: Optional[dict] = None, fit_attributes: bool = False, vertex_lock=None,
-             return_mapping: bool = False, far_repair: Optional[bool] = None, two_sided_rims: bool = True,
+             return_mapping: bool = False, far_repair: Optional[bool] = None, two_sided: str = "rims",
              record: bool = False, progress: Optional[Callable[[float], Optional[bool]]] = None) -> SimplifyResult:
     """Simplifies a triangle mesh by quadric-error pair contraction (Garland & Heckbert 1997).
 
@@ -402,9 +403,11 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
         flat places to far ones where that lowers the local Hausdorff distance to the input without
         raising the local error (borders stay on the input's, seams stay); None (default): with the
         refit, as the command line.
-      two_sided_rims: where the input makes a sheet two-sided by a reversed copy of each face, put
-        the copy back on the output faces along its rims, so they stay closed (qem::SimplifyOptions::
-        two_sided_rims; counted in the target); False leaves out every reversed copy.
+      two_sided: where the input makes a sheet two-sided by a reversed copy of each face, one side
+        is simplified and the copies come back on the output faces along the rims ("rims": the rims
+        stay closed), on every output face whose input face had one ("all": both sides, for
+        renderers that cull back faces), or on none ("none"); counted in the target
+        (qem::SimplifyOptions::two_sided).
       threads: threads for the parallel parts (0 = all cores); the result is the same for any count.
       keep_components: every connected part keeps at least one face (a closed one four); False lets
         a part contract to nothing (GH97 as published).
@@ -460,7 +463,9 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
         raise ValueError("far_repair: a record replays the contractions, and the repair changes the mesh after them, "
                          "so record=True cannot be combined with far_repair=True")
     options.far_repair = options.refit_rounds > 0 if far_repair is None else bool(far_repair)
-    options.two_sided_rims = bool(two_sided_rims)
+    if not isinstance(two_sided, str):
+        raise ValueError(f"two_sided: expected one of {', '.join(_OPTION_NAMES['two_sided'])}, got {two_sided!r}")
+    options.two_sided = two_sided
     options.map_input_vertices = bool(return_mapping)
     options.fit_attributes = bool(fit_attributes)
     if attribute_weights is not None:

@@ -158,7 +158,8 @@ void bind_simplify(py::module_& m) {
       .def_readwrite("refit_points_per_vertex", &SimplifyOptions::refit_points_per_vertex)
       .def_readwrite("refit_by_reduction", &SimplifyOptions::refit_by_reduction)
       .def_readwrite("far_repair", &SimplifyOptions::far_repair)
-      .def_readwrite("two_sided_rims", &SimplifyOptions::two_sided_rims)
+      .def_property("two_sided", [](const SimplifyOptions& o) { return to_string(o.two_sided); },
+                    [](SimplifyOptions& o, const std::string& s) { o.two_sided = enum_named<TwoSided>("two_sided", s); })
       .def_readwrite("fit_attributes", &SimplifyOptions::fit_attributes)
       .def_readwrite("map_input_vertices", &SimplifyOptions::map_input_vertices)
       .def_property(
@@ -190,7 +191,8 @@ void bind_simplify(py::module_& m) {
     if (option == "placement") return option_names<Placement>();
     if (option == "scheme") return option_names<Scheme>();
     if (option == "inversion") return option_names<InversionPolicy>();
-    throw py::value_error("option: expected weighting, placement, scheme or inversion, got '" + option + "'");
+    if (option == "two_sided") return option_names<TwoSided>();
+    throw py::value_error("option: expected weighting, placement, scheme, inversion or two_sided, got '" + option + "'");
   });
 
   py::class_<Record>(m, "Record", "qem::Record: the base mesh and the contraction sequence of one run")
@@ -273,7 +275,7 @@ void bind_simplify(py::module_& m) {
         out["vertex_relocations"] = r.vertex_relocations;
         out["dropped_degenerate_faces"] = r.dropped_degenerate_faces;
         out["dropped_duplicate_faces"] = r.dropped_duplicate_faces;
-        out["rim_twin_faces"] = r.rim_twin_faces;
+        out["twin_faces"] = r.twin_faces;
         out["vertex_source"] = take_indices(std::move(r.vertex_source), 1, p.data.size() / 3);
         out["face_source"] = take_indices(std::move(r.face_source), 1, f.data.size() / 3);
         out["output_vertex_of_input"] =

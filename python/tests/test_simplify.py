@@ -260,9 +260,9 @@ def _open_edges(v, f):
     return int((counts == 1).sum())
 
 
-def test_two_sided_rims():
+def test_two_sided():
     # A wavy sheet made two-sided by a reversed copy of each face: its rim is closed in the input and
-    # stays closed with two_sided_rims (the default), the twins counted in the target.
+    # stays closed with two_sided="rims" (the default) or "all", the twins counted in the target.
     n = 16
     x, y = np.meshgrid(np.linspace(0, 1, n), np.linspace(0, 1, n))
     v = np.stack([x.ravel(), y.ravel(), 0.1 * np.sin(5 * x.ravel()) * np.cos(4 * y.ravel())], axis=1)
@@ -272,8 +272,14 @@ def test_two_sided_rims():
     f = np.concatenate([front, front[:, ::-1]]).astype(np.uint32)
     assert _open_edges(v, f) == 0
     r = qem.simplify(v, f, target_faces=100)
-    assert r.rim_twin_faces > 0 and r.dropped_duplicate_faces == len(front)
+    assert 0 < r.twin_faces < len(r.faces) / 2 and r.dropped_duplicate_faces == len(front)
     assert 90 <= len(r.faces) <= 100
     assert _open_edges(r.vertices, r.faces) == 0
-    one = qem.simplify(v, f, target_faces=100, two_sided_rims=False)
-    assert one.rim_twin_faces == 0 and _open_edges(one.vertices, one.faces) > 0
+    both = qem.simplify(v, f, target_faces=100, two_sided="all")
+    assert 2 * both.twin_faces == len(both.faces) and 90 <= len(both.faces) <= 100
+    assert _open_edges(both.vertices, both.faces) == 0
+    one = qem.simplify(v, f, target_faces=100, two_sided="none")
+    assert one.twin_faces == 0 and _open_edges(one.vertices, one.faces) > 0
+    assert qem.option_names("two_sided") == ["rims", "all", "none"]
+    with pytest.raises(ValueError, match="two_sided"):
+        qem.simplify(v, f, target_faces=100, two_sided=True)

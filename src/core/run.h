@@ -26,7 +26,7 @@ struct RunHooks {
   /// Called with the input just before its indices are released (what needs the input's faces).
   std::function<void(MeshView)> before_release;
   /// Filled with WorkingMesh::reversed_twins. When there are any, the caller's index array and
-  /// attributes are kept (not consumed): it may run again, to a target lowered by the twins it adds.
+  /// attributes are kept (not consumed): it may run again, to a target lowered for the twins it adds.
   std::vector<std::pair<std::uint32_t, std::uint32_t>>* reversed_twins = nullptr;
   /// Fill SimplifyResult::output_vertex_of_input even when the options do not ask for it.
   bool map_input_vertices = false;

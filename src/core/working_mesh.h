@@ -50,7 +50,7 @@ struct WorkingMesh {
   std::size_t dropped_degenerate = 0, dropped_duplicate = 0;  ///< input faces left out
   /// Each input face kept that had a duplicate of the opposite orientation dropped (a two-sided
   /// sheet's faces, a flap), with the first such duplicate, in increasing order of the kept face:
-  /// qem/simplify.h, two_sided_rims.
+  /// qem/simplify.h, SimplifyOptions::two_sided.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> reversed_twins;
 
   std::size_t vertex_count() const { return pos.size(); }

@@ -93,7 +93,7 @@ MeshPartResult simplify_part(const MeshPart& part, const SimplifyOptions& option
   o.refit_rounds = 0;         // the refit fits the final result to the whole input,
   o.fit_attributes = false;  // and so does the attribute fit,
   o.far_repair = false;      // and the far places are repaired there
-  o.two_sided_rims = false;  // the parts' outputs are welded and simplified again: twins would go
+  o.two_sided = TwoSided::None;  // the parts' outputs are welded and simplified again: twins would go
   o.map_input_vertices = true;
   SimplifyResult r = simplify(MeshView(part.mesh), o);
   MeshPartResult out;
@@ -314,6 +314,15 @@ SimplifyResult simplify_partitioned(MeshView input, const SimplifyOptions& optio
     run_parts_on_threads(parts, options, results, partition.progress, rep);
   }
   rep.parts_seconds = seconds_since(start);
+  // Duplicate faces may be the reversed copies that make a sheet two-sided, which only a whole run
+  // puts back (SimplifyOptions::two_sided: the rims' twins are found by the core that drops them,
+  // and counted in the target by running again). Such an input is simplified whole instead.
+  if (options.two_sided != TwoSided::None &&
+      std::any_of(results.begin(), results.end(), [](const MeshPartResult& r) { return r.dropped_duplicate_faces > 0; })) {
+    rep = PartitionReport{};
+    rep.parts = 1;
+    return simplify(input, options);
+  }
   return finish_partitioned(input, options, parts, results, &rep);
 }
 

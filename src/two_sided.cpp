@@ -1,4 +1,4 @@
-#include "two_sided_rims.h"
+#include "two_sided.h"
 
 #include <algorithm>
 #include <numeric>
@@ -70,6 +70,14 @@ std::vector<std::uint32_t> faces_on_twinned_rims(const Mesh& mesh, std::span<con
   return faces;
 }
 
+std::vector<std::uint32_t> faces_with_twins(std::span<const std::uint32_t> face_source,
+                                            std::span<const TwinFaces> twins) {
+  std::vector<std::uint32_t> faces;
+  for (std::uint32_t f = 0; f < face_source.size(); ++f)
+    if (twin_of(twins, face_source[f])) faces.push_back(f);
+  return faces;
+}
+
 std::size_t twin_vertices_needed(const Mesh& mesh, std::span<const std::uint32_t> faces) {
   if (!has_sided_attribute(mesh)) return 0;
   std::vector<std::uint32_t> corners;
@@ -116,7 +124,7 @@ void add_reversed_twins(SimplifyResult& result, std::span<const std::uint32_t> f
     if (!mesh.face_materials.empty()) mesh.face_materials.push_back(mesh.face_materials[f]);
     if (sources) result.face_source.push_back(twin_of(twins, result.face_source[f])->second);
   }
-  result.rim_twin_faces += faces.size();
+  result.twin_faces += faces.size();
 }
 
 }  // namespace qem

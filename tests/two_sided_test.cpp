@@ -1,5 +1,6 @@
-// Two-sided rims (SimplifyOptions::two_sided_rims, src/two_sided_rims.h): a sheet made two-sided by
-// a reversed copy of each face keeps its rim closed through simplification, inside the face target.
+// Two-sided sheets (SimplifyOptions::two_sided, src/two_sided.h): a sheet made two-sided by a
+// reversed copy of each face keeps its rim closed (Rims) or both sides (All) through
+// simplification, inside the face target.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -7,6 +8,7 @@
 #include <cmath>
 #include <set>
 
+#include "qem/partition.h"
 #include "qem/simplify.h"
 #include "test_meshes.h"
 
@@ -65,38 +67,38 @@ void expect_reversed_copies(const Mesh& m, std::size_t twins) {
 
 }  // namespace
 
-TEST(TwoSidedRims, SheetKeepsItsRimClosedWithinTheTarget) {
+TEST(TwoSided, SheetKeepsItsRimClosedWithinTheTarget) {
   const Mesh in = two_sided_sheet(12);  // 288 faces a side
   EXPECT_EQ(test::open_edges_welded(in), 0u) << "the input's rim is closed by the back faces";
   SimplifyOptions o;
   o.target_faces = 80;
   const SimplifyResult r = simplify(in, o);
   EXPECT_EQ(r.dropped_duplicate_faces, 288u);
-  EXPECT_GT(r.rim_twin_faces, 0u);
+  EXPECT_GT(r.twin_faces, 0u);
   EXPECT_LE(r.mesh.face_count(), 80u) << "the twins count in the target";
   EXPECT_GE(r.mesh.face_count(), 70u);
   EXPECT_EQ(test::open_edges_welded(r.mesh), 0u) << "a crack opened along the rim";
-  expect_reversed_copies(r.mesh, r.rim_twin_faces);
+  expect_reversed_copies(r.mesh, r.twin_faces);
   ASSERT_EQ(r.face_source.size(), r.mesh.face_count());
   // A twin's source is the input's back face of its front face's source.
-  const std::size_t fronts = r.mesh.face_count() - r.rim_twin_faces;
+  const std::size_t fronts = r.mesh.face_count() - r.twin_faces;
   for (std::size_t f = fronts; f < r.mesh.face_count(); ++f) EXPECT_GE(r.face_source[f], 288u);
   for (std::size_t f = 0; f < fronts; ++f) EXPECT_LT(r.face_source[f], 288u);
 }
 
-TEST(TwoSidedRims, OneSidedLeavesTheRimOpen) {
+TEST(TwoSided, NoneLeavesTheRimOpen) {
   const Mesh in = two_sided_sheet(12);
   SimplifyOptions o;
   o.target_faces = 80;
-  o.two_sided_rims = false;
+  o.two_sided = TwoSided::None;
   const SimplifyResult r = simplify(in, o);
-  EXPECT_EQ(r.rim_twin_faces, 0u);
+  EXPECT_EQ(r.twin_faces, 0u);
   EXPECT_GT(test::open_edges_welded(r.mesh), 0u);
   EXPECT_GE(r.mesh.face_count(), 79u);
   EXPECT_LE(r.mesh.face_count(), 80u);
 }
 
-TEST(TwoSidedRims, ClosedTwoSidedSurfaceGetsNoTwins) {
+TEST(TwoSided, ClosedTwoSidedSurfaceGetsNoTwins) {
   Mesh in = test::icosphere(2);
   const std::size_t nf = in.face_count();
   for (std::size_t f = 0; f < nf; ++f)
@@ -104,14 +106,14 @@ TEST(TwoSidedRims, ClosedTwoSidedSurfaceGetsNoTwins) {
   SimplifyOptions o;
   o.target_faces = 60;
   const SimplifyResult two = simplify(in, o);
-  o.two_sided_rims = false;
+  o.two_sided = TwoSided::None;
   const SimplifyResult one = simplify(in, o);
-  EXPECT_EQ(two.rim_twin_faces, 0u);
+  EXPECT_EQ(two.twin_faces, 0u);
   EXPECT_EQ(two.mesh.indices, one.mesh.indices);
   EXPECT_EQ(two.mesh.positions, one.mesh.positions);
 }
 
-TEST(TwoSidedRims, SameDuplicateTurnIsNoTwin) {
+TEST(TwoSided, SameDuplicateTurnIsNoTwin) {
   Mesh in = test::height_field(8, [](double x, double y) { return 0.1 * x * y; });
   const std::size_t nf = in.face_count();
   for (std::size_t f = 0; f < nf; ++f)  // the same turn again: a plain duplicate, not a back side
@@ -120,22 +122,22 @@ TEST(TwoSidedRims, SameDuplicateTurnIsNoTwin) {
   o.target_faces = 40;
   const SimplifyResult r = simplify(in, o);
   EXPECT_EQ(r.dropped_duplicate_faces, nf);
-  EXPECT_EQ(r.rim_twin_faces, 0u);
+  EXPECT_EQ(r.twin_faces, 0u);
 }
 
-TEST(TwoSidedRims, BackVerticesTurnTheirNormals) {
+TEST(TwoSided, BackVerticesTurnTheirNormals) {
   const Mesh in = two_sided_sheet_with_normals(10);
   const std::size_t input_vertices = in.vertex_count();
   SimplifyOptions o;
   o.target_faces = 60;
   o.target_vertices = 70;
   const SimplifyResult r = simplify(in, o);
-  ASSERT_GT(r.rim_twin_faces, 0u);
+  ASSERT_GT(r.twin_faces, 0u);
   EXPECT_LE(r.mesh.face_count(), 60u);
   EXPECT_LE(r.mesh.vertex_count(), 70u) << "the back vertices count in the vertex target";
   EXPECT_EQ(test::open_edges_welded(r.mesh), 0u);
   const VertexAttribute& n = test::attribute(r.mesh, AttributeKind::Normal);
-  const std::size_t fronts = r.mesh.face_count() - r.rim_twin_faces;
+  const std::size_t fronts = r.mesh.face_count() - r.twin_faces;
   for (std::size_t f = 0; f < r.mesh.face_count(); ++f)
     for (int c = 0; c < 3; ++c) {
       const std::uint32_t v = r.mesh.indices[3 * f + c];
@@ -147,16 +149,91 @@ TEST(TwoSidedRims, BackVerticesTurnTheirNormals) {
   for (std::uint32_t s : r.vertex_source) EXPECT_LT(s, input_vertices);
 }
 
-TEST(TwoSidedRims, ConsumedInputRunsAgainAsAView) {
+TEST(TwoSided, ConsumedInputRunsAgainAsAView) {
   const Mesh in = two_sided_sheet(12);
   SimplifyOptions o;
   o.target_ratio = 0.25;  // of the 288 faces kept: 72, twins included
   const SimplifyResult viewed = simplify(MeshView(in), o);
   Mesh copy = in;
   const SimplifyResult consumed = simplify(std::move(copy), o);
-  EXPECT_GT(viewed.rim_twin_faces, 0u);
+  EXPECT_GT(viewed.twin_faces, 0u);
   EXPECT_LE(viewed.mesh.face_count(), 72u);
   EXPECT_EQ(consumed.mesh.indices, viewed.mesh.indices);
   EXPECT_EQ(consumed.mesh.positions, viewed.mesh.positions);
   EXPECT_EQ(consumed.face_source, viewed.face_source);
+}
+
+TEST(TwoSided, AllKeepsBothSidesWithinTheTarget) {
+  const Mesh in = two_sided_sheet(12);  // 288 faces a side
+  SimplifyOptions o;
+  o.target_faces = 80;
+  o.two_sided = TwoSided::All;
+  const SimplifyResult r = simplify(in, o);
+  ASSERT_GT(r.twin_faces, 0u);
+  EXPECT_EQ(2 * r.twin_faces, r.mesh.face_count()) << "every front face has its back";
+  EXPECT_LE(r.mesh.face_count(), 80u) << "the twins count in the target";
+  EXPECT_GE(r.mesh.face_count(), 70u);
+  EXPECT_EQ(test::open_edges_welded(r.mesh), 0u);
+  expect_reversed_copies(r.mesh, r.twin_faces);
+  ASSERT_EQ(r.face_source.size(), r.mesh.face_count());
+  for (std::size_t f = 0; f < r.mesh.face_count(); ++f)
+    EXPECT_EQ(r.face_source[f] >= 288u, f >= r.twin_faces) << "fronts from the front faces, backs from the backs";
+}
+
+TEST(TwoSided, AllTakesTheRatioOfBothSides) {
+  const Mesh in = two_sided_sheet(12);  // 576 faces, both sides
+  SimplifyOptions o;
+  o.target_ratio = 0.25;
+  o.two_sided = TwoSided::All;
+  const SimplifyResult r = simplify(in, o);
+  EXPECT_EQ(2 * r.twin_faces, r.mesh.face_count());
+  EXPECT_LE(r.mesh.face_count(), 144u);
+  EXPECT_GE(r.mesh.face_count(), 136u);
+}
+
+TEST(TwoSided, AllWithNormalsWithinTheVertexTarget) {
+  const Mesh in = two_sided_sheet_with_normals(10);
+  SimplifyOptions o;
+  o.target_faces = 0;
+  o.target_vertices = 60;
+  o.two_sided = TwoSided::All;
+  const SimplifyResult r = simplify(in, o);
+  ASSERT_GT(r.twin_faces, 0u);
+  EXPECT_EQ(2 * r.twin_faces, r.mesh.face_count());
+  EXPECT_LE(r.mesh.vertex_count(), 60u) << "the back vertices count in the vertex target";
+  EXPECT_GE(r.mesh.vertex_count(), 50u);
+  const VertexAttribute& n = test::attribute(r.mesh, AttributeKind::Normal);
+  for (std::size_t f = 0; f < r.mesh.face_count(); ++f) {
+    const double z = n.values[3 * std::size_t(r.mesh.indices[3 * f]) + 2];
+    EXPECT_GT(f < r.twin_faces ? z : -z, 0.9) << "face " << f;
+  }
+}
+
+TEST(TwoSided, NamesAreTheCommandLines) {
+  for (TwoSided t : {TwoSided::Rims, TwoSided::All, TwoSided::None}) {
+    TwoSided back = TwoSided::None == t ? TwoSided::Rims : TwoSided::None;
+    ASSERT_TRUE(from_string(to_string(t), back));
+    EXPECT_EQ(back, t);
+  }
+  EXPECT_EQ(option_names<TwoSided>(), (std::vector<std::string>{"rims", "all", "none"}));
+}
+
+TEST(TwoSided, PartitionedRunWithDuplicatesRunsWhole) {
+  const Mesh in = two_sided_sheet(16);
+  SimplifyOptions o;
+  o.target_faces = 120;
+  PartitionOptions partition;
+  partition.parts = 2;
+  PartitionReport report;
+  const SimplifyResult parted = simplify_partitioned(in, o, partition, &report);
+  const SimplifyResult whole = simplify(in, o);
+  EXPECT_EQ(report.parts, 1u) << "the twins are put back by the whole run only";
+  EXPECT_GT(parted.twin_faces, 0u);
+  EXPECT_EQ(parted.mesh.indices, whole.mesh.indices);
+  EXPECT_EQ(parted.mesh.positions, whole.mesh.positions);
+  EXPECT_EQ(test::open_edges_welded(parted.mesh), 0u);
+  o.two_sided = TwoSided::None;  // one side: the parts stand
+  const SimplifyResult one = simplify_partitioned(in, o, partition, &report);
+  EXPECT_EQ(report.parts, 2u);
+  EXPECT_EQ(one.twin_faces, 0u);
 }
