@@ -169,16 +169,20 @@ int run_lod_mesh(const LodArgs& a) {
   const SimplifyResult result = simplify(mesh, opt, attributes ? nullptr : &recorder);
   const double simplify_cpu = process_cpu_seconds() - cpu_simplify0;
   const double cpu_replay0 = process_cpu_seconds();
-  const Record record = attributes ? Record{} : make_record(mesh, recorder.log);
-  const std::size_t base_faces = attributes ? result.input_faces : record.base.face_count();
-  const std::size_t base_vertices = attributes ? result.input_vertices : record.base.vertex_count();
+  // A record replays one side of a sheet made two-sided by reversed copies of its faces (it holds
+  // the contractions, not the twins put back after them: SimplifyOptions::two_sided); such an
+  // input's levels are runs of their own too.
+  const bool own_runs = attributes || (opt.two_sided != TwoSided::None && result.dropped_duplicate_faces > 0);
+  const Record record = own_runs ? Record{} : make_record(mesh, recorder.log);
+  const std::size_t base_faces = own_runs ? result.input_faces : record.base.face_count();
+  const std::size_t base_vertices = own_runs ? result.input_vertices : record.base.vertex_count();
   std::vector<std::size_t> targets = a.faces;
   for (double r : a.ratios) targets.push_back(std::size_t(std::floor(r * double(base_faces))));
   std::sort(targets.begin(), targets.end(), std::greater<>());  // finest first, as the manifest lists them
   targets.erase(std::unique(targets.begin(), targets.end()), targets.end());
   std::vector<ReplayLevel> levels;
-  if (!attributes) levels = replay_levels(record, targets);
-  for (std::size_t target : attributes ? targets : std::vector<std::size_t>{}) {
+  if (!own_runs) levels = replay_levels(record, targets);
+  for (std::size_t target : own_runs ? targets : std::vector<std::size_t>{}) {
     SimplifyOptions level = opt;
     level.target_ratio = 0, level.target_faces = target, level.as_far_as_possible = target == 0;
     // Refitted in the run, which holds its seams (simplify.cpp): the chain's refit below sees no wedges.
@@ -189,7 +193,7 @@ int run_lod_mesh(const LodArgs& a) {
     r.mesh.material_names = mesh.material_names, r.mesh.material_library = mesh.material_library;
     levels.push_back({std::move(r.mesh), target, r.contractions, r.max_error});
   }
-  if (refit.rounds > 0 && !attributes) refit_levels(mesh, levels, refit_as, result.input_vertices);
+  if (refit.rounds > 0 && !own_runs) refit_levels(mesh, levels, refit_as, result.input_vertices);
   const double replay_cpu = process_cpu_seconds() - cpu_replay0;
 
   namespace fs = std::filesystem;
@@ -232,9 +236,9 @@ int run_lod_mesh(const LodArgs& a) {
     for (const ReplayLevel& l : levels)
       std::fprintf(stderr, "qem: level %zu faces, %zu vertices, max error %.4g\n", l.mesh.face_count(),
                    l.mesh.vertex_count(), l.max_error);
-    std::fprintf(stderr,
-                 "qem: %zu levels from one run (%s), simplify %.3f s + replay %.3f s CPU, %.3f s total\n",
-                 levels.size(), result.stop_detail.c_str(), simplify_cpu, replay_cpu, total.seconds());
+    std::fprintf(stderr, "qem: %zu levels from %s (%s), simplify %.3f s + %s %.3f s CPU, %.3f s total\n",
+                 levels.size(), own_runs ? "a run each" : "one run", result.stop_detail.c_str(), simplify_cpu,
+                 own_runs ? "levels" : "replay", replay_cpu, total.seconds());
   }
   return 0;
 }

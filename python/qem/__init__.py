@@ -606,12 +606,14 @@ class Level(Mesh):
     __slots__ = ("target_faces", "contractions", "max_error")
 
 
-def lod(vertices, faces, *, ratios=None, target_faces=None, refit="light", **options) -> list:
+def lod(vertices, faces, *, ratios=None, target_faces=None, refit="light", two_sided="rims", **options) -> list:
     """An LOD chain from one recorded run: levels finest first, as `qem lod` writes them.
 
     ratios: fractions of the input's faces kept, e.g. [0.5, 0.25, 0.1]; or target_faces: face
     counts (0: as far as the checks allow). Every other option of `simplify` (weighting, placement, threshold, ..., threads)
     applies; each level is refitted as `refit` says (the light refit by default, as the CLI).
+    two_sided as in `simplify`: an input with reversed duplicate faces gets each level from a run of
+    its own (a record holds no twins), as `qem lod` does.
     Returns a list of qem.Level (vertices, faces, target_faces, contractions, max_error).
     """
     if (ratios is None) == (target_faces is None):
@@ -631,6 +633,9 @@ def lod(vertices, faces, *, ratios=None, target_faces=None, refit="light", **opt
     o = _options(target_faces=None, target_ratio=1.0, target_vertices=None, max_error=None,
                  max_error_relative=None, refit=refit, record=False, **defaults)
     o.target_ratio = 0
+    if not isinstance(two_sided, str):
+        raise ValueError(f"two_sided: expected one of {', '.join(_OPTION_NAMES['two_sided'])}, got {two_sided!r}")
+    o.two_sided = two_sided
     levels = _qem.lod(vertices, faces, o, [int(n) for n in (target_faces or [])], [float(r) for r in (ratios or [])])
     out = []
     for d in levels:

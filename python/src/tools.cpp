@@ -152,13 +152,26 @@ py::list lod(py::handle vertices, py::handle faces, SimplifyOptions options, con
     const MeshView view(p.data, f.data);
     ContractionRecorder recorder;
     const SimplifyResult run = qem::simplify(view, options, &recorder);
-    const Record record = make_record(view, recorder.log);
+    // As `qem lod`: a record replays one side of a sheet made two-sided by reversed copies of its
+    // faces, so such an input's levels are runs of their own, which put the twins back.
+    const bool own_runs = options.two_sided != TwoSided::None && run.dropped_duplicate_faces > 0;
+    const Record record = own_runs ? Record{} : make_record(view, recorder.log);
+    const std::size_t base_faces = own_runs ? run.input_faces : record.base.face_count();
     std::vector<std::size_t> targets = faces_targets;
-    for (double r : ratios) targets.push_back(std::size_t(std::floor(r * double(record.base.face_count()))));
+    for (double r : ratios) targets.push_back(std::size_t(std::floor(r * double(base_faces))));
     std::sort(targets.begin(), targets.end(), std::greater<>());
     targets.erase(std::unique(targets.begin(), targets.end()), targets.end());
-    levels = replay_levels(record, targets);
-    refit_levels(view, levels, refit_as, run.input_vertices);  // nothing without a refit
+    if (own_runs) {
+      for (std::size_t target : targets) {
+        SimplifyOptions level = refit_as;
+        level.target_ratio = 0, level.target_faces = target, level.as_far_as_possible = target == 0;
+        SimplifyResult r = qem::simplify(view, level);
+        levels.push_back({std::move(r.mesh), target, r.contractions, r.max_error});
+      }
+    } else {
+      levels = replay_levels(record, targets);
+      refit_levels(view, levels, refit_as, run.input_vertices);  // nothing without a refit
+    }
   }
   py::list out;
   for (ReplayLevel& l : levels) {

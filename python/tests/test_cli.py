@@ -86,6 +86,23 @@ def test_lod_matches_cli(cli, shared_data, tmp_path):
         assert (tmp_path / f"py{i}.ply").read_bytes() == (tmp_path / f"gh_bunny_zipper_lod{i}.ply").read_bytes()
 
 
+def test_lod_of_a_two_sided_input_matches_cli(cli, shared_data, tmp_path):
+    # 87 reversed duplicates: each level is a run of its own (a record holds no twins), the same
+    # bytes as `qem simplify --faces` at the level's target and as qem.lod.
+    src = shared_data / "trimesh_bunny_messy.ply"
+    run(cli, "lod", src, tmp_path, "--ratios", "0.5,0.1", "--quiet")
+    manifest = json.loads((tmp_path / "manifest.json").read_text())
+    m = qem.load(src)
+    levels = qem.lod(m.vertices, m.faces, ratios=[0.5, 0.1])
+    for i, (entry, level) in enumerate(zip(manifest["levels"], levels)):
+        run(cli, "simplify", src, tmp_path / f"s{i}.ply", "--faces", entry["target_faces"], "--quiet")
+        lod_bytes = (tmp_path / entry["path"]).read_bytes()
+        assert lod_bytes == (tmp_path / f"s{i}.ply").read_bytes()
+        qem.save(tmp_path / f"py{i}.ply", level)
+        assert (tmp_path / f"py{i}.ply").read_bytes() == lod_bytes
+    assert qem.simplify(m.vertices, m.faces, target_faces=manifest["levels"][1]["target_faces"]).twin_faces > 0
+
+
 def test_record_file_replays_with_cli(cli, shared_data, tmp_path):
     src = shared_data / "gh_bunny_zipper.ply"
     m = qem.load(src)
