@@ -236,4 +236,12 @@ TEST(TwoSided, PartitionedRunWithDuplicatesRunsWhole) {
   const SimplifyResult one = simplify_partitioned(in, o, partition, &report);
   EXPECT_EQ(report.parts, 2u);
   EXPECT_EQ(one.twin_faces, 0u);
+  // A ratio is of the faces left once the duplicates are dropped, as in a whole run.
+  o.target_faces = 0;
+  o.target_ratio = 0.25;
+  const SimplifyResult ratio = simplify_partitioned(in, o, partition, &report);
+  EXPECT_EQ(report.parts, 2u);
+  EXPECT_EQ(ratio.input_faces, in.face_count() / 2);
+  EXPECT_LE(ratio.mesh.face_count(), in.face_count() / 8);
+  EXPECT_GE(ratio.mesh.face_count(), in.face_count() / 8 - 8);
 }

@@ -175,7 +175,8 @@ SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options
 
   // The final pass: the same rules and target over the merged mesh, the cuts no longer locked
   // (the caller's locks still are).
-  const partition_detail::Targets total = partition_detail::resolve_targets(options, nondegenerate);
+  // A ratio is of the faces the parts simplified (their duplicates dropped), as the core's is.
+  const partition_detail::Targets total = partition_detail::resolve_targets(options, nondegenerate - part_dups);
   SimplifyOptions o = options;
   o.target_faces = total.faces;
   o.target_ratio = 0;

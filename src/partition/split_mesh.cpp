@@ -48,7 +48,7 @@ Targets resolve_targets(const SimplifyOptions& o, std::size_t faces) {
   Targets t;
   if (o.target_faces > 0) t.faces = o.target_faces;
   // As the core resolves a ratio (core/settings.cpp): of the faces left after dropping degenerate
-  // ones, the larger face target winning when both are given.
+  // ones (and, in finish_partitioned, duplicates), the larger face target winning when both are given.
   if (o.target_ratio > 0) t.faces = std::max(t.faces, std::size_t(std::floor(o.target_ratio * double(faces))));
   t.vertices = o.target_vertices;
   return t;
