@@ -210,6 +210,34 @@ TEST(OutOfCore, OpenSurfaceKeepsItsBorder) {
   EXPECT_EQ(entries(dir), 0u);
 }
 
+// A sheet made two-sided by a reversed copy of each face: every clustered triple comes out twice,
+// once a side, which the mod-2 rule for folds dropped, whole: the output had no face at all. The
+// copies of one input triangle count once; phase 2 keeps one side and puts the rims' twins back.
+TEST(OutOfCore, TwoSidedSheetIsKeptWithItsRimClosed) {
+  const std::string dir = fresh_dir("two_sided");
+  const std::string path = dir + "/sheet.ply";
+  Mesh sheet = test::height_field(300, [](double x, double y) { return 0.05 * std::sin(7 * x + 1) * std::cos(6 * y); });
+  const std::size_t front = sheet.face_count();
+  for (std::size_t f = 0; f < front; ++f)
+    sheet.indices.insert(sheet.indices.end(), {sheet.indices[3 * f], sheet.indices[3 * f + 2], sheet.indices[3 * f + 1]});
+  save_mesh(path, sheet);
+  ASSERT_EQ(test::open_edges_welded(sheet), 0u);
+  SimplifyOptions opt;
+  opt.target_faces = 2000;
+  OutOfCoreOptions ooc;
+  ooc.memory_limit = std::uint64_t(16) << 20;
+  ooc.temp_dir = dir;
+  OutOfCoreReport report;
+  const SimplifyResult r = simplify_out_of_core(path, opt, ooc, &report);
+  EXPECT_LT(report.clustered_faces, sheet.face_count() / 2);  // it really clustered
+  EXPECT_GT(r.mesh.face_count(), 1800u);
+  EXPECT_LE(r.mesh.face_count(), 2000u);
+  EXPECT_GT(r.twin_faces, 0u);
+  EXPECT_EQ(test::open_edges_welded(r.mesh), 0u) << "the rim is closed, as in the input";
+  fs::remove(path);
+  EXPECT_EQ(entries(dir), 0u);
+}
+
 // The refit after phase 2 fits the output to the input's points, not to the clustered mesh: the
 // cells average away detail finer than themselves, and at a few clustered faces per output face
 // the reduction rule gave phase 2's own refit no round at all (the 2.9M terrain to 10 % under

@@ -42,7 +42,9 @@ Clustered cluster(const Mesh& mesh, const Grid& grid, std::uint64_t max_cells, u
     c.finish();
     out.levels = c.levels();
     for (std::uint32_t i = 0; i < c.cells().size(); ++i) out.cells[c.cells().key(i)] = c.cells().cell(i);
-    const std::vector<std::uint32_t> ids = read_clustered_faces(c, faces);
+    std::vector<std::uint64_t> shapes;
+    const std::vector<std::uint32_t> ids = read_clustered_faces(c, faces, shapes);
+    EXPECT_EQ(shapes.size() * 3, ids.size());
     for (std::size_t f = 0; f < ids.size(); f += 3)
       out.faces.push_back({c.cells().key(ids[f]), c.cells().key(ids[f + 1]), c.cells().key(ids[f + 2])});
   }

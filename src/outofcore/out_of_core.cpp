@@ -319,7 +319,11 @@ void pull_into_cell(const core::Quadric& q, const double mean[3], const double c
 /// times...); the in-core simplifier would keep one of them and open a crack. Dropping the triples
 /// that come out an even number of times and keeping one of those that come out an odd number
 /// keeps every edge's count even: no boundary edge the input did not have.
-void drop_paired_faces(std::vector<std::uint32_t>& indices) {
+/// Copies of one input triangle (`shapes`: the same corners; a sheet made two-sided by a reversed
+/// copy of each face) count once: a two-sided sheet is one surface, not a fold, and dropping its
+/// pairs dropped the whole sheet. Its copies are all kept, for phase 2, whose core keeps one and
+/// puts the reversed twins back along the rims (SimplifyOptions::two_sided).
+void drop_paired_faces(std::vector<std::uint32_t>& indices, const std::vector<std::uint64_t>& shapes) {
   const std::size_t nf = indices.size() / 3;
   // Each face as its sorted corners and its place in the file: sorting these groups the copies of
   // a face, the first in file order leading each group.
@@ -334,10 +338,21 @@ void drop_paired_faces(std::vector<std::uint32_t>& indices) {
   auto same_face = [&](std::size_t i, std::size_t j) {
     return order[i][0] == order[j][0] && order[i][1] == order[j][1] && order[i][2] == order[j][2];
   };
+  std::vector<std::uint64_t> group;
   for (std::size_t i = 0; i < nf;) {
     std::size_t j = i + 1;
     while (j < nf && same_face(i, j)) ++j;
-    if ((j - i) % 2 == 1) keep[order[i][3]] = true;  // the first in file order
+    if (j == i + 1) {
+      keep[order[i][3]] = true;
+    } else {
+      group.clear();
+      for (std::size_t k = i; k < j; ++k) group.push_back(shapes[order[k][3]]);
+      std::sort(group.begin(), group.end());
+      const std::size_t triangles = std::size_t(std::unique(group.begin(), group.end()) - group.begin());
+      if (triangles % 2 == 1)  // the first in file order, with its copies
+        for (std::size_t k = i; k < j; ++k)
+          if (shapes[order[k][3]] == shapes[order[i][3]]) keep[order[k][3]] = true;
+    }
     i = j;
   }
   std::vector<std::array<std::uint32_t, 4>>().swap(order);
@@ -631,9 +646,11 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
     place_cells(0, std::min(n, per));
     for (std::thread& h : helpers) h.join();
   }
-  clustered_mesh.indices = outofcore::read_clustered_faces(clustering, faces);
+  std::vector<std::uint64_t> shapes;  // per clustered face, its input triangle's
+  clustered_mesh.indices = outofcore::read_clustered_faces(clustering, faces, shapes);
   cells.release();
-  drop_paired_faces(clustered_mesh.indices);
+  drop_paired_faces(clustered_mesh.indices, shapes);
+  std::vector<std::uint64_t>().swap(shapes);
   report.clustered_faces = clustered_mesh.face_count();
   report.temp_bytes_written = outofcore::temp_bytes_written() - temp_bytes_before;
   lap("clustering");

@@ -1,6 +1,8 @@
 #include "outofcore/parallel_clustering.h"
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
 #include <condition_variable>
 #include <deque>
@@ -68,6 +70,25 @@ class BlockCells {
   std::vector<Slot> slots_;
 };
 
+// The triangle's shape: a hash of its three corners' coordinates, in no order of corners, so that a
+// triangle and its reversed copy (a two-sided sheet's back face, on the same vertices or on others
+// at the same places) have the same shape and other triangles, almost surely, other shapes.
+std::uint64_t shape_of(const double p[9]) {
+  std::array<std::array<std::uint64_t, 3>, 3> c;
+  for (int k = 0; k < 3; ++k)
+    for (int a = 0; a < 3; ++a) c[k][a] = std::bit_cast<std::uint64_t>(p[3 * k + a] + 0.0);  // -0 as 0
+  std::sort(c.begin(), c.end());
+  std::uint64_t h = 0x9e3779b97f4a7c15ull;
+  for (const auto& corner : c)
+    for (std::uint64_t x : corner) {  // splitmix64 steps
+      h ^= x + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
+      h = (h ^ (h >> 30)) * 0xbf58476d1ce4e5b9ull;
+      h = (h ^ (h >> 27)) * 0x94d049bb133111ebull;
+      h ^= h >> 31;
+    }
+  return h;
+}
+
 }  // namespace
 
 struct ParallelClustering::Block {
@@ -76,6 +97,7 @@ struct ParallelClustering::Block {
   std::vector<float> xyz;              // soup input
   BlockCells cells;
   std::vector<std::uint32_t> triples;  // block-local cell ids
+  std::vector<std::uint64_t> shapes;   // per triple, its triangle's shape_of
   const PositionSource* positions = nullptr;
   bool done = false;
 
@@ -87,6 +109,7 @@ struct ParallelClustering::Block {
   void cluster(const Grid& grid) {
     cells.clear();
     triples.clear();
+    shapes.clear();
     const std::size_t n = triangles();
     double p[9];
     for (std::size_t t = 0; t < n; ++t) {
@@ -131,8 +154,10 @@ struct ParallelClustering::Block {
           cell.moment[0] += m.x, cell.moment[1] += m.y, cell.moment[2] += m.z;
         }
       }
-      if (id[0] != id[1] && id[1] != id[2] && id[0] != id[2])
+      if (id[0] != id[1] && id[1] != id[2] && id[0] != id[2]) {
         triples.insert(triples.end(), {id[0], id[1], id[2]});
+        shapes.push_back(shape_of(p));
+      }
     }
   }
 };
@@ -270,8 +295,11 @@ void ParallelClustering::merge_ready(bool wait_all) {
 void ParallelClustering::add_block(Block& block) {
   for (std::size_t i = 0; i < block.cells.keys.size(); ++i)
     cells_.cell(cells_.find_or_add(coarser_cell(block.cells.keys[i], levels_))) += block.cells.sums[i];
-  for (std::size_t t = 0; t < block.triples.size(); ++t) faces_.put(block.cells.keys[block.triples[t]]);
-  triples_ += block.triples.size() / 3;
+  for (std::size_t t = 0; t < block.shapes.size(); ++t) {
+    for (int k = 0; k < 3; ++k) faces_.put(block.cells.keys[block.triples[3 * t + k]]);
+    faces_.put(block.shapes[t]);
+  }
+  triples_ += block.shapes.size();
   while (cells_.size() > max_cells_) {
     cells_.coarsen();
     ++levels_;
@@ -285,25 +313,29 @@ void ParallelClustering::finish() {
   if (workers_) merge_ready(true);
 }
 
-std::vector<std::uint32_t> read_clustered_faces(ParallelClustering& clustering, TempFile& faces) {
+std::vector<std::uint32_t> read_clustered_faces(ParallelClustering& clustering, TempFile& faces,
+                                                std::vector<std::uint64_t>& shapes) {
   faces.rewind_for_reading();
   const CellTable& cells = clustering.cells();
   const int levels = clustering.levels();
   std::vector<std::uint32_t> indices;
-  std::vector<CellKey> buf(3 << 16);
+  shapes.clear();
+  std::vector<CellKey> buf(4 << 16);  // per triple: three cell keys and the triangle's shape
   std::uint64_t left = clustering.triples();
   while (left > 0) {
-    const std::size_t n = std::size_t(std::min<std::uint64_t>(left, buf.size() / 3));
-    if (faces.read(buf.data(), 24 * n) != 24 * n)
+    const std::size_t n = std::size_t(std::min<std::uint64_t>(left, buf.size() / 4));
+    if (faces.read(buf.data(), 32 * n) != 32 * n)
       throw Error(faces.path() + ": the temporary file is shorter than written");
     for (std::size_t t = 0; t < n; ++t) {
       std::uint32_t id[3];
       for (int k = 0; k < 3; ++k) {
-        id[k] = cells.find(coarser_cell(buf[3 * t + k], levels));
+        id[k] = cells.find(coarser_cell(buf[4 * t + k], levels));
         if (id[k] == CellTable::kNoCell) throw Error(faces.path() + ": a face names a cell never met");
       }
-      if (id[0] != id[1] && id[1] != id[2] && id[0] != id[2])
+      if (id[0] != id[1] && id[1] != id[2] && id[0] != id[2]) {
         indices.insert(indices.end(), {id[0], id[1], id[2]});
+        shapes.push_back(buf[4 * t + 3]);
+      }
     }
     left -= n;
   }

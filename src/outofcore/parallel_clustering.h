@@ -108,7 +108,9 @@ class ParallelClustering {
 };
 
 /// Reads the triples of `clustering` back as faces of the final cells' ids, dropping those whose
-/// corners fell into fewer than three final cells.
-std::vector<std::uint32_t> read_clustered_faces(ParallelClustering& clustering, TempFile& faces);
+/// corners fell into fewer than three final cells; `shapes` gets each kept face's input triangle's
+/// shape (a hash of its corners in no order: a triangle and its reversed copy have the same).
+std::vector<std::uint32_t> read_clustered_faces(ParallelClustering& clustering, TempFile& faces,
+                                                std::vector<std::uint64_t>& shapes);
 
 }  // namespace qem::outofcore
