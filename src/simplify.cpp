@@ -218,7 +218,7 @@ double sampled_distance(std::span<const double> positions, std::span<const std::
 SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options, SimplifyObserver* observer,
                                   std::vector<std::uint32_t>* consumed_indices,
                                   std::vector<VertexAttribute>* consumed_attributes,
-                                  std::vector<std::pair<std::uint32_t, std::uint32_t>>* reversed_twins) {
+                                  std::vector<TwinFaces>* reversed_twins) {
   check_options(options);
   const bool refit = options.refit_rounds > 0;
   const bool bounded = std::isfinite(options.max_distance);

@@ -229,7 +229,7 @@ def _options(*, target_faces, target_ratio, target_vertices, max_error, max_erro
              max_distance=None, max_distance_relative=None,
              threshold_relative, weighting, placement, boundary_weight, lock_border, inversion, max_turn,
              allow_non_manifold, scheme, refit, threads, record, keep_components=True, prune=None,
-             prune_relative=None, exact_border=True, forget=_FORGET, forget_attributes=False):
+             prune_relative=None, exact_border=True, forget=_FORGET, forget_attributes=False, two_sided="rims"):
     o = _qem.SimplifyOptions()
 
     def count(name, value):
@@ -297,7 +297,7 @@ def _options(*, target_faces, target_ratio, target_vertices, max_error, max_erro
     else:
         o.threshold = number("threshold", threshold)
     for name, value in (("weighting", weighting), ("placement", placement), ("inversion", inversion),
-                        ("scheme", scheme)):
+                        ("scheme", scheme), ("two_sided", two_sided)):
         if not isinstance(value, str):
             raise ValueError(f"{name}: expected one of {', '.join(_OPTION_NAMES[name])}, got {value!r}")
         setattr(o, name, value)
@@ -451,7 +451,7 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
                        boundary_weight=boundary_weight, lock_border=lock_border, inversion=inversion,
                        max_turn=max_turn, allow_non_manifold=allow_non_manifold, scheme=scheme, refit=refit,
                        forget=forget, forget_attributes=forget_attributes, threads=threads, record=record, keep_components=keep_components, prune=prune,
-                       prune_relative=prune_relative, exact_border=exact_border)
+                       prune_relative=prune_relative, exact_border=exact_border, two_sided=two_sided)
     # The light default follows the command line here too: not on a mesh with texture coordinates
     # or normals, where it lowers E but raises their errors a little (docs/attributes.md, "Seams,
     # locks and the refit"); colours alone keep it; "full" or (rounds, points) still refits them,
@@ -463,9 +463,6 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
         raise ValueError("far_repair: a record replays the contractions, and the repair changes the mesh after them, "
                          "so record=True cannot be combined with far_repair=True")
     options.far_repair = options.refit_rounds > 0 if far_repair is None else bool(far_repair)
-    if not isinstance(two_sided, str):
-        raise ValueError(f"two_sided: expected one of {', '.join(_OPTION_NAMES['two_sided'])}, got {two_sided!r}")
-    options.two_sided = two_sided
     options.map_input_vertices = bool(return_mapping)
     options.fit_attributes = bool(fit_attributes)
     if attribute_weights is not None:
@@ -631,11 +628,8 @@ def lod(vertices, faces, *, ratios=None, target_faces=None, refit="light", two_s
         raise TypeError(f"lod() got unexpected keyword arguments: {', '.join(sorted(unknown))}")
     defaults.update(options)
     o = _options(target_faces=None, target_ratio=1.0, target_vertices=None, max_error=None,
-                 max_error_relative=None, refit=refit, record=False, **defaults)
+                 max_error_relative=None, refit=refit, record=False, two_sided=two_sided, **defaults)
     o.target_ratio = 0
-    if not isinstance(two_sided, str):
-        raise ValueError(f"two_sided: expected one of {', '.join(_OPTION_NAMES['two_sided'])}, got {two_sided!r}")
-    o.two_sided = two_sided
     levels = _qem.lod(vertices, faces, o, [int(n) for n in (target_faces or [])], [float(r) for r in (ratios or [])])
     out = []
     for d in levels:

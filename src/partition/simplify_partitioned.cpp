@@ -93,7 +93,7 @@ MeshPartResult simplify_part(const MeshPart& part, const SimplifyOptions& option
   o.refit_rounds = 0;         // the refit fits the final result to the whole input,
   o.fit_attributes = false;  // and so does the attribute fit,
   o.far_repair = false;      // and the far places are repaired there
-  o.two_sided = TwoSided::None;  // the parts' outputs are welded and simplified again: twins would go
+  o.two_sided = TwoSided::None;  // twins are put back by a whole run only (simplify_partitioned)
   o.map_input_vertices = true;
   SimplifyResult r = simplify(MeshView(part.mesh), o);
   MeshPartResult out;
