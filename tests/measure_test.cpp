@@ -132,27 +132,47 @@ TEST(Measure, BvhBuiltOnThreadsIsTheSameTree) {
     ASSERT_EQ(c.triangle, a.triangle) << "query " << i;
     ASSERT_TRUE(bit_equal(b.d2, a.d2) && bit_equal(c.d2, a.d2)) << "query " << i;
     for (std::uint32_t t : {0u, 40000u, 81919u})  // the stored triangles, each where its index says
-      ASSERT_TRUE(std::equal(one.triangle(t), one.triangle(t) + 9, two.triangle(t)));
+      ASSERT_EQ(one.triangle(t), two.triangle(t));
   }
 }
 
-// A tree whose corners come from a function (TriangleBvh's second form: the refit's surface maps
-// them into its frame as it builds) is the tree of the same corners given as an array.
-TEST(Measure, BvhFromACornerFunctionIsTheSameTree) {
-  const Mesh sphere = test::icosphere(6);
+// A tree of an indexed mesh (TriangleBvh's second form: it keeps the vertices and each face's
+// indices, as the refit's surface does) is the tree of the same corners given as an array: the
+// same nodes, the same stored triangles, and bit for bit the same answers, also on a mesh whose
+// faces share no vertex order with their positions (shuffled) and with unreferenced vertices.
+TEST(Measure, BvhOfAnIndexedMeshIsTheSameTree) {
+  Mesh sphere = test::icosphere(6);
+  // Faces in a shuffled order, and a vertex no face has (the tree must not need every vertex).
+  measure_detail::Rng shuffle(9);
+  const std::size_t nf = sphere.face_count();
+  for (std::size_t f = nf - 1; f > 0; --f) {
+    const std::size_t g = std::size_t(shuffle.uniform() * double(f + 1)) % (f + 1);
+    for (int k = 0; k < 3; ++k) std::swap(sphere.indices[3 * f + k], sphere.indices[3 * g + k]);
+  }
+  sphere.positions.insert(sphere.positions.end(), {5.0, 5.0, 5.0});
   const measure_detail::Surface s = measure_detail::make_surface(sphere, "sphere");
   const measure_detail::TriangleBvh from_array(s.corners, 2);
-  const measure_detail::TriangleBvh from_function(
-      s.corners.size() / 9, [&](std::uint32_t t, double* out) { std::copy_n(&s.corners[9 * std::size_t(t)], 9, out); }, 2);
-  ASSERT_EQ(from_function.node_count(), from_array.node_count());
-  ASSERT_EQ(from_function.triangle_count(), from_array.triangle_count());
-  for (std::uint32_t t = 0; t < from_array.triangle_count(); t += 997)
-    ASSERT_TRUE(std::equal(from_array.triangle(t), from_array.triangle(t) + 9, from_function.triangle(t)));
+  const measure_detail::TriangleBvh indexed(
+      core::UnzeroedVector<double>(sphere.positions.begin(), sphere.positions.end()), sphere.indices, 2);
+  ASSERT_EQ(indexed.node_count(), from_array.node_count());
+  ASSERT_EQ(indexed.triangle_count(), from_array.triangle_count());
+  for (std::uint32_t t = 0; t < from_array.triangle_count(); t += 97)
+    ASSERT_EQ(indexed.triangle(t), from_array.triangle(t)) << "triangle " << t;
   measure_detail::Rng rng(5);
-  for (int i = 0; i < 200; ++i) {
+  std::uint32_t hint_a = UINT32_MAX, hint_b = UINT32_MAX;
+  for (int i = 0; i < 400; ++i) {
     const double p[3] = {3 * rng.uniform() - 1.5, 3 * rng.uniform() - 1.5, 3 * rng.uniform() - 1.5};
-    const auto a = from_array.closest(p), b = from_function.closest(p);
+    const auto a = from_array.closest(p), b = indexed.closest(p);
     ASSERT_TRUE(bit_equal(a.d2, b.d2) && a.triangle == b.triangle) << "query " << i;
+    ASSERT_TRUE(bit_equal(a.d2, brute_force_d2(s.corners, p))) << "query " << i;
+    const auto c = from_array.closest(p, &hint_a), d = indexed.closest(p, &hint_b);
+    ASSERT_TRUE(bit_equal(c.d2, d.d2) && c.triangle == d.triangle && hint_a == hint_b) << "query " << i;
+    std::vector<std::uint32_t> near_a, near_b;
+    from_array.within(p, 0.01, near_a);
+    indexed.within(p, 0.01, near_b);
+    std::sort(near_a.begin(), near_a.end());
+    std::sort(near_b.begin(), near_b.end());
+    ASSERT_EQ(near_a, near_b) << "query " << i;
   }
 }
 

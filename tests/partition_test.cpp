@@ -126,6 +126,31 @@ TEST(Partition, SameBytesForAnyThreadCount) {
   EXPECT_NE(other.mesh.positions, one.mesh.positions);
 }
 
+// finish_partitioned taking the parts over (simplify_partitioned's: they are freed once welded,
+// before the refit and the repair against the whole input) gives what the form that only reads
+// them gives: nothing after the weld reads the parts.
+TEST(Partition, FinishingWithThePartsTakenOverGivesTheSameResult) {
+  const Mesh& in = bumpy_sphere();
+  SimplifyOptions o = ratio(0.05, 2);
+  o.refit_rounds = 2, o.refit_points_per_vertex = 8, o.refit_by_reduction = true, o.far_repair = true;
+  std::vector<MeshPart> parts = split_mesh(in, o, 4);
+  std::vector<MeshPartResult> results;
+  for (const MeshPart& part : parts) results.push_back(simplify_part(part, o));
+  const SimplifyResult read = finish_partitioned(in, o, std::span<const MeshPart>(parts), results);
+  const SimplifyResult taken = finish_partitioned(in, o, std::move(parts), std::move(results));
+  EXPECT_GT(read.refit_rounds, 0u);
+  EXPECT_EQ(taken.mesh.positions, read.mesh.positions);
+  EXPECT_EQ(taken.mesh.indices, read.mesh.indices);
+  EXPECT_EQ(taken.vertex_source, read.vertex_source);
+  EXPECT_EQ(taken.face_source, read.face_source);
+  EXPECT_EQ(taken.output_vertex_of_input, read.output_vertex_of_input);
+  EXPECT_EQ(taken.input_vertices, read.input_vertices);
+  // And simplify_partitioned's own run is that one.
+  const SimplifyResult whole = simplify_partitioned(in, o, in_parts(4));
+  EXPECT_EQ(whole.mesh.positions, read.mesh.positions);
+  EXPECT_EQ(whole.mesh.indices, read.mesh.indices);
+}
+
 TEST(Partition, ErrorStaysNearTheInCoreRun) {
   const Mesh& in = bumpy_sphere();
   for (double r : {0.1, 0.01}) {

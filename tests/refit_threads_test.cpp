@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -135,7 +136,10 @@ TEST(RefitThreads, SurfaceInFrameIsTheSameOnAnyThreads) {
     std::size_t wrong_start = 0, wrong_corners = 0;
     for (std::uint32_t v = 0; v < m.vertex_count(); ++v) wrong_start += surface.face_at(v) != lowest[v];
     for (std::uint32_t t = 0; t < m.face_count(); ++t)
-      wrong_corners += !std::equal(surface.triangle(t), surface.triangle(t) + 9, &corners[9 * std::size_t(t)]);
+    {
+      const std::array<double, 9> c = surface.triangle(t);
+      wrong_corners += !std::equal(c.begin(), c.end(), &corners[9 * std::size_t(t)]);
+    }
     EXPECT_EQ(wrong_start, 0u) << threads << " threads";
     EXPECT_EQ(wrong_corners, 0u) << threads << " threads";
     for (const Vec3& p : {Vec3{0.3, 0.1, -0.2}, Vec3{-0.05, 0.2, 0.1}, Vec3{0.4, -0.4, 0.0}}) {

@@ -112,5 +112,10 @@ std::vector<MeshPart> split_mesh(MeshView input, const SimplifyOptions& options,
 /// Welds the simplified parts of split_mesh(input, options, ...) and runs the final pass.
 SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options, std::span<const MeshPart> parts,
                                   std::span<const MeshPartResult> results, PartitionReport* report = nullptr);
+/// The same, taking the parts and their results over: they are freed once welded, before the refit
+/// and the repair against the whole input, whose tree and points are the run's peak of memory
+/// (the parts hold the input's faces and vertices again).
+SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options, std::vector<MeshPart>&& parts,
+                                  std::vector<MeshPartResult>&& results, PartitionReport* report = nullptr);
 
 }  // namespace qem

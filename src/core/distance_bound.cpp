@@ -11,7 +11,7 @@ bool SurfaceDistance::piece_within(const Vec3& a, const Vec3& b, const Vec3& c, 
                                   std::uint32_t parent) const {
   using measure_detail::squared_distance;
   const auto near = [&](std::uint32_t id) {
-    const double* t = tree_.triangle(id);
+    const std::array<double, 9> t = tree_.triangle(id);
     const Vec3 ta{t[0], t[1], t[2]}, tb{t[3], t[4], t[5]}, tc{t[6], t[7], t[8]};
     const auto one = [&](const Vec3& p) {
       return squared_distance(p, measure_detail::closest_point_on_triangle(p, ta, tb, tc)) <= d * d;

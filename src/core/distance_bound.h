@@ -40,11 +40,10 @@ class SurfaceDistance {
   /// Per vertex of the surface's mesh, one triangle that has it (UINT32_MAX: none): a start for
   /// searches from points known to lie near a vertex (face_at).
   using FaceAtVertex = UnzeroedVector<std::uint32_t>;
-  /// With a face at each vertex; triangle t's corners written by `corners_of(t, out)`
-  /// (TriangleBvh's second form).
-  SurfaceDistance(std::size_t count, const std::function<void(std::uint32_t, double*)>& corners_of,
+  /// Of an indexed mesh (TriangleBvh's second form: it keeps `vertices`), with a face at each vertex.
+  SurfaceDistance(UnzeroedVector<double> vertices, std::span<const std::uint32_t> indices,
                   FaceAtVertex face_at_vertex, unsigned threads = 1)
-      : tree_(count, corners_of, threads), face_at_vertex_(std::move(face_at_vertex)) {}
+      : tree_(std::move(vertices), indices, threads), face_at_vertex_(std::move(face_at_vertex)) {}
   bool empty() const { return tree_.empty(); }
   /// A triangle that has vertex v, or UINT32_MAX (unknown).
   std::uint32_t face_at(std::uint32_t v) const {
@@ -76,7 +75,7 @@ class SurfaceDistance {
     tree_.within(q, radius * radius, out);
   }
   /// The corners of triangle t (9 doubles).
-  const double* triangle(std::uint32_t t) const { return tree_.triangle(t); }
+  std::array<double, 9> triangle(std::uint32_t t) const { return tree_.triangle(t); }
   /// Distance from p to triangle t of the surface (at least distance(p)).
   double distance_to(const Vec3& p, std::uint32_t t) const {
     const double q[3] = {p.x, p.y, p.z};

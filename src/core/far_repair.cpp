@@ -203,7 +203,7 @@ class Repairer {
     std::sort(near.begin(), near.end());  // the sums in one order, whatever the tree's walk
     constexpr double kAt[4][3] = {{1.0 / 3, 1.0 / 3, 1.0 / 3}, {0.5, 0.5, 0}, {0, 0.5, 0.5}, {0.5, 0, 0.5}};
     for (std::uint32_t t : near) {
-      const double* c = surface_.triangle(t);
+      const std::array<double, 9> c = surface_.triangle(t);
       const Vec3 corner[3] = {{c[0], c[1], c[2]}, {c[3], c[4], c[5]}, {c[6], c[7], c[8]}};
       const double area = 0.5 * length(cross(corner[1] - corner[0], corner[2] - corner[0]));
       const std::uint32_t* v = &opt_.input_faces[3 * std::size_t(t)];
@@ -900,7 +900,7 @@ class Repairer {
     surface_.triangles_near(centre, radius, near);
     const double limit2 = limit * limit, radius2 = radius * radius;
     for (std::uint32_t t : near) {
-      const double* c = surface_.triangle(t);
+      const std::array<double, 9> c = surface_.triangle(t);
       const Vec3 a{c[0], c[1], c[2]}, b{c[3], c[4], c[5]}, d{c[6], c[7], c[8]};
       // Samples no farther apart than a quarter of the region, up to 16 divisions an edge.
       const double longest = std::max({length(b - a), length(d - b), length(a - d)});

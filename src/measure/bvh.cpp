@@ -15,6 +15,7 @@ namespace qem::measure_detail {
 namespace {
 
 constexpr std::uint32_t kLeaf = 4;     // triangles per leaf at most
+constexpr std::uint32_t kNoIndices[3] = {0, 0, 0};
 constexpr std::uint32_t kGrid = 1024;  // Morton cells per axis: 30-bit codes
 // Query stacks: a search holds at most depth + 1 entries, and the depth stays below 30 + 32.
 constexpr int kStack = 128;
@@ -54,8 +55,9 @@ inline float float_above(double x) { return -float_below(-x); }
 
 }  // namespace
 
-template <class CornersOf>
-void TriangleBvh::build(std::size_t count, const CornersOf& corners_of, unsigned threads) {
+template <class CornersOf, class IndicesOf>
+void TriangleBvh::build(std::size_t count, const CornersOf& corners_of, const IndicesOf& indices_of,
+                        unsigned threads) {
   const std::uint32_t n = std::uint32_t(count);
   if (n == 0) return;
   // Every step but the radix sort and the top-down split is per triangle (or per node) and runs
@@ -157,11 +159,17 @@ void TriangleBvh::build(std::size_t count, const CornersOf& corners_of, unsigned
   nodes_.resize(used);
   Indices().swap(sorted_code);
   // The triangles in leaf order, so that a leaf reads contiguous memory (here, for its box, too).
-  tris_.resize(9 * std::size_t(n));
+  if (vertices_.empty())
+    tris_.resize(9 * std::size_t(n));
+  else
+    corner_index_.resize(3 * std::size_t(n));
   slot_of_.resize(n);
   core::for_chunks(n, kChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
-      corners_of(order[i], &tris_[9 * i]);
+      if (vertices_.empty())
+        corners_of(order[i], &tris_[9 * i]);
+      else
+        std::copy_n(&indices_of(order[i])[0], 3, &corner_index_[3 * i]);
       slot_of_[order[i]] = std::uint32_t(i);
     }
   });
@@ -176,8 +184,11 @@ void TriangleBvh::build(std::size_t count, const CornersOf& corners_of, unsigned
       Node& node = nodes_[i];
       if (node.count == 0) continue;
       Bounds b;
-      for (std::uint32_t k = node.first; k < node.first + node.count; ++k)
-        for (int c = 0; c < 3; ++c) b.grow(&tris_[9 * std::size_t(k) + 3 * c]);
+      for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
+        double c[9];
+        corners_of_slot(k, c);
+        for (int j = 0; j < 3; ++j) b.grow(&c[3 * j]);
+      }
       set_box(node, b);
     }
   });
@@ -192,18 +203,28 @@ void TriangleBvh::build(std::size_t count, const CornersOf& corners_of, unsigned
 TriangleBvh::TriangleBvh(std::span<const double> corners, unsigned threads) {
   build(
       corners.size() / 9,
-      [corners](std::uint32_t t, double* out) { std::copy_n(&corners[9 * std::size_t(t)], 9, out); }, threads);
+      [corners](std::uint32_t t, double* out) { std::copy_n(&corners[9 * std::size_t(t)], 9, out); },
+      [](std::uint32_t) { return kNoIndices; }, threads);  // (not read: no vertices_)
 }
 
-TriangleBvh::TriangleBvh(std::size_t count, const std::function<void(std::uint32_t, double*)>& corners_of,
-                         unsigned threads) {
-  build(count, corners_of, threads);
+TriangleBvh::TriangleBvh(core::UnzeroedVector<double> vertices, std::span<const std::uint32_t> indices,
+                         unsigned threads)
+    : vertices_(std::move(vertices)) {
+  if (vertices_.empty()) vertices_.resize(3);  // (no triangle can refer to it: marks the form)
+  const auto indices_of = [&](std::uint32_t t) { return &indices[3 * std::size_t(t)]; };
+  build(
+      indices.size() / 3,
+      [&](std::uint32_t t, double* out) {
+        for (int k = 0; k < 3; ++k) std::copy_n(&vertices_[3 * std::size_t(indices_of(t)[k])], 3, &out[3 * k]);
+      },
+      indices_of, threads);
 }
 
 double TriangleBvh::slot_d2(const double p[3], std::uint32_t slot, double point[3]) const {
-  const double* t = &tris_[9 * std::size_t(slot)];
   const Vec3 q{p[0], p[1], p[2]};
-  const Vec3 c = closest_point_on_triangle(q, {t[0], t[1], t[2]}, {t[3], t[4], t[5]}, {t[6], t[7], t[8]});
+  Vec3 a, b, d;
+  corners_at(slot, a, b, d);
+  const Vec3 c = closest_point_on_triangle(q, a, b, d);
   point[0] = c.x, point[1] = c.y, point[2] = c.z;
   return squared_distance(q, c);
 }
@@ -270,9 +291,9 @@ TriangleBvh::Hit TriangleBvh::search(const double p[3], double best, std::uint32
     const Node& node = nodes_[e.node];
     if (node.count > 0) {
       for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
-        const double* t = &tris_[9 * std::size_t(i)];
-        const Vec3 c =
-            closest_point_on_triangle(q, {t[0], t[1], t[2]}, {t[3], t[4], t[5]}, {t[6], t[7], t[8]});
+        Vec3 a, b, d;
+        corners_at(i, a, b, d);
+        const Vec3 c = closest_point_on_triangle(q, a, b, d);
         const double d2 = squared_distance(q, c);
         if (d2 < best || (d2 == best && best_tri != UINT32_MAX && ids_[i] < ids_[best_tri]))
           best = d2, best_tri = i;

@@ -4,17 +4,19 @@
 // differing bit turns on, boxes filled bottom up; linear time, a fraction of the binned
 // surface-area-heuristic build it replaces, for the same answers (queries break ties by triangle
 // index, never by the tree's layout). Nodes, boxes and triangles live in flat arrays, children of
-// a node are adjacent, and triangles are stored in leaf order so a leaf reads contiguous memory.
+// a node are adjacent, and triangles are stored in leaf order so a leaf reads contiguous memory:
+// their nine coordinates, or, for a tree of an indexed mesh, their three vertex indices.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
-#include <functional>
 #include <limits>
 #include <span>
 #include <vector>
 
 #include "core/default_init_allocator.h"
+#include "geometry/vec3.h"
 
 namespace qem::measure_detail {
 
@@ -33,11 +35,12 @@ class TriangleBvh {
   /// `corners`: 9 doubles per triangle (a.xyz b.xyz c.xyz). Built on up to `threads` threads; the
   /// tree is the same on any number.
   explicit TriangleBvh(std::span<const double> corners, unsigned threads = 1);
-  /// The same tree, triangle t's 9 coordinates written by `corners_of(t, out)` (called on the
-  /// threads, more than once per triangle: the same numbers each time). For corners that are
-  /// computed, e.g. mapped into a frame: no array of all of them beside the tree's own copy.
-  TriangleBvh(std::size_t count, const std::function<void(std::uint32_t, double*)>& corners_of,
-              unsigned threads = 1);
+  /// The same tree over an indexed mesh: `vertices` (3 doubles each, taken over by the tree) and
+  /// `indices` (3 per triangle, each below the vertex count). The tree keeps the vertices and each
+  /// triangle's three indices instead of its nine coordinates: a third of the memory on a closed
+  /// mesh (a vertex per two faces), and a build that writes a third of the bytes. The answers are
+  /// those of the first form given each triangle's corners.
+  TriangleBvh(core::UnzeroedVector<double> vertices, std::span<const std::uint32_t> indices, unsigned threads = 1);
 
   /// The closest point of all triangles to `p` (of two as close, the one of lower index, so the
   /// answer does not depend on the tree's layout); none closer than sqrt(max_d2) -> Hit with d2 = inf.
@@ -60,7 +63,11 @@ class TriangleBvh {
   void within(const double p[3], double max_d2, std::vector<std::uint32_t>& out) const;
 
   /// The 9 coordinates of (input) triangle `id`.
-  const double* triangle(std::uint32_t id) const { return &tris_[9 * std::size_t(slot_of_[id])]; }
+  std::array<double, 9> triangle(std::uint32_t id) const {
+    std::array<double, 9> out;
+    corners_of_slot(slot_of_[id], out.data());
+    return out;
+  }
 
   std::size_t triangle_count() const { return ids_.size(); }
   std::size_t node_count() const { return nodes_.size(); }
@@ -78,14 +85,38 @@ class TriangleBvh {
     std::uint32_t count;  ///< triangles in a leaf; 0 for an inner node
   };
   static_assert(sizeof(Node) == 32);
-  template <class CornersOf>
-  void build(std::size_t count, const CornersOf& corners_of, unsigned threads);
+  // `corners_of(t, out)`: triangle t's 9 coordinates; `indices_of(t)`: its 3 vertex indices (read
+  // only when vertices_ is set).
+  template <class CornersOf, class IndicesOf>
+  void build(std::size_t count, const CornersOf& corners_of, const IndicesOf& indices_of, unsigned threads);
   Hit search(const double p[3], double best, std::uint32_t best_slot) const;
   double slot_d2(const double p[3], std::uint32_t slot, double point[3]) const;
+  /// The corners of the triangle stored at `slot`, as points.
+  void corners_at(std::uint32_t slot, Vec3& a, Vec3& b, Vec3& c) const {
+    if (vertices_.empty()) {
+      const double* t = &tris_[9 * std::size_t(slot)];
+      a = {t[0], t[1], t[2]}, b = {t[3], t[4], t[5]}, c = {t[6], t[7], t[8]};
+      return;
+    }
+    const std::uint32_t* i = &corner_index_[3 * std::size_t(slot)];
+    const double *p = &vertices_[3 * std::size_t(i[0])], *q = &vertices_[3 * std::size_t(i[1])],
+                 *r = &vertices_[3 * std::size_t(i[2])];
+    a = {p[0], p[1], p[2]}, b = {q[0], q[1], q[2]}, c = {r[0], r[1], r[2]};
+  }
+  void corners_of_slot(std::uint32_t slot, double out[9]) const {
+    Vec3 a, b, c;
+    corners_at(slot, a, b, c);
+    const Vec3 corner[3] = {a, b, c};
+    for (int k = 0; k < 3; ++k) out[3 * k] = corner[k].x, out[3 * k + 1] = corner[k].y, out[3 * k + 2] = corner[k].z;
+  }
 
   // Written whole by the build before any read: not zero-filled first.
   core::UnzeroedVector<Node> nodes_;
-  core::UnzeroedVector<double> tris_;           ///< 9 per triangle, in leaf order
+  // The triangles in leaf order: 9 coordinates each (tris_), or, for an indexed mesh, 3 indices
+  // each (corner_index_) into the vertices (vertices_, not empty then).
+  core::UnzeroedVector<double> tris_;
+  core::UnzeroedVector<double> vertices_;
+  core::UnzeroedVector<std::uint32_t> corner_index_;
   core::UnzeroedVector<std::uint32_t> ids_;      ///< input index of each stored triangle
   core::UnzeroedVector<std::uint32_t> slot_of_;  ///< stored position of each input triangle
 };

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <chrono>
 #include <ctime>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <numeric>
@@ -110,8 +111,12 @@ MeshPartResult simplify_part(const MeshPart& part, const SimplifyOptions& option
   return out;
 }
 
-SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options, std::span<const MeshPart> parts,
-                                  std::span<const MeshPartResult> results, PartitionReport* report) {
+namespace {
+
+// finish_partitioned; `release` frees the parts and their results (once they are welded).
+SimplifyResult finish(MeshView input, const SimplifyOptions& options, std::span<const MeshPart> parts,
+                      std::span<const MeshPartResult> results, PartitionReport* report,
+                      const std::function<void()>& release) {
   if (parts.size() != results.size()) throw Error("finish_partitioned: one result per part is needed");
   constexpr std::uint32_t kNone = SimplifyResult::kUnmapped;
   // Weld: a vertex of a part's output that started as a cut vertex never moved and was never
@@ -253,6 +258,11 @@ SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options
   for (std::uint8_t s : seen) referenced += s;
   result.input_vertices = referenced;
   result.output_vertex_of_input = std::move(went);
+  // Nothing below reads the parts or the welding's arrays.
+  for (auto* v : {&merged_source, &merged_face_source, &welded, &welded_by}) std::vector<std::uint32_t>().swap(*v);
+  std::vector<std::vector<std::uint32_t>>().swap(merged_of);
+  std::vector<std::uint8_t>().swap(seen);
+  if (release) release();
 
   // The refit fits the result to the whole input, as simplify's own refit does, with the input's
   // surface: without it the refit has no Hausdorff guard and far points still pull, and it raised
@@ -292,6 +302,23 @@ SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options
   return result;
 }
 
+}  // namespace
+
+SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options, std::span<const MeshPart> parts,
+                                  std::span<const MeshPartResult> results, PartitionReport* report) {
+  return finish(input, options, parts, results, report, {});
+}
+
+SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options, std::vector<MeshPart>&& parts,
+                                  std::vector<MeshPartResult>&& results, PartitionReport* report) {
+  std::vector<MeshPart> own_parts = std::move(parts);
+  std::vector<MeshPartResult> own_results = std::move(results);
+  return finish(input, options, own_parts, own_results, report, [&] {
+    std::vector<MeshPart>().swap(own_parts);
+    std::vector<MeshPartResult>().swap(own_results);
+  });
+}
+
 SimplifyResult simplify_partitioned(MeshView input, const SimplifyOptions& options, const PartitionOptions& partition,
                                     PartitionReport* report) {
   check_options(options);
@@ -303,7 +330,7 @@ SimplifyResult simplify_partitioned(MeshView input, const SimplifyOptions& optio
     return simplify(input, options);
   }
   auto start = std::chrono::steady_clock::now();
-  const std::vector<MeshPart> parts = split_mesh(input, options, part_count, &rep);
+  std::vector<MeshPart> parts = split_mesh(input, options, part_count, &rep);
   rep.split_seconds = seconds_since(start);
   start = std::chrono::steady_clock::now();
   std::vector<MeshPartResult> results(parts.size());
@@ -324,7 +351,7 @@ SimplifyResult simplify_partitioned(MeshView input, const SimplifyOptions& optio
     rep.parts = 1;
     return simplify(input, options);
   }
-  return finish_partitioned(input, options, parts, results, &rep);
+  return finish_partitioned(input, options, std::move(parts), std::move(results), &rep);
 }
 
 }  // namespace qem
