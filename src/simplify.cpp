@@ -11,6 +11,7 @@
 #include "core/distance_bound.h"
 #include "core/far_repair.h"
 #include "core/parallel_chunks.h"
+#include "core/release_memory.h"
 #include "core/run.h"
 #include "core/settings.h"
 #include "geometry/box.h"
@@ -268,9 +269,11 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
   MeshView input_surface = input;  // the faces kept when the core consumed them
   input_surface.indices = input_faces;
   if (refitted || repaired) {
+    core::release_free_memory_after(out.input_faces);  // what the core freed, before the refit's arrays
     const unsigned threads = core::resolve_threads(options.threads);
     if (!consumed_indices) weights = refit_detail::vertex_areas(input, threads);
     points = refit_detail::FitPoints(input.positions, weights, threads);
+    std::vector<double>().swap(weights);  // the points keep theirs
     surface = refit_detail::surface_in_frame(input.positions, input_faces, points.frame(), threads);
   }
   std::vector<std::uint8_t> fixed;  // the locked vertices stay

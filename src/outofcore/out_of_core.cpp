@@ -4,7 +4,6 @@
 #include "qem/out_of_core.h"
 
 #include <fcntl.h>
-#include <malloc.h>
 #include <sys/mman.h>
 #include <sys/resource.h>
 #include <unistd.h>
@@ -25,6 +24,7 @@
 
 #include "cluster/cluster_quadric.h"
 #include "core/quadric.h"
+#include "core/release_memory.h"
 #include "geometry/vec3.h"
 #include "outofcore/cell_table.h"
 #include "outofcore/mesh_stream.h"
@@ -705,7 +705,7 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
     progress.phase("refitting", 3);
     // Phase 2's freed memory goes back to the system, so that the refit's peak adds to the
     // output's, not to phase 2's.
-    ::malloc_trim(0);
+    core::release_free_memory();
     const std::uint64_t points_in_file = soup ? 3 * report.input_faces : report.input_vertices;
     std::vector<double> xyz = input_points(path, double(points_wanted), points_in_file);
     const std::vector<double> weights(xyz.size() / 3, 1.0);

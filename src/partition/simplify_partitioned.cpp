@@ -14,6 +14,7 @@
 
 #include "analysis/disjoint_sets.h"
 #include "core/parallel_chunks.h"
+#include "core/release_memory.h"
 #include "core/run.h"
 #include "partition/partition_targets.h"
 #include "core/same_position.h"
@@ -263,6 +264,7 @@ SimplifyResult finish(MeshView input, const SimplifyOptions& options, std::span<
   std::vector<std::vector<std::uint32_t>>().swap(merged_of);
   std::vector<std::uint8_t>().swap(seen);
   if (release) release();
+  core::release_free_memory_after(input.face_count());  // what the parts' runs freed, before the refit's arrays
 
   // The refit fits the result to the whole input, as simplify's own refit does, with the input's
   // surface: without it the refit has no Hausdorff guard and far points still pull, and it raised

@@ -328,6 +328,11 @@ class Refitter {
     for (unsigned round = 0; round < opt_.rounds; ++round) {
       std::vector<double> next;
       if (!solve(proj, next)) break;
+      // What is read of this projection from here on is each point's closest face (where the
+      // next one starts) and its energy: the rest goes before the next is made (on a large input
+      // the points' arrays are the refit's largest).
+      Projection::Array<std::uint32_t>().swap(proj.face);
+      Projection::Array<double>().swap(proj.bary);
       std::size_t held = hold_turned_faces(next);
       if (surface_) held += hold_far_from_original(next);
       Projection next_proj = project(next, &proj);
