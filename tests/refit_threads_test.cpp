@@ -135,8 +135,7 @@ TEST(RefitThreads, SurfaceInFrameIsTheSameOnAnyThreads) {
     const core::SurfaceDistance surface = refit_detail::surface_in_frame(m.positions, m.indices, frame, threads);
     std::size_t wrong_start = 0, wrong_corners = 0;
     for (std::uint32_t v = 0; v < m.vertex_count(); ++v) wrong_start += surface.face_at(v) != lowest[v];
-    for (std::uint32_t t = 0; t < m.face_count(); ++t)
-    {
+    for (std::uint32_t t = 0; t < m.face_count(); ++t) {
       const std::array<double, 9> c = surface.triangle(t);
       wrong_corners += !std::equal(c.begin(), c.end(), &corners[9 * std::size_t(t)]);
     }

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -17,7 +19,7 @@ std::size_t resident_bytes() {
   if (!f) return 0;
   const bool read = std::fscanf(f, "%ld %ld", &pages, &resident) == 2;
   std::fclose(f);
-  return read ? std::size_t(resident) * 4096 : 0;
+  return read ? std::size_t(resident) * std::size_t(sysconf(_SC_PAGESIZE)) : 0;
 }
 
 // `count` blocks of 64 KB (below glibc's mmap threshold: they come from the heap), written, then
@@ -34,30 +36,33 @@ std::unique_ptr<char[]> freed_heap_blocks(std::size_t count, std::size_t& freed)
   return std::move(blocks.back());  // the others are freed here
 }
 
+// Only glibc's own allocator (not a sanitizer's) keeps freed blocks that malloc_trim hands back,
+// and only Linux says how much is resident.
+class ReleaseMemory : public ::testing::Test {
+ protected:
+  void SetUp() override {
+#if !defined(__GLIBC__) || defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+    GTEST_SKIP() << "glibc's own allocator only";
+#endif
+    if (resident_bytes() == 0) GTEST_SKIP() << "no /proc/self/statm";
+  }
+};
+
 }  // namespace
 
 // 64 MB of freed heap blocks: after release_free_memory the resident set is at least half of
 // that lower.
-TEST(ReleaseMemory, FreedHeapBlocksLeaveTheResidentSet) {
-#if !defined(__GLIBC__) || defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-  GTEST_SKIP() << "glibc's own allocator only";
-#else
-  if (resident_bytes() == 0) GTEST_SKIP() << "no /proc/self/statm";
+TEST_F(ReleaseMemory, FreedHeapBlocksLeaveTheResidentSet) {
   std::size_t freed = 0;
   const std::unique_ptr<char[]> last = freed_heap_blocks(1024, freed);
   const std::size_t before = resident_bytes();
   qem::core::release_free_memory();
   const std::size_t after = resident_bytes();
   EXPECT_LT(after + freed / 2, before) << "resident " << before << " -> " << after << " bytes";
-#endif
 }
 
 // Below kReleaseFromFaces nothing is handed back (the next phase would fault the pages in again).
-TEST(ReleaseMemory, SmallPhasesKeepTheirMemory) {
-#if !defined(__GLIBC__) || defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-  GTEST_SKIP() << "glibc's own allocator only";
-#else
-  if (resident_bytes() == 0) GTEST_SKIP() << "no /proc/self/statm";
+TEST_F(ReleaseMemory, SmallPhasesKeepTheirMemory) {
   std::size_t freed = 0;
   const std::unique_ptr<char[]> last = freed_heap_blocks(512, freed);
   const std::size_t before = resident_bytes();
@@ -65,5 +70,4 @@ TEST(ReleaseMemory, SmallPhasesKeepTheirMemory) {
   EXPECT_GT(resident_bytes() + freed / 2, before);
   qem::core::release_free_memory_after(qem::core::kReleaseFromFaces);
   EXPECT_LT(resident_bytes() + freed / 2, before);
-#endif
 }

@@ -17,7 +17,6 @@
 
 #include <cmath>
 #include <cstdint>
-#include <functional>
 #include <utility>
 #include <span>
 #include <vector>

@@ -15,7 +15,6 @@ namespace qem::measure_detail {
 namespace {
 
 constexpr std::uint32_t kLeaf = 4;     // triangles per leaf at most
-constexpr std::uint32_t kNoIndices[3] = {0, 0, 0};
 constexpr std::uint32_t kGrid = 1024;  // Morton cells per axis: 30-bit codes
 // Query stacks: a search holds at most depth + 1 entries, and the depth stays below 30 + 32.
 constexpr int kStack = 128;
@@ -55,8 +54,8 @@ inline float float_above(double x) { return -float_below(-x); }
 
 }  // namespace
 
-template <class CornersOf, class IndicesOf>
-void TriangleBvh::build(std::size_t count, const CornersOf& corners_of, const IndicesOf& indices_of,
+template <class CornersOf>
+void TriangleBvh::build(std::size_t count, const CornersOf& corners_of, const std::uint32_t* indices,
                         unsigned threads) {
   const std::uint32_t n = std::uint32_t(count);
   if (n == 0) return;
@@ -159,17 +158,17 @@ void TriangleBvh::build(std::size_t count, const CornersOf& corners_of, const In
   nodes_.resize(used);
   Indices().swap(sorted_code);
   // The triangles in leaf order, so that a leaf reads contiguous memory (here, for its box, too).
-  if (vertices_.empty())
-    tris_.resize(9 * std::size_t(n));
-  else
+  if (indices)
     corner_index_.resize(3 * std::size_t(n));
+  else
+    tris_.resize(9 * std::size_t(n));
   slot_of_.resize(n);
   core::for_chunks(n, kChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
-      if (vertices_.empty())
-        corners_of(order[i], &tris_[9 * i]);
+      if (indices)
+        std::copy_n(&indices[3 * std::size_t(order[i])], 3, &corner_index_[3 * i]);
       else
-        std::copy_n(&indices_of(order[i])[0], 3, &corner_index_[3 * i]);
+        corners_of(order[i], &tris_[9 * i]);
       slot_of_[order[i]] = std::uint32_t(i);
     }
   });
@@ -203,21 +202,19 @@ void TriangleBvh::build(std::size_t count, const CornersOf& corners_of, const In
 TriangleBvh::TriangleBvh(std::span<const double> corners, unsigned threads) {
   build(
       corners.size() / 9,
-      [corners](std::uint32_t t, double* out) { std::copy_n(&corners[9 * std::size_t(t)], 9, out); },
-      [](std::uint32_t) { return kNoIndices; }, threads);  // (not read: no vertices_)
+      [corners](std::uint32_t t, double* out) { std::copy_n(&corners[9 * std::size_t(t)], 9, out); }, nullptr,
+      threads);
 }
 
 TriangleBvh::TriangleBvh(core::UnzeroedVector<double> vertices, std::span<const std::uint32_t> indices,
                          unsigned threads)
     : vertices_(std::move(vertices)) {
-  if (vertices_.empty()) vertices_.resize(3);  // (no triangle can refer to it: marks the form)
-  const auto indices_of = [&](std::uint32_t t) { return &indices[3 * std::size_t(t)]; };
   build(
       indices.size() / 3,
       [&](std::uint32_t t, double* out) {
-        for (int k = 0; k < 3; ++k) std::copy_n(&vertices_[3 * std::size_t(indices_of(t)[k])], 3, &out[3 * k]);
+        for (int k = 0; k < 3; ++k) std::copy_n(&vertices_[3 * std::size_t(indices[3 * std::size_t(t) + k])], 3, &out[3 * k]);
       },
-      indices_of, threads);
+      indices.data(), threads);
 }
 
 double TriangleBvh::slot_d2(const double p[3], std::uint32_t slot, double point[3]) const {

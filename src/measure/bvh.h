@@ -85,15 +85,15 @@ class TriangleBvh {
     std::uint32_t count;  ///< triangles in a leaf; 0 for an inner node
   };
   static_assert(sizeof(Node) == 32);
-  // `corners_of(t, out)`: triangle t's 9 coordinates; `indices_of(t)`: its 3 vertex indices (read
-  // only when vertices_ is set).
-  template <class CornersOf, class IndicesOf>
-  void build(std::size_t count, const CornersOf& corners_of, const IndicesOf& indices_of, unsigned threads);
+  // `corners_of(t, out)`: triangle t's 9 coordinates; `indices`: 3 vertex indices per triangle
+  // (into vertices_) for the indexed form, stored instead of the coordinates; nullptr otherwise.
+  template <class CornersOf>
+  void build(std::size_t count, const CornersOf& corners_of, const std::uint32_t* indices, unsigned threads);
   Hit search(const double p[3], double best, std::uint32_t best_slot) const;
   double slot_d2(const double p[3], std::uint32_t slot, double point[3]) const;
   /// The corners of the triangle stored at `slot`, as points.
   void corners_at(std::uint32_t slot, Vec3& a, Vec3& b, Vec3& c) const {
-    if (vertices_.empty()) {
+    if (corner_index_.empty()) {
       const double* t = &tris_[9 * std::size_t(slot)];
       a = {t[0], t[1], t[2]}, b = {t[3], t[4], t[5]}, c = {t[6], t[7], t[8]};
       return;
@@ -104,16 +104,15 @@ class TriangleBvh {
     a = {p[0], p[1], p[2]}, b = {q[0], q[1], q[2]}, c = {r[0], r[1], r[2]};
   }
   void corners_of_slot(std::uint32_t slot, double out[9]) const {
-    Vec3 a, b, c;
-    corners_at(slot, a, b, c);
-    const Vec3 corner[3] = {a, b, c};
+    Vec3 corner[3];
+    corners_at(slot, corner[0], corner[1], corner[2]);
     for (int k = 0; k < 3; ++k) out[3 * k] = corner[k].x, out[3 * k + 1] = corner[k].y, out[3 * k + 2] = corner[k].z;
   }
 
   // Written whole by the build before any read: not zero-filled first.
   core::UnzeroedVector<Node> nodes_;
   // The triangles in leaf order: 9 coordinates each (tris_), or, for an indexed mesh, 3 indices
-  // each (corner_index_) into the vertices (vertices_, not empty then).
+  // each (corner_index_, empty in the other form) into the vertices (vertices_).
   core::UnzeroedVector<double> tris_;
   core::UnzeroedVector<double> vertices_;
   core::UnzeroedVector<std::uint32_t> corner_index_;
