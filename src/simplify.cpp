@@ -60,9 +60,9 @@ namespace {
 // Per point of `points`, whether it is on the input's border (`faces`), for relocations; empty
 // when `mesh` has what a relocation could not give its new vertex (no relocation runs then).
 std::vector<std::uint8_t> border_points_for(const Mesh& mesh, std::span<const std::uint32_t> faces,
-                                            const refit_detail::FitPoints& points) {
+                                            const refit_detail::FitPoints& points, unsigned threads) {
   if (!mesh.vertex_properties.empty()) return {};
-  return core::points_on_border(faces, points.source);
+  return core::points_on_border(faces, points.source, threads);
 }
 
 // The far-place repair of `mesh` with `options`' turn limit and threads (core/far_repair.h), against
@@ -126,7 +126,7 @@ void refit_levels(MeshView original, std::span<ReplayLevel> levels, const Simpli
   // The input's border points, once for every level (the levels share the input and carry the
   // same kinds of data).
   const std::vector<std::uint8_t> on_border =
-      border_points_for(*groups.front().second.front(), original.indices, points);
+      border_points_for(*groups.front().second.front(), original.indices, points, threads);
   for (auto& [refit_options, meshes] : groups)
     for (Mesh* mesh : meshes) {
       std::vector<std::uint8_t> held(locked.empty() ? 0 : mesh->vertex_count(), 0);
@@ -149,7 +149,8 @@ void repair_after_refit(SimplifyResult& result, const SimplifyOptions& options, 
                         const refit_detail::FitPoints& points, const core::SurfaceDistance& surface,
                         std::span<const std::uint8_t> held) {
   const core::FarRepairResult made = repair_mesh(result.mesh, options, input,
-                                                 border_points_for(result.mesh, input.indices, points), points, surface, held);
+                                                 border_points_for(result.mesh, input.indices, points, core::resolve_threads(options.threads)), points,
+                     surface, held);
   result.edge_flips = made.flips;
   result.vertex_moves = made.moves;
   result.vertex_relocations = made.relocations.size();

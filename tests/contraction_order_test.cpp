@@ -60,6 +60,25 @@ TEST(RadixSort, MatchesAStableSortOnFloatKeysWithTiesAndNegatives) {
   for (std::size_t i = 1; i < ids.size(); ++i) ASSERT_LE(key[ids[i - 1]], key[ids[i]]);
 }
 
+// On the threads (an array of several chunks), the sort is the one-thread sort: stable, by the
+// whole 32-bit key, on shuffled ids with many ties.
+TEST(RadixSort, OnThreadsMatchesAStableSort) {
+  std::mt19937 rng(9);
+  const std::size_t n = 700000;  // three chunks of 2^18
+  std::vector<std::uint32_t> key(n);
+  for (std::uint32_t& k : key) k = rng() % 3 == 0 ? rng() : (rng() % 5000) << (rng() % 22);
+  std::vector<std::uint32_t> ids(n), scratch;
+  for (std::uint32_t i = 0; i < n; ++i) ids[i] = i;
+  std::shuffle(ids.begin(), ids.end(), rng);
+  std::vector<std::uint32_t> expected = ids;
+  std::stable_sort(expected.begin(), expected.end(), [&](std::uint32_t a, std::uint32_t b) { return key[a] < key[b]; });
+  for (unsigned threads : {1u, 2u, 3u}) {
+    std::vector<std::uint32_t> sorted = ids;
+    core::radix_sort_by_key(sorted, scratch, [&](std::uint32_t i) { return key[i]; }, threads);
+    EXPECT_EQ(sorted, expected) << threads << " threads";
+  }
+}
+
 // Items as (vertex, item) pairs, emitted in order: what rebuild() is given.
 static void rebuild_from(core::VertexLists& lists, std::uint32_t n,
                          const std::vector<std::pair<std::uint32_t, std::uint32_t>>& items) {

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/distance_bound.h"
+#include "core/valid_pairs.h"
 #include "geometry/frame.h"
 #include "mesh_checks.h"
 #include "measure/point_triangle.h"
@@ -335,7 +336,7 @@ double tent(double x, double y) { return 0.03 * std::max(0.0, 1 - std::hypot(x -
 core::FarRepairResult relocate(Mesh& approx, const Mesh& input, std::size_t relocations, bool add_vertices = false) {
   std::vector<std::uint32_t> source(input.vertex_count());
   for (std::uint32_t v = 0; v < source.size(); ++v) source[v] = v;
-  const std::vector<std::uint8_t> on_border = core::points_on_border(input.indices, source);
+  const std::vector<std::uint8_t> on_border = core::points_on_border(input.indices, source, 1);
   core::FarRepairOptions o;
   o.relocations = relocations;
   o.point_on_border = on_border;
@@ -460,7 +461,7 @@ TEST(FarRepair, RelocationsCarryValuesAndMaterials) {
   paint(input), paint(with);
   std::vector<std::uint32_t> source(input.vertex_count());
   for (std::uint32_t v = 0; v < source.size(); ++v) source[v] = v;
-  const std::vector<std::uint8_t> on_border = core::points_on_border(input.indices, source);
+  const std::vector<std::uint8_t> on_border = core::points_on_border(input.indices, source, 1);
   std::vector<std::uint8_t> held(with.vertex_count(), 0);
   for (std::size_t v = 0; v < held.size(); ++v) held[v] = with.positions[3 * v] == 0.5;
   core::FarRepairOptions o;
@@ -535,7 +536,7 @@ TEST(FarRepair, ALoneSpikeGetsAVertexPartOfTheWayUp) {
   Mesh with = grid;
   std::vector<std::uint32_t> source(input.vertex_count());
   for (std::uint32_t v = 0; v < source.size(); ++v) source[v] = v;
-  const std::vector<std::uint8_t> on_border = core::points_on_border(input.indices, source);
+  const std::vector<std::uint8_t> on_border = core::points_on_border(input.indices, source, 1);
   core::FarRepairOptions o;
   o.relocations = 8;
   o.point_on_border = on_border;
@@ -634,4 +635,28 @@ TEST(FarRepair, ACracksTwoSidesSplitTogether) {
 }
 
 }  // namespace
+// The input's border vertices (core::border_vertices, what points_on_border reads) are the ends of
+// the edges unique_edges counts once, on any number of threads: on a sphere with holes cut into it
+// (several chunks of vertices), a fin on a shared edge (three faces), a face with a repeated
+// vertex, a face given twice and a vertex no face uses.
+TEST(FarRepair, BorderVerticesAreTheEndsOfSingleFaceEdgesOnAnyThreads) {
+  Mesh m = test::icosphere(6);  // 40,962 vertices
+  std::vector<std::uint32_t> kept;
+  for (std::size_t f = 0; f < m.face_count(); ++f)
+    if (f % 97 != 5) kept.insert(kept.end(), &m.indices[3 * f], &m.indices[3 * f] + 3);
+  const std::uint32_t a = kept[0], b = kept[1], c = kept[2], n = std::uint32_t(m.vertex_count());
+  m.positions.insert(m.positions.end(), {0, 0, 2, 0, 0, 3});  // vertices n (a fin's tip) and n + 1 (unused)
+  kept.insert(kept.end(), {a, b, n});  // a third face on edge (a, b)
+  kept.insert(kept.end(), {c, c, n});  // a repeated vertex: edge (c, n) counted twice by it
+  kept.insert(kept.end(), &kept[30], &kept[33]);  // a face given twice: its edges have 3 faces
+  m.indices = kept;
+  const std::size_t count = m.vertex_count();
+  std::vector<std::uint8_t> expected(count, 0);
+  for (const core::Edge& e : core::unique_edges(m.indices, count))
+    if (e.faces == 1) expected[e.lo] = expected[e.hi] = 1;
+  ASSERT_GT(std::count(expected.begin(), expected.end(), 1), 1000);
+  ASSERT_EQ(expected[n + 1], 0);
+  for (unsigned threads : {1u, 2u, 3u}) EXPECT_EQ(core::border_vertices(m.indices, count, threads), expected);
+}
+
 }  // namespace qem

@@ -134,6 +134,47 @@ TEST(Measure, BvhBuiltOnThreadsIsTheSameTree) {
     for (std::uint32_t t : {0u, 40000u, 81919u})  // the stored triangles, each where its index says
       ASSERT_EQ(one.triangle(t), two.triangle(t));
   }
+  for (std::size_t i = 0; i < one.node_count(); ++i) {  // node for node (slot 1 is unused)
+    if (i == 1) continue;
+    for (const measure_detail::TriangleBvh* other : {&two, &three}) {
+      const auto &a = one.node(i), &b = other->node(i);
+      ASSERT_TRUE(a.first == b.first && a.count == b.count) << "node " << i;
+      for (int k = 0; k < 3; ++k) ASSERT_TRUE(a.lo[k] == b.lo[k] && a.hi[k] == b.hi[k]) << "node " << i;
+    }
+  }
+}
+
+// The subtrees split on the threads (ranges of 32,768 triangles and fewer) are laid out as one
+// depth-first pass lays out the whole tree: each inner node's children are the next free pair of
+// slots when it is reached, left subtree before right; the leaves cover the stored triangles in
+// order; every box holds its children's.
+TEST(Measure, BvhKeepsTheDepthFirstLayout) {
+  const Mesh sphere = test::icosphere(7);  // 327,680 triangles: ten ranges and more split on the threads
+  const measure_detail::Surface s = measure_detail::make_surface(sphere, "sphere");
+  const measure_detail::TriangleBvh tree(s.corners, 2);
+  std::size_t next_pair = 2, next_triangle = 0, leaves = 0;
+  std::vector<std::size_t> stack{0};
+  while (!stack.empty()) {
+    const std::size_t i = stack.back();
+    stack.pop_back();
+    const auto& node = tree.node(i);
+    if (node.count > 0) {
+      ASSERT_EQ(node.first, next_triangle) << "leaf " << i;
+      ASSERT_LE(node.count, 4u);
+      next_triangle += node.count, ++leaves;
+      continue;
+    }
+    ASSERT_EQ(node.first, next_pair) << "inner node " << i;
+    next_pair += 2;
+    for (std::size_t c : {std::size_t(node.first), std::size_t(node.first) + 1})
+      for (int k = 0; k < 3; ++k)
+        ASSERT_TRUE(node.lo[k] <= tree.node(c).lo[k] && tree.node(c).hi[k] <= node.hi[k]) << "node " << i;
+    stack.push_back(node.first + 1);  // the right child after the whole left subtree
+    stack.push_back(node.first);
+  }
+  EXPECT_EQ(next_triangle, s.corners.size() / 9);
+  EXPECT_EQ(next_pair, tree.node_count());
+  EXPECT_GT(leaves, s.corners.size() / 9 / 4);
 }
 
 // A tree of an indexed mesh (TriangleBvh's second form: it keeps the vertices and each face's

@@ -1496,16 +1496,11 @@ class Repairer {
 }  // namespace
 
 std::vector<std::uint8_t> points_on_border(std::span<const std::uint32_t> indices,
-                                           std::span<const std::uint32_t> point_source) {
-  // The edges through the per-vertex face lists, as the simplifier finds its borders: linear, where
-  // a sort of every face's three edges was the largest serial step of the repair's set-up on
-  // million-face inputs.
+                                           std::span<const std::uint32_t> point_source, unsigned threads) {
   const std::span<const std::uint32_t> faces = indices.first(indices.size() - indices.size() % 3);
   std::size_t vertex_count = 0;
   for (std::uint32_t v : faces) vertex_count = std::max<std::size_t>(vertex_count, std::size_t(v) + 1);
-  std::vector<std::uint8_t> border(vertex_count, 0);
-  for (const Edge& e : unique_edges(faces, vertex_count))
-    if (e.faces == 1) border[e.lo] = border[e.hi] = 1;
+  const std::vector<std::uint8_t> border = border_vertices(faces, vertex_count, threads);
   std::vector<std::uint8_t> on(point_source.size(), 0);
   for (std::size_t p = 0; p < point_source.size(); ++p)
     on[p] = point_source[p] < vertex_count && border[point_source[p]];

@@ -149,9 +149,9 @@ struct FarRepairResult {
 /// positions of the moved vertices; the counts of faces and vertices stay, but for the
 /// relocations' `dropped` faces and `added` vertices.
 /// Per point of `point_source` (an input vertex each, FitPoints::source): 1 where that vertex is an
-/// end of an edge that only one of `indices`' faces has.
+/// end of an edge that only one of `indices`' faces has; the same on any number of `threads`.
 std::vector<std::uint8_t> points_on_border(std::span<const std::uint32_t> indices,
-                                           std::span<const std::uint32_t> point_source);
+                                           std::span<const std::uint32_t> point_source, unsigned threads);
 
 FarRepairResult repair_far_places(Mesh& approx, const Frame& frame, const SurfaceDistance& surface,
                                   std::span<const double> points, std::span<const double> weights,

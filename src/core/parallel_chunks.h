@@ -11,6 +11,7 @@
 #include <thread>
 #include <vector>
 
+#include "core/default_init_allocator.h"
 #include "core/thread_pool.h"
 
 namespace qem::core {
@@ -42,6 +43,18 @@ void for_chunks(std::size_t n, std::size_t chunk_size, unsigned threads, Fn&& fn
   run_with_helpers(extra, work);
   for (const std::exception_ptr& failure : failures)
     if (failure) std::rethrow_exception(failure);
+}
+
+/// n copies of `value`, written in fixed chunks on the threads: a large array's first writes are
+/// the kernel's page faults, a serial stretch when one thread makes them (the same array on any
+/// number of threads).
+template <class T>
+UnzeroedVector<T> filled(std::size_t n, T value, unsigned threads) {
+  UnzeroedVector<T> out(n);
+  for_chunks(n, std::size_t(1) << 16, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
+    std::fill(out.begin() + std::ptrdiff_t(begin), out.begin() + std::ptrdiff_t(end), value);
+  });
+  return out;
 }
 
 /// Two independent pieces of work: side by side when there are threads (one of them on a helper

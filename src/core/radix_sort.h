@@ -10,6 +10,8 @@
 #include <cstring>
 #include <vector>
 
+#include "core/parallel_chunks.h"
+
 namespace qem::core {
 
 inline std::uint32_t sortable_bits(float key) {
@@ -21,12 +23,42 @@ inline std::uint32_t sortable_bits(float key) {
 /// Sorts `ids` by the unsigned key key_of(id), stably. `scratch` is reused storage. The keys are
 /// read again in each digit pass instead of being stored beside the ids: half the memory, which
 /// matters more than the extra reads on the meshes this sorts. `Ids`: a vector of uint32 (any
-/// allocator).
+/// allocator). With `threads`, a large array's passes run in fixed chunks on the threads: each
+/// chunk counts its digits, and scatters to where the chunks before it (and the smaller digits)
+/// end, which is where the one-thread pass puts each id: the same order on any number of threads.
+/// (On a ten-million-face mesh the serial sort was a tenth of a second beside idle threads.)
 template <class Ids, class KeyOf>
-void radix_sort_by_key(Ids& ids, Ids& scratch, KeyOf key_of) {
+void radix_sort_by_key(Ids& ids, Ids& scratch, KeyOf key_of, unsigned threads = 1) {
   constexpr int kBits = 11, kBuckets = 1 << kBits, kDigits = 3;
+  constexpr std::size_t kChunk = std::size_t(1) << 18;
   const std::size_t n = ids.size();
   scratch.resize(n);
+  if (threads > 1 && n > kChunk) {
+    const std::size_t chunks = (n + kChunk - 1) / kChunk;
+    std::vector<std::array<std::uint32_t, kBuckets>> count(chunks);
+    for (int d = 0; d < kDigits; ++d) {
+      const auto digit = [&](std::uint32_t id) { return (key_of(id) >> (d * kBits)) & (kBuckets - 1); };
+      for_chunks(n, kChunk, threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
+        count[c].fill(0);
+        for (std::size_t i = begin; i < end; ++i) ++count[c][digit(ids[i])];
+      });
+      std::uint32_t sum = 0;  // each (digit, chunk) bucket's start: digits in order, chunks within
+      for (int b = 0; b < kBuckets; ++b)
+        for (std::size_t c = 0; c < chunks; ++c) {
+          const std::uint32_t here = count[c][b];
+          count[c][b] = sum;
+          sum += here;
+        }
+      for_chunks(n, kChunk, threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) {
+          const std::uint32_t id = ids[i];
+          scratch[count[c][digit(id)]++] = id;
+        }
+      });
+      ids.swap(scratch);
+    }
+    return;
+  }
   std::vector<std::array<std::uint32_t, kBuckets>> count(kDigits);
   for (auto& c : count) c.fill(0);
   for (std::size_t i = 0; i < n; ++i) {

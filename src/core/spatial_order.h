@@ -33,7 +33,7 @@ inline std::uint64_t spread_bits_3d(std::uint64_t x) {
 /// Indices 0..n-1 sorted by the Morton code of point_of(i) (a Vec3) over the points' bounding
 /// box, ties by index: the order is fully determined by the input. The box and the codes are made
 /// in fixed chunks on up to `threads` threads (per-chunk boxes merged in chunk order: min and max
-/// are exact), the sort on the calling thread: the same order on any number of threads.
+/// are exact), and so is the sort (radix_sort.h): the same order on any number of threads.
 template <class PointOf>
 std::vector<std::uint32_t> morton_order(std::size_t n, PointOf point_of, unsigned threads = 1) {
   constexpr std::size_t kChunk = std::size_t(1) << 16;
@@ -72,7 +72,7 @@ std::vector<std::uint32_t> morton_order(std::size_t n, PointOf point_of, unsigne
   // equal top bits, almost always a single point, by its full code. Linear time, so cheaper on
   // large meshes than the comparison sort of (code, index) it replaces (docs/benchmarks.md,
   // "Measurements behind the code").
-  radix_sort_by_key(order, scratch, [&](std::uint32_t i) { return std::uint32_t(code[i] >> 31); });
+  radix_sort_by_key(order, scratch, [&](std::uint32_t i) { return std::uint32_t(code[i] >> 31); }, threads);
   for (std::size_t begin = 0, end; begin < n; begin = end) {
     end = begin + 1;
     while (end < n && code[order[end]] >> 31 == code[order[begin]] >> 31) ++end;

@@ -6,6 +6,7 @@
 
 #include <nanoflann.hpp>
 
+#include "core/parallel_chunks.h"
 #include "core/small_sort.h"
 #include "qem/error.h"
 
@@ -47,6 +48,37 @@ std::vector<Edge> unique_edges(std::span<const std::uint32_t> triangles, std::si
     for (std::size_t c = 0; c < triangles.size(); ++c) emit(triangles[c], std::uint32_t(c / 3));
   });
   return unique_edges(triangles, faces, vertex_count);
+}
+
+std::vector<std::uint8_t> border_vertices(std::span<const std::uint32_t> triangles, std::size_t vertex_count,
+                                          unsigned threads) {
+  VertexLists faces;
+  faces.rebuild(vertex_count, [&](auto emit) {
+    for (std::size_t c = 0; c < triangles.size(); ++c) emit(triangles[c], std::uint32_t(c / 3));
+  });
+  std::vector<std::uint8_t> border(vertex_count);
+  constexpr std::size_t kChunk = std::size_t(1) << 14;
+  for_chunks(vertex_count, kChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> other;  // v's neighbours, how many faces each
+    for (std::size_t v = begin; v < end; ++v) {
+      other.clear();
+      // A face listed k times at v (k corners at v) counts each other corner k times, as
+      // unique_edges counts it from the edge's lower end.
+      for (std::uint32_t f : faces[std::uint32_t(v)])
+        for (int k = 0; k < 3; ++k) {
+          const std::uint32_t w = triangles[3 * std::size_t(f) + k];
+          if (w == v) continue;
+          auto it = std::find_if(other.begin(), other.end(), [w](const auto& o) { return o.first == w; });
+          if (it == other.end())
+            other.push_back({w, 1});
+          else
+            ++it->second;
+        }
+      const bool single = std::any_of(other.begin(), other.end(), [](const auto& o) { return o.second == 1; });
+      border[v] = single;
+    }
+  });
+  return border;
 }
 
 namespace {

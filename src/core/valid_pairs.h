@@ -23,6 +23,13 @@ std::vector<Edge> unique_edges(std::span<const std::uint32_t> triangles, const V
 /// The same from the triangle list alone (its face lists made here), for callers that have none.
 std::vector<Edge> unique_edges(std::span<const std::uint32_t> triangles, std::size_t vertex_count);
 
+/// Per vertex of a triangle list, 1 where one of its edges has a single face: the ends of the edges
+/// of unique_edges with `faces == 1`, without making the edge list (twice the faces' memory, all
+/// fresh pages, on the serial path of a large run's repair). Each vertex is decided from its own
+/// faces alone, so the vertices are split among `threads` with the same result on any count.
+std::vector<std::uint8_t> border_vertices(std::span<const std::uint32_t> triangles, std::size_t vertex_count,
+                                          unsigned threads);
+
 /// How many of its nearest vertices within t each vertex pairs with (see close_pairs).
 inline constexpr std::size_t kMaxThresholdPairsPerVertex = 8;
 

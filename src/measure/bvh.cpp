@@ -108,7 +108,7 @@ void TriangleBvh::build(std::size_t count, const CornersOf& corners_of, const st
       order[t] = std::uint32_t(t);
     }
   });
-  core::radix_sort_by_key(order, scratch, [&](std::uint32_t t) { return code[t]; });
+  core::radix_sort_by_key(order, scratch, [&](std::uint32_t t) { return code[t]; }, threads);
   Indices().swap(scratch);
   Indices sorted_code(n);
   core::for_chunks(n, kChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
@@ -118,43 +118,86 @@ void TriangleBvh::build(std::size_t count, const CornersOf& corners_of, const st
 
   // Top down: a range splits where its codes' highest differing bit turns on (a spatial median,
   // as in an octree); a range of equal codes splits in half. The depth stays below 30 + log2(n).
+  const auto split_point = [&](std::uint32_t begin, std::uint32_t end) {
+    const std::uint32_t lo_code = sorted_code[begin], hi_code = sorted_code[end - 1];
+    if (lo_code == hi_code) return begin + (end - begin) / 2;
+    const std::uint32_t bit = std::uint32_t(1) << (31 - std::countl_zero(lo_code ^ hi_code));
+    // The codes share every bit above `bit`, so `bit` is off, then on, along the range.
+    return std::uint32_t(std::partition_point(sorted_code.begin() + begin, sorted_code.begin() + end,
+                                              [&](std::uint32_t c) { return (c & bit) == 0; }) -
+                         sorted_code.begin());
+  };
+  // Nodes in depth-first order, left before right; an inner node's children are a pair at `first`
+  // (even slots: slot 1 stays unused), written when the node is, so each subtree's pairs are one
+  // run of slots. The ranges of at most kSubtree triangles are split on the threads (each into the
+  // run of slots its subtree takes, counted first), the few above them here: serial, the split and
+  // its first writes to the node array's fresh pages were seconds of a ten-million-face run. The
+  // layout is the one a single depth-first pass makes, on any number of threads.
   // Room for the most nodes there can be: every leaf holds a triangle at least, so at most n
   // leaves and n - 1 inner nodes, and slot 1. Pages are taken as the nodes are written (about
   // 0.65 n of them on scanned meshes), and never copied to a larger array.
-  nodes_.resize(2 * std::size_t(n) + 1);
-  std::size_t used = 2;
-  nodes_[0] = {};
-  nodes_[1] = {};  // slot 1, unused: pairs of children start at even slots
-  struct Task {
-    std::uint32_t node, begin, end;
+  constexpr std::uint32_t kSubtree = std::uint32_t(1) << 15;
+  struct Subtree {
+    std::uint32_t node = 0, begin = 0, end = 0, first = 0, pairs = 0;
   };
-  std::vector<Task> stack{{0, 0, n}};
-  while (!stack.empty()) {
-    const Task task = stack.back();
-    stack.pop_back();
-    nodes_[task.node].first = task.begin;
-    nodes_[task.node].count = task.end - task.begin;
-    if (task.end - task.begin <= kLeaf) continue;
-    const std::uint32_t lo_code = sorted_code[task.begin], hi_code = sorted_code[task.end - 1];
-    std::uint32_t mid;
-    if (lo_code == hi_code) {
-      mid = task.begin + (task.end - task.begin) / 2;
-    } else {
-      const std::uint32_t bit = std::uint32_t(1) << (31 - std::countl_zero(lo_code ^ hi_code));
-      // The codes share every bit above `bit`, so `bit` is off, then on, along the range.
-      mid =
-          std::uint32_t(std::partition_point(sorted_code.begin() + task.begin, sorted_code.begin() + task.end,
-                                             [&](std::uint32_t c) { return (c & bit) == 0; }) -
-                        sorted_code.begin());
+  std::vector<Subtree> subtrees;
+  const auto find_subtrees = [&](auto&& self, std::uint32_t begin, std::uint32_t end) -> void {
+    if (end - begin <= kSubtree) {
+      subtrees.push_back({0, begin, end, 0, 0});
+      return;
     }
-    const std::uint32_t left = std::uint32_t(used);
-    nodes_[used++] = {};
-    nodes_[used++] = {};
-    nodes_[task.node].first = left;
-    nodes_[task.node].count = 0;
-    stack.push_back({left + 1, mid, task.end});
-    stack.push_back({left, task.begin, mid});
-  }
+    const std::uint32_t mid = split_point(begin, end);
+    self(self, begin, mid);
+    self(self, mid, end);
+  };
+  find_subtrees(find_subtrees, 0, n);
+  const auto count_pairs = [&](auto&& self, std::uint32_t begin, std::uint32_t end) -> std::uint32_t {
+    if (end - begin <= kLeaf) return 0;
+    const std::uint32_t mid = split_point(begin, end);
+    return 1 + self(self, begin, mid) + self(self, mid, end);
+  };
+  core::for_chunks(subtrees.size(), 1, threads, [&](std::size_t i, std::size_t, std::size_t) {
+    subtrees[i].pairs = count_pairs(count_pairs, subtrees[i].begin, subtrees[i].end);
+  });
+  nodes_.resize(2 * std::size_t(n) + 1);
+  nodes_[1] = {};  // slot 1, unused: pairs of children start at even slots
+  std::uint32_t used = 2;
+  std::vector<std::uint32_t> top_inner;  // the inner nodes above the subtrees, parents first
+  std::size_t next_subtree = 0;
+  const auto place = [&](auto&& self, std::uint32_t node, std::uint32_t begin, std::uint32_t end) -> void {
+    if (end - begin <= kSubtree) {
+      Subtree& t = subtrees[next_subtree++];
+      t.node = node, t.first = used;
+      used += 2 * t.pairs;
+      return;
+    }
+    const std::uint32_t mid = split_point(begin, end), left = used;
+    used += 2;
+    nodes_[node] = {};
+    nodes_[node].first = left;
+    nodes_[node].count = 0;
+    top_inner.push_back(node);
+    self(self, left, begin, mid);
+    self(self, left + 1, mid, end);
+  };
+  place(place, 0, 0, n);
+  const auto write = [&](auto&& self, std::uint32_t node, std::uint32_t begin, std::uint32_t end,
+                         std::uint32_t& next) -> void {
+    nodes_[node] = {};
+    nodes_[node].first = begin;
+    nodes_[node].count = end - begin;
+    if (end - begin <= kLeaf) return;
+    const std::uint32_t mid = split_point(begin, end), left = next;
+    next += 2;
+    nodes_[node].first = left;
+    nodes_[node].count = 0;
+    self(self, left, begin, mid, next);
+    self(self, left + 1, mid, end, next);
+  };
+  core::for_chunks(subtrees.size(), 1, threads, [&](std::size_t i, std::size_t, std::size_t) {
+    std::uint32_t next = subtrees[i].first;
+    write(write, subtrees[i].node, subtrees[i].begin, subtrees[i].end, next);
+  });
   nodes_.resize(used);
   Indices().swap(sorted_code);
   // The triangles in leaf order, so that a leaf reads contiguous memory (here, for its box, too).
@@ -191,12 +234,19 @@ void TriangleBvh::build(std::size_t count, const CornersOf& corners_of, const st
       set_box(node, b);
     }
   });
-  for (std::size_t i = nodes_.size(); i-- > 0;) {
+  // Each subtree's run of slots from the end (children come after their parent), then its root,
+  // on the threads; then the nodes above the subtrees, children first.
+  const auto inner_box = [&](std::size_t i) {
     Node& node = nodes_[i];
-    if (node.count > 0 || i == 1) continue;
+    if (node.count > 0) return;
     const Node &l = nodes_[node.first], &r = nodes_[node.first + 1];
     for (int k = 0; k < 3; ++k) node.lo[k] = std::min(l.lo[k], r.lo[k]), node.hi[k] = std::max(l.hi[k], r.hi[k]);
-  }
+  };
+  core::for_chunks(subtrees.size(), 1, threads, [&](std::size_t t, std::size_t, std::size_t) {
+    for (std::size_t i = subtrees[t].first + 2 * std::size_t(subtrees[t].pairs); i-- > subtrees[t].first;) inner_box(i);
+    inner_box(subtrees[t].node);
+  });
+  for (std::size_t i = top_inner.size(); i-- > 0;) inner_box(top_inner[i]);
 }
 
 TriangleBvh::TriangleBvh(std::span<const double> corners, unsigned threads) {

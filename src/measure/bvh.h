@@ -73,7 +73,6 @@ class TriangleBvh {
   std::size_t node_count() const { return nodes_.size(); }
   bool empty() const { return ids_.empty(); }
 
- private:
   // The box in floats, rounded outward: a search prunes by the box's distance, which may only be
   // smaller than the true one, so the answers are those of double boxes, from half the memory.
   // Two children (32 bytes each) are read together: slot 1 of nodes_ is left empty, so that every
@@ -81,10 +80,14 @@ class TriangleBvh {
   // large arrays are: cli/huge_pages.cpp).
   struct Node {
     float lo[3], hi[3];
-    std::uint32_t first;  ///< leaf: first triangle; inner: left child (right child = first + 1)
+    std::uint32_t first;  ///< leaf: first stored triangle; inner: left child (right child = first + 1)
     std::uint32_t count;  ///< triangles in a leaf; 0 for an inner node
   };
   static_assert(sizeof(Node) == 32);
+  /// Node i (0: the root), for tests of the layout.
+  const Node& node(std::size_t i) const { return nodes_[i]; }
+
+ private:
   // `corners_of(t, out)`: triangle t's 9 coordinates; `indices`: 3 vertex indices per triangle
   // (into vertices_) for the indexed form, stored instead of the coordinates; nullptr otherwise.
   template <class CornersOf>

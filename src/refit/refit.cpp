@@ -82,6 +82,8 @@ constexpr double kFarHausdorff = 2;
 constexpr double kHausdorffMargin = 0.02;
 /// Doubles per face in Refitter::bounding_spheres: centre, radius, unit normal, padding.
 constexpr std::size_t kSphere = 8;
+/// Those spheres: every double written (on the threads) before any is read.
+using Spheres = core::UnzeroedVector<double>;
 
 Vec3 at(const std::vector<double>& x, std::uint32_t v) { return {x[3 * v], x[3 * v + 1], x[3 * v + 2]}; }
 
@@ -190,7 +192,7 @@ struct SparseRows {
 
 /// y = a x for the three coordinates at once (x, y: 3 per vertex): each row of a read once, rows
 /// in fixed chunks on the threads (each row's sum is made as on one thread).
-void multiply(const SparseRows& a, const std::vector<double>& x, std::vector<double>& y, unsigned threads) {
+void multiply(const SparseRows& a, std::span<const double> x, std::span<double> y, unsigned threads) {
   core::for_chunks(a.diagonal.size(), std::size_t(1) << 14, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
     for (std::size_t v = begin; v < end; ++v) {
       double sum[3] = {0, 0, 0};
@@ -211,7 +213,9 @@ void conjugate_gradients(const SparseRows& a, const std::vector<double>& b, std:
   constexpr double kTolerance = 1e-10;
   constexpr int kMaxSteps = 1000;
   const std::size_t n = a.diagonal.size();
-  std::vector<double> r(3 * n), z(3 * n), p(3 * n), q(3 * n);
+  // Written whole below before they are read; first touched on the threads.
+  core::UnzeroedVector<double> r = core::filled(3 * n, 0.0, threads), z = core::filled(3 * n, 0.0, threads),
+                               p = core::filled(3 * n, 0.0, threads), q = core::filled(3 * n, 0.0, threads);
   double limit[3] = {0, 0, 0}, rz[3] = {0, 0, 0}, rr[3] = {0, 0, 0};
   multiply(a, x, q, threads);
   for (std::size_t v = 0; v < n; ++v)
@@ -381,7 +385,7 @@ class Refitter {
         for (int k = 0; k < 3; ++k) corners[3 * c + k] = x[3 * tri_[c] + k];
       tree = measure_detail::TriangleBvh(corners);
     }
-    std::vector<double> spheres;  // per face: centre and radius, to skip far faces in closest_around
+    Spheres spheres;  // per face: centre and radius, to skip far faces in closest_around
     if (before || !near_vertex_.empty()) spheres = bounding_spheres(x);
     Projection p;
     p.nearest.resize(count);
@@ -418,9 +422,9 @@ class Refitter {
   // mean, radius = the farthest corner's distance plus 1e-12 (of the diagonal: the frame is
   // normalised), far above the rounding of the distances (~1e-16), so a face the bound skips could
   // never have been the closest; and the face's unit normal (kSphere doubles a face).
-  std::vector<double> bounding_spheres(const std::vector<double>& x) const {
-    std::vector<double> out(tri_.size() / 3 * kSphere);
-    for (std::size_t f = 0; f < tri_.size() / 3; ++f) {
+  Spheres bounding_spheres(const std::vector<double>& x) const {
+    Spheres out(tri_.size() / 3 * kSphere);
+    const auto sphere = [&](std::size_t f) {
       const std::uint32_t* t = &tri_[3 * f];
       const Vec3 a = at(x, t[0]), b = at(x, t[1]), c = at(x, t[2]);
       const Vec3 m = (1.0 / 3) * (a + b + c);
@@ -434,7 +438,11 @@ class Refitter {
       const double nn = dot(n, n), ee = dot(e1, e1) * dot(e2, e2);
       const double scale = nn > 1e-12 * ee && nn > 0 ? 1 / std::sqrt(nn) : 0.0;
       o[4] = n.x * scale, o[5] = n.y * scale, o[6] = n.z * scale;
-    }
+    };
+    core::for_chunks(tri_.size() / 3, kChunk, core::resolve_threads(opt_.threads),
+                     [&](std::size_t, std::size_t begin, std::size_t end) {
+                       for (std::size_t f = begin; f < end; ++f) sphere(f);
+                     });
     return out;
   }
 
@@ -443,7 +451,7 @@ class Refitter {
   // bounding sphere lies farther away than the closest point so far cannot be closer and is
   // skipped: the answer of testing every face, for a fraction of the point-triangle tests.
   measure_detail::TriangleBvh::Hit closest_around(const std::vector<double>& x,
-                                                  const std::vector<double>& spheres, const double* q,
+                                                  const Spheres& spheres, const double* q,
                                                   std::uint32_t f) const {
     measure_detail::TriangleBvh::Hit hit;
     double reach = HUGE_VAL;  // sqrt(hit.d2)
@@ -535,7 +543,7 @@ class Refitter {
   // bounds a pathological case. It ends in a local minimum: the tree's answer unless a closer face
   // lies beyond a farther one (never, on the benchmark meshes: docs/benchmarks.md).
   measure_detail::TriangleBvh::Hit closest_by_walk(const std::vector<double>& x,
-                                                   const std::vector<double>& spheres, const double* q,
+                                                   const Spheres& spheres, const double* q,
                                                    std::uint32_t v) const {
     std::uint32_t f = UINT32_MAX;
     double nearest = HUGE_VAL;
@@ -559,7 +567,9 @@ class Refitter {
     // Per face, the 3x3 block sum_i w_i b_i b_i^T, each corner's row stored at the corner's place
     // in its vertex's ring (so that the matrix below reads them in order); per vertex,
     // sum_i w_i b_i p_i.
-    std::vector<double> block(9 * nf, 0.0), rhs(3 * n, 0.0), data(n, 0.0);
+    const unsigned threads = core::resolve_threads(opt_.threads);
+    core::UnzeroedVector<double> block = core::filled(9 * nf, 0.0, threads), rhs = core::filled(3 * n, 0.0, threads),
+                                 data = core::filled(n, 0.0, threads);
     const auto block_row = [&](std::size_t f, int r) {
       return &block[3 * std::size_t(ring_slot_[3 * f + r])];
     };
@@ -599,42 +609,64 @@ class Refitter {
       }
     // The matrix, row by row: for each face around the row's vertex (in the ring's order: by
     // face), that vertex's row of the face's block. Fixed vertices are eliminated: their row is
-    // the identity, their column moves to the rhs.
+    // the identity, their column moves to the rhs. A row reads and writes only its own vertex's
+    // entries, so the rows are made in fixed chunks on the threads and joined in chunk order: the
+    // matrix of one pass in vertex order, on any number of threads.
+    constexpr std::size_t kRowChunk = std::size_t(1) << 14;
+    struct Rows {
+      std::vector<std::uint32_t> column, end;  // end: each row's end within the chunk's columns
+      std::vector<double> value;
+    };
+    std::vector<Rows> chunk_rows((n + kRowChunk - 1) / kRowChunk);
     SparseRows a;
-    a.column.reserve(8 * n), a.value.reserve(8 * n), a.diagonal.resize(n), a.start.reserve(n + 1);
-    std::vector<std::uint32_t> slot(n, UINT32_MAX);  // where a column is in the row being made
-    std::vector<std::pair<std::uint32_t, double>> row;
+    a.diagonal.resize(n);
     std::vector<double> b(3 * n);
-    for (std::uint32_t v = 0; v < n; ++v) {
-      row.clear();
-      const auto add = [&](std::uint32_t c, double value) {
-        if (slot[c] == UINT32_MAX) slot[c] = std::uint32_t(row.size()), row.emplace_back(c, 0.0);
-        row[slot[c]].second += value;
-      };
-      for (std::uint32_t i = ring_start_[v]; i < ring_start_[v + 1] && !fixed_[v]; ++i) {
-        const std::uint32_t* t = &tri_[3 * std::size_t(ring_faces_[i])];
-        for (int c = 0; c < 3; ++c) {
-          const double entry = block[3 * std::size_t(i) + c];
-          if (entry == 0) continue;
-          if (fixed_[t[c]])
-            for (int k = 0; k < 3; ++k) rhs[3 * v + k] -= entry * x_[3 * t[c] + k];
-          else
-            add(t[c], entry);
+    core::for_chunks(n, kRowChunk, threads, [&](std::size_t chunk, std::size_t begin, std::size_t end) {
+      Rows& out = chunk_rows[chunk];
+      out.column.reserve(8 * (end - begin)), out.value.reserve(8 * (end - begin)), out.end.reserve(end - begin);
+      std::vector<std::pair<std::uint32_t, double>> row;  // a few columns: found by a scan
+      for (std::uint32_t v = std::uint32_t(begin); v < end; ++v) {
+        row.clear();
+        const auto add = [&](std::uint32_t c, double value) {
+          auto it = std::find_if(row.begin(), row.end(), [c](const auto& e) { return e.first == c; });
+          if (it == row.end()) it = row.insert(row.end(), {c, 0.0});
+          it->second += value;
+        };
+        for (std::uint32_t i = ring_start_[v]; i < ring_start_[v + 1] && !fixed_[v]; ++i) {
+          const std::uint32_t* t = &tri_[3 * std::size_t(ring_faces_[i])];
+          for (int c = 0; c < 3; ++c) {
+            const double entry = block[3 * std::size_t(i) + c];
+            if (entry == 0) continue;
+            if (fixed_[t[c]])
+              for (int k = 0; k < 3; ++k) rhs[3 * v + k] -= entry * x_[3 * t[c] + k];
+            else
+              add(t[c], entry);
+          }
         }
+        // Vertices without data stay put (their row is lambda X = lambda X_old at full weight).
+        const double lambda = fixed_[v] ? 1.0 : data[v] > 0 ? kAnchor * mean : mean;
+        add(v, lambda);
+        std::sort(row.begin(), row.end());
+        for (const auto& [c, value] : row) {
+          out.column.push_back(c), out.value.push_back(value);
+          if (c == v) a.diagonal[v] = value;
+        }
+        out.end.push_back(std::uint32_t(out.column.size()));
+        for (int k = 0; k < 3; ++k)
+          b[3 * v + k] = fixed_[v] ? x_[3 * v + k] : rhs[3 * v + k] + lambda * x_[3 * v + k];
       }
-      // Vertices without data stay put (their row is lambda X = lambda X_old at full weight).
-      const double lambda = fixed_[v] ? 1.0 : data[v] > 0 ? kAnchor * mean : mean;
-      add(v, lambda);
-      for (const auto& [c, value] : row) slot[c] = UINT32_MAX;
-      std::sort(row.begin(), row.end());
-      for (const auto& [c, value] : row) {
-        a.column.push_back(c), a.value.push_back(value);
-        if (c == v) a.diagonal[v] = value;
-      }
-      a.start.push_back(std::uint32_t(a.column.size()));
-      for (int k = 0; k < 3; ++k)
-        b[3 * v + k] = fixed_[v] ? x_[3 * v + k] : rhs[3 * v + k] + lambda * x_[3 * v + k];
-    }
+    });
+    std::vector<std::size_t> offset(chunk_rows.size() + 1, 0);
+    for (std::size_t c = 0; c < chunk_rows.size(); ++c) offset[c + 1] = offset[c] + chunk_rows[c].column.size();
+    a.start.resize(n + 1);
+    a.column.resize(offset.back()), a.value.resize(offset.back());
+    core::for_chunks(chunk_rows.size(), 1, threads, [&](std::size_t c, std::size_t, std::size_t) {
+      Rows& rows = chunk_rows[c];
+      std::copy(rows.column.begin(), rows.column.end(), a.column.begin() + std::ptrdiff_t(offset[c]));
+      std::copy(rows.value.begin(), rows.value.end(), a.value.begin() + std::ptrdiff_t(offset[c]));
+      for (std::size_t i = 0; i < rows.end.size(); ++i) a.start[c * kRowChunk + i + 1] = std::uint32_t(offset[c] + rows.end[i]);
+      rows = Rows();
+    });
     next = x_;  // the guess: where the vertices are
     conjugate_gradients(a, b, next, core::resolve_threads(opt_.threads));
     for (std::size_t v = 0; v < n; ++v)
