@@ -73,13 +73,25 @@ std::vector<std::uint32_t> morton_order(std::size_t n, PointOf point_of, unsigne
   // large meshes than the comparison sort of (code, index) it replaces (docs/benchmarks.md,
   // "Measurements behind the code").
   radix_sort_by_key(order, scratch, [&](std::uint32_t i) { return std::uint32_t(code[i] >> 31); }, threads);
-  for (std::size_t begin = 0, end; begin < n; begin = end) {
-    end = begin + 1;
-    while (end < n && code[order[end]] >> 31 == code[order[begin]] >> 31) ++end;
-    if (end - begin > 1)
-      std::sort(order.begin() + std::ptrdiff_t(begin), order.begin() + std::ptrdiff_t(end),
-                [&](std::uint32_t a, std::uint32_t b) { return code[a] != code[b] ? code[a] < code[b] : a < b; });
-  }
+  // On the threads: first where each chunk's first run starts (reads only; a run may reach
+  // through several chunks), then the runs from there to the next chunk's first, each sorted
+  // whole by one thread: the same order on any number.
+  const auto top = [&](std::size_t k) { return code[order[k]] >> 31; };
+  const std::size_t chunks = (n + kChunk - 1) / kChunk;
+  std::vector<std::size_t> run_start(chunks + 1, n);
+  for_chunks(n, kChunk, threads, [&](std::size_t c, std::size_t begin, std::size_t) {
+    while (begin > 0 && begin < n && top(begin) == top(begin - 1)) ++begin;
+    run_start[c] = begin;
+  });
+  for_chunks(chunks, 1, threads, [&](std::size_t c, std::size_t, std::size_t) {
+    for (std::size_t begin = run_start[c], end; begin < run_start[c + 1]; begin = end) {
+      end = begin + 1;
+      while (end < run_start[c + 1] && top(end) == top(begin)) ++end;  // runs end at the next start
+      if (end - begin > 1)
+        std::sort(order.begin() + std::ptrdiff_t(begin), order.begin() + std::ptrdiff_t(end),
+                  [&](std::uint32_t a, std::uint32_t b) { return code[a] != code[b] ? code[a] < code[b] : a < b; });
+    }
+  });
   return order;
 }
 

@@ -163,21 +163,25 @@ FitPoints::FitPoints(std::span<const double> points, std::span<const double> wei
   }, threads);
 }
 
-FitPoints FitPoints::thinned(std::size_t group) const {
+FitPoints FitPoints::thinned(std::size_t group, unsigned threads) const {
   FitPoints out;
   out.centre = centre, out.diag = diag;
-  const std::size_t n = order.size();
-  for (std::size_t begin = 0; begin < n; begin += group) {
-    const std::size_t end = std::min(n, begin + group);
-    double w = 0;
-    for (std::size_t k = begin; k < end; ++k) w += weight[order[k]];
-    const std::uint32_t middle = order[begin + (end - begin) / 2];
-    out.position.insert(out.position.end(), &position[3 * middle], &position[3 * middle] + 3);
-    out.weight.push_back(w);
-    out.source.push_back(source[middle]);
-    out.order.push_back(std::uint32_t(out.order.size()));  // runs follow the Morton order
-    out.total_weight += w;
-  }
+  const std::size_t n = order.size(), runs = (n + group - 1) / group;
+  out.position.resize(3 * runs), out.weight.resize(runs), out.source.resize(runs), out.order.resize(runs);
+  // Each run on its own (in fixed chunks of runs on the threads); the total in run order.
+  core::for_chunks(runs, kChunk, threads, [&](std::size_t, std::size_t first_run, std::size_t end_run) {
+    for (std::size_t r = first_run; r < end_run; ++r) {
+      const std::size_t begin = r * group, end = std::min(n, begin + group);
+      double w = 0;
+      for (std::size_t k = begin; k < end; ++k) w += weight[order[k]];
+      const std::uint32_t middle = order[begin + (end - begin) / 2];
+      std::copy_n(&position[3 * std::size_t(middle)], 3, &out.position[3 * r]);
+      out.weight[r] = w;
+      out.source[r] = source[middle];
+      out.order[r] = std::uint32_t(r);  // runs follow the Morton order
+    }
+  });
+  for (std::size_t r = 0; r < runs; ++r) out.total_weight += out.weight[r];
   return out;
 }
 
@@ -896,7 +900,7 @@ RefitResult refit_to_points(const FitPoints& points, Mesh& approx, const RefitOp
   const std::size_t n = points.weight.size();
   std::size_t group = 0;  // 0 or 1: every point
   if (wanted > 0) group = wanted <= 1 ? n : std::size_t(double(n) / wanted);
-  const FitPoints sample = group >= 2 ? points.thinned(group) : FitPoints{};
+  const FitPoints sample = group >= 2 ? points.thinned(group, core::resolve_threads(options.threads)) : FitPoints{};
   Refitter refitter(group >= 2 ? sample : points, approx, options, near_vertex, surface);
   return refitter.run();
 }

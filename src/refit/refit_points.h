@@ -29,8 +29,9 @@ struct FitPoints {
   /// on up to `threads` threads, the same on any number.
   FitPoints(std::span<const double> points, std::span<const double> weights, unsigned threads = 1);
   /// One point for each run of `group` consecutive points in Morton order: the run's middle
-  /// point, carrying the run's summed weight (RefitOptions::points_per_vertex). Same frame.
-  FitPoints thinned(std::size_t group) const;
+  /// point, carrying the run's summed weight (RefitOptions::points_per_vertex). Same frame; the
+  /// same points on any number of `threads`.
+  FitPoints thinned(std::size_t group, unsigned threads = 1) const;
   // (Filled on the threads when made, not zeroed first: on a large input these are otherwise a
   // serial stretch of fresh pages.)
   core::UnzeroedVector<double> position;       ///< 3 per kept point, normalised
