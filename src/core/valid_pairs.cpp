@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <string>
 
 #include <nanoflann.hpp>
@@ -56,6 +57,7 @@ std::vector<std::uint8_t> border_vertices(std::span<const std::uint32_t> triangl
   // the fill in corner order on this thread, the arrays' pages first touched on the threads (on a
   // ten-million-face input those faults were most of this step).
   const std::size_t corners = triangles.size() - triangles.size() % 3;
+  if (corners >= 0xffffffffu) throw std::length_error("border_vertices: face lists beyond 32-bit offsets");
   UnzeroedVector<std::uint32_t> start = filled(vertex_count + 1, std::uint32_t(0), threads);
   for (std::size_t c = 0; c < corners; ++c) ++start[triangles[c] + 1];
   for (std::size_t v = 0; v < vertex_count; ++v) start[v + 1] += start[v];

@@ -27,6 +27,7 @@ std::vector<Edge> unique_edges(std::span<const std::uint32_t> triangles, std::si
 /// of unique_edges with `faces == 1`, without making the edge list (12 bytes an edge, all
 /// fresh pages, on the serial path of a large run's repair). Each vertex is decided from its own
 /// faces alone, so the vertices are split among `threads` with the same result on any count.
+/// Every index must be below `vertex_count`.
 std::vector<std::uint8_t> border_vertices(std::span<const std::uint32_t> triangles, std::size_t vertex_count,
                                           unsigned threads);
 
