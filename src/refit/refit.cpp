@@ -672,7 +672,7 @@ class Refitter {
       rows = Rows();
     });
     next = x_;  // the guess: where the vertices are
-    conjugate_gradients(a, b, next, core::resolve_threads(opt_.threads));
+    conjugate_gradients(a, b, next, threads);
     for (std::size_t v = 0; v < n; ++v)
       for (int k = 0; k < 3; ++k)
         if (fixed_[v] || !std::isfinite(next[3 * v + k])) next[3 * v + k] = x_[3 * v + k];
