@@ -76,8 +76,7 @@ class TriangleBvh {
   // The box in floats, rounded outward: a search prunes by the box's distance, which may only be
   // smaller than the true one, so the answers are those of double boxes, from half the memory.
   // Two children (32 bytes each) are read together: slot 1 of nodes_ is left empty, so that every
-  // pair starts at an even slot, one 64-byte line where the array is so aligned (the executable's
-  // large arrays are: cli/huge_pages.cpp).
+  // pair starts at an even slot, one 64-byte line (nodes_ is so aligned).
   struct Node {
     float lo[3], hi[3];
     std::uint32_t first;  ///< leaf: first stored triangle; inner: left child (right child = first + 1)
@@ -113,7 +112,7 @@ class TriangleBvh {
   }
 
   // Written whole by the build before any read: not zero-filled first.
-  core::UnzeroedVector<Node> nodes_;
+  std::vector<Node, core::AlignedDefaultInitAllocator<Node, 64>> nodes_;
   // The triangles in leaf order: 9 coordinates each (tris_), or, for an indexed mesh, 3 indices
   // each (corner_index_, empty in the other form) into the vertices (vertices_).
   core::UnzeroedVector<double> tris_;
