@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 #include <string>
 
 #include <nanoflann.hpp>
 
+#include "core/faces_at_vertices.h"
 #include "core/parallel_chunks.h"
 #include "core/small_sort.h"
 #include "qem/error.h"
@@ -53,24 +53,7 @@ std::vector<Edge> unique_edges(std::span<const std::uint32_t> triangles, std::si
 
 std::vector<std::uint8_t> border_vertices(std::span<const std::uint32_t> triangles, std::size_t vertex_count,
                                           unsigned threads) {
-  // Each vertex's faces (a face once per corner at the vertex), by a counting sort: the counts and
-  // the fill in corner order on this thread, the arrays' pages first touched on the threads (on a
-  // ten-million-face input those faults were most of this step).
-  const std::size_t corners = triangles.size() - triangles.size() % 3;
-  if (corners >= 0xffffffffu) throw std::length_error("border_vertices: face lists beyond 32-bit offsets");
-  UnzeroedVector<std::uint32_t> start = filled(vertex_count + 1, std::uint32_t(0), threads);
-  for (std::size_t c = 0; c < corners; ++c) ++start[triangles[c] + 1];
-  for (std::size_t v = 0; v < vertex_count; ++v) start[v + 1] += start[v];
-  UnzeroedVector<std::uint32_t> fill = filled(vertex_count, std::uint32_t(0), threads);
-  UnzeroedVector<std::uint32_t> listed = filled(corners, std::uint32_t(0), threads);
-  for (std::size_t c = 0; c < corners; ++c) {
-    const std::uint32_t v = triangles[c];
-    listed[start[v] + fill[v]++] = std::uint32_t(c / 3);
-  }
-  UnzeroedVector<std::uint32_t>().swap(fill);
-  const auto faces = [&](std::size_t v) {
-    return std::span<const std::uint32_t>(listed.data() + start[v], start[v + 1] - start[v]);
-  };
+  const FacesAtVertices faces = faces_at_vertices(triangles, vertex_count, threads);
   std::vector<std::uint8_t> border(vertex_count);
   constexpr std::size_t kChunk = std::size_t(1) << 14;
   for_chunks(vertex_count, kChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
@@ -79,7 +62,7 @@ std::vector<std::uint8_t> border_vertices(std::span<const std::uint32_t> triangl
       other.clear();
       // A face listed k times at v (k corners at v) counts each other corner k times, as
       // unique_edges counts it from the edge's lower end.
-      for (std::uint32_t f : faces(v))
+      for (std::uint32_t f : faces.at(v))
         for (int k = 0; k < 3; ++k) {
           const std::uint32_t w = triangles[3 * std::size_t(f) + k];
           if (w == v) continue;

@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "core/attribute_weight.h"
+#include "core/faces_at_vertices.h"
 #include "geometry/vec3.h"
 #include "measure/point_triangle.h"
 
@@ -44,15 +45,14 @@ void fit_attributes(std::span<const double> positions, std::span<const std::uint
   };
 
   // The output faces around each output vertex (compressed rows), and each vertex's area share.
-  std::vector<std::uint32_t> start(n + 1, 0), around(out.indices.size());
-  for (std::uint32_t v : out.indices) ++start[v + 1];
-  for (std::size_t v = 0; v < n; ++v) start[v + 1] += start[v];
-  std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+  const core::FacesAtVertices rows = core::faces_at_vertices(out.indices, n, 1);
+  const auto& start = rows.start;
+  const auto& around = rows.faces;
   std::vector<double> area(n, 0);
   for (std::uint32_t f = 0; f < faces; ++f) {
     const std::uint32_t* t = &out.indices[3 * std::size_t(f)];
     const double a = length(cross(out_pos(t[1]) - out_pos(t[0]), out_pos(t[2]) - out_pos(t[0]))) / 2;
-    for (int k = 0; k < 3; ++k) around[fill[t[k]]++] = f, area[t[k]] += a / 3;
+    for (int k = 0; k < 3; ++k) area[t[k]] += a / 3;
   }
 
   // The unknowns: the vertices not held, numbered in order.
