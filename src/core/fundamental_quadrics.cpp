@@ -9,38 +9,58 @@ namespace qem::core {
 
 namespace {
 
-// Face f's plane quadric as its corner k adds it (only angle weighting depends on the corner).
-Quadric plane_of_face(const WorkingMesh& m, std::uint32_t f, int k, Weighting weighting) {
+// A face's unit normal n, offset d (n.x + d = 0 on the plane) and twice its area (0: no plane).
+struct FacePlane {
+  Vec3 n;
+  double d = 0, twice_area = 0;
+};
+
+FacePlane plane_of_face(const WorkingMesh& m, std::uint32_t f) {
   const std::uint32_t* t = m.face(f);
   Vec3 n = cross(m.pos[t[1]] - m.pos[t[0]], m.pos[t[2]] - m.pos[t[0]]);
   const double len = length(n);
-  if (!(len > 0)) return Quadric{};  // zero-area face: no plane (GH97 §5 needs a unit normal)
+  if (!(len > 0)) return {};  // zero-area face: no plane (GH97 §5 needs a unit normal)
   n = n * (1.0 / len);
-  const double d = -dot(n, m.pos[t[0]]);
+  return {n, -dot(n, m.pos[t[0]]), len};
+}
+
+// The plane's quadric as face f's corner k adds it (only angle weighting depends on the corner).
+Quadric corner_quadric(const WorkingMesh& m, std::uint32_t f, int k, const FacePlane& p, Weighting weighting) {
+  if (!(p.twice_area > 0)) return Quadric{};
   switch (weighting) {
-    case Weighting::Area: return Quadric::plane(n, d, len / 2);  // HG99 §2
-    case Weighting::Uniform: return Quadric::plane(n, d, 1);     // GH97 §5
+    case Weighting::Area: return Quadric::plane(p.n, p.d, p.twice_area / 2);  // HG99 §2
+    case Weighting::Uniform: return Quadric::plane(p.n, p.d, 1);              // GH97 §5
     case Weighting::Angle: break;
   }
+  const std::uint32_t* t = m.face(f);
   const Vec3 e1 = m.pos[t[(k + 1) % 3]] - m.pos[t[k]], e2 = m.pos[t[(k + 2) % 3]] - m.pos[t[k]];
-  return Quadric::plane(n, d, std::atan2(length(cross(e1, e2)), dot(e1, e2)));
+  return Quadric::plane(p.n, p.d, std::atan2(length(cross(e1, e2)), dot(e1, e2)));
 }
 
 }  // namespace
 
 void face_quadrics(const WorkingMesh& m, Weighting weighting, unsigned threads, std::vector<Quadric>& quadric) {
   quadric.resize(m.pos.size());
-  // Per vertex over its face list (in face order), so every sum is made in the same order for
-  // any thread count; each face's plane is computed at each of its corners.
-  for_chunks(m.pos.size(), std::size_t(1) << 13, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
-    for (std::size_t v = begin; v < end; ++v) {
-      Quadric q{};
-      for (std::uint32_t f : m.vertex_faces[v]) {
-        if (!m.face_alive[f]) continue;  // the greedy order's lists keep dead faces
-        const std::uint32_t* t = m.face(f);
-        q += plane_of_face(m, f, t[0] == v ? 0 : t[1] == v ? 1 : 2, weighting);
+  // Face by face, each plane made once and added to its corners: every vertex's sum runs over its
+  // faces in face order. Whatever the threads: a thread owns a range of vertices and reads every
+  // face, but makes and adds only the faces with a corner in its range, so every sum is the
+  // serial one, bit for bit.
+  for_vertex_ranges(m.pos.size(), threads, std::size_t(1) << 13, [&](std::size_t lo, std::size_t hi) {
+    std::fill(quadric.begin() + std::ptrdiff_t(lo), quadric.begin() + std::ptrdiff_t(hi), Quadric{});
+    const auto in_range = [&](std::uint32_t v) { return v >= lo && v < hi; };
+    for (std::uint32_t f = 0; f < m.face_alive.size(); ++f) {
+      if (!m.face_alive[f]) continue;
+      const std::uint32_t* t = m.face(f);
+      if (!in_range(t[0]) && !in_range(t[1]) && !in_range(t[2])) continue;
+      const FacePlane plane = plane_of_face(m, f);
+      if (weighting != Weighting::Angle) {
+        const Quadric q = corner_quadric(m, f, 0, plane, weighting);
+        for (int k = 0; k < 3; ++k)
+          if (in_range(t[k])) quadric[t[k]] += q;
+        continue;
       }
-      quadric[v] = q;
+      for (int k = 0; k < 3; ++k)
+        if (in_range(t[k])) quadric[t[k]] += corner_quadric(m, f, k, plane, weighting);
     }
   });
 }

@@ -1,8 +1,12 @@
 #include "core/order_greedy.h"
 
+#include <cmath>
+#include <limits>
+
 #include "core/contraction.h"
 #include "core/forgetting.h"
 #include "core/indexed_heap.h"
+#include "core/parallel_chunks.h"
 
 namespace qem::core {
 
@@ -48,17 +52,24 @@ struct GreedyLists {
 void run_greedy(Context& c, const std::vector<std::uint8_t>* stale, double forget_at) {
   PairSet& ps = c.pairs;
   IndexedHeap heap;
+  // (A stale pair's pair_cost would give the same key as it has: rounded to float already.)
   const auto fill_heap = [&](const std::vector<std::uint8_t>* stale) {
-    heap.reset(ps.pairs.size());
-    if (!stale) ps.cost.assign(ps.pairs.size(), 0);
-    for (std::uint32_t p = 0; p < ps.pairs.size(); ++p) {
+    const std::uint32_t n = std::uint32_t(ps.pairs.size());
+    const auto to_cost = [&](std::uint32_t p) { return ps.pairs[p].state == kCandidate && !(stale && !(*stale)[p]); };
+    // The costs on the threads (pair_cost only reads; NaN: refused), as the passes' re-costs are
+    // made; then the heap and the refusals in pair order, as one thread would.
+    UnzeroedVector<double> cost(n);
+    constexpr std::size_t kChunk = std::size_t(1) << 12;
+    for_chunks(n, kChunk, c.settings.threads, [&](std::size_t, std::size_t begin, std::size_t end) {
+      for (std::uint32_t p = std::uint32_t(begin); p < end; ++p)
+        if (to_cost(p) && !pair_cost(c, p, cost[p])) cost[p] = std::numeric_limits<double>::quiet_NaN();
+    });
+    heap.reset(n);
+    if (!stale) ps.cost.assign(n, 0);
+    for (std::uint32_t p = 0; p < n; ++p) {
       if (ps.pairs[p].state != kCandidate) continue;
-      if (stale && !(*stale)[p]) {  // pair_cost would give the same key (rounded to float already)
-        heap.push_unordered(p, ps.cost[p]);
-        continue;
-      }
-      double cost;
-      if (pair_cost(c, p, cost)) heap.push_unordered(p, cost), ps.cost[p] = float(cost);
+      if (!to_cost(p)) heap.push_unordered(p, ps.cost[p]);
+      else if (!std::isnan(cost[p])) heap.push_unordered(p, cost[p]), ps.cost[p] = float(cost[p]);
       else refuse(c, p);
     }
     heap.heapify();

@@ -30,7 +30,7 @@ constexpr std::size_t kBands = 8;
 // vertex may sit in different chunks).
 void recost_dirty_pairs(Context& c, PassState& s) {
   PairSet& ps = c.pairs;
-  constexpr std::size_t kChunk = std::size_t(1) << 16;
+  constexpr std::size_t kChunk = std::size_t(1) << 12;  // small meshes' passes on the threads too
   std::vector<std::vector<std::uint32_t>> blocked((ps.pairs.size() + kChunk - 1) / kChunk);
   for_chunks(ps.pairs.size(), kChunk, c.settings.threads, [&](std::size_t chunk, std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {

@@ -45,6 +45,17 @@ void for_chunks(std::size_t n, std::size_t chunk_size, unsigned threads, Fn&& fn
     if (failure) std::rethrow_exception(failure);
 }
 
+/// Calls fn(lo, hi) for ranges [lo, hi) of the vertices [0, nv), one range per thread (a single
+/// one below `per_range` vertices a thread), side by side. A pass over every face that touches
+/// only the vertices of its range gives the serial result on any number of threads.
+template <class Fn>
+void for_vertex_ranges(std::size_t nv, unsigned threads, std::size_t per_range, Fn fn) {
+  const std::size_t ranges = std::max<std::size_t>(1, std::min<std::size_t>(threads, nv / per_range + 1));
+  for_chunks(ranges, 1, unsigned(ranges), [&](std::size_t r, std::size_t, std::size_t) {
+    fn(nv * r / ranges, nv * (r + 1) / ranges);
+  });
+}
+
 /// n copies of `value`, written in fixed chunks on the threads: a large array's first writes are
 /// the kernel's page faults, a serial stretch when one thread makes them (the same array on any
 /// number of threads).

@@ -822,16 +822,6 @@ class Refitter {
   bool ready_ = false;
 };
 
-// Calls fn(lo, hi) for ranges [lo, hi) of the vertices [0, nv), one range per thread (a single one
-// below 65,536 vertices a thread), side by side. A pass over every face that touches only the
-// vertices of its range gives the serial result on any number of threads.
-template <class Fn>
-void for_vertex_ranges(std::size_t nv, unsigned threads, Fn fn) {
-  const std::size_t ranges = std::max<std::size_t>(1, std::min<std::size_t>(threads, nv / 65536 + 1));
-  core::for_chunks(ranges, 1, unsigned(ranges), [&](std::size_t r, std::size_t, std::size_t) {
-    fn(nv * r / ranges, nv * (r + 1) / ranges);
-  });
-}
 }  // namespace
 
 std::vector<double> vertex_areas(MeshView mesh, unsigned threads) {
@@ -841,7 +831,7 @@ std::vector<double> vertex_areas(MeshView mesh, unsigned threads) {
   // few along the range's edges). So the result is the serial one, bit for bit.
   const std::size_t nv = mesh.vertex_count();
   std::vector<double> area(nv, 0.0);
-  for_vertex_ranges(nv, threads, [&](std::size_t lo, std::size_t hi) {
+  core::for_vertex_ranges(nv, threads, 65536, [&](std::size_t lo, std::size_t hi) {
     const auto mine = [&](std::uint32_t v) { return v >= lo && v < hi; };
     for (std::size_t f = 0; f < mesh.indices.size(); f += 3) {
       const std::uint32_t* t = &mesh.indices[f];
@@ -883,7 +873,7 @@ core::SurfaceDistance surface_in_frame(std::span<const double> positions, std::s
   // Per vertex, the lowest face that has it: each range's pass over the faces in order sees it
   // first.
   core::SurfaceDistance::FaceAtVertex face_at(positions.size() / 3);
-  for_vertex_ranges(face_at.size(), threads, [&](std::size_t lo, std::size_t hi) {
+  core::for_vertex_ranges(face_at.size(), threads, 65536, [&](std::size_t lo, std::size_t hi) {
     std::fill(face_at.begin() + std::ptrdiff_t(lo), face_at.begin() + std::ptrdiff_t(hi), UINT32_MAX);
     for (std::size_t c = 0; c < indices.size(); ++c) {
       const std::uint32_t v = indices[c];
