@@ -331,11 +331,18 @@ TriangleBvh::Hit TriangleBvh::search(const double p[3], double best, std::uint32
   };
   Entry stack[kStack];  // holds at most depth + 1 entries; the build bounds the depth (kSahDepth)
   int top = 0;
-  stack[top++] = {0, box_d2(p, nodes_[0].lo, nodes_[0].hi)};
-  while (top > 0) {
-    const Entry e = stack[--top];
-    if (e.d2 > best) continue;  // (not >=: a face as close but of a lower index wins the tie)
-    const Node& node = nodes_[e.node];
+  // The nearer child of a node is searched next without going through the stack; the farther
+  // waits there.
+  std::uint32_t at = 0;
+  if (box_d2(p, nodes_[0].lo, nodes_[0].hi) > best) at = UINT32_MAX;
+  for (;;) {
+    if (at == UINT32_MAX) {
+      if (top == 0) break;
+      const Entry e = stack[--top];
+      if (e.d2 > best) continue;  // (not >=: a face as close but of a lower index wins the tie)
+      at = e.node;
+    }
+    const Node& node = nodes_[at];
     if (node.count > 0) {
       for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
         Vec3 a, b, d;
@@ -345,19 +352,17 @@ TriangleBvh::Hit TriangleBvh::search(const double p[3], double best, std::uint32
         if (d2 < best || (d2 == best && best_tri != UINT32_MAX && ids_[i] < ids_[best_tri]))
           best = d2, best_tri = i;
       }
+      at = UINT32_MAX;
       continue;
     }
     const Node& l = nodes_[node.first];
     const Node& r = nodes_[node.first + 1];
     const double dl = box_d2(p, l.lo, l.hi), dr = box_d2(p, r.lo, r.hi);
-    // Push the farther child first so the nearer one is searched first and tightens `best`.
-    if (dl <= dr) {
-      if (dr <= best) stack[top++] = {node.first + 1, dr};
-      if (dl <= best) stack[top++] = {node.first, dl};
-    } else {
-      if (dl <= best) stack[top++] = {node.first, dl};
-      if (dr <= best) stack[top++] = {node.first + 1, dr};
-    }
+    const bool left_first = dl <= dr;
+    const double d_near = left_first ? dl : dr, d_far = left_first ? dr : dl;
+    const std::uint32_t near = left_first ? node.first : node.first + 1;
+    if (d_far <= best) stack[top++] = {left_first ? node.first + 1 : node.first, d_far};
+    at = d_near <= best ? near : UINT32_MAX;
   }
   if (best_tri != UINT32_MAX) {
     // The closest point is recomputed once here rather than stored at every improvement.
