@@ -19,9 +19,10 @@ namespace qem {
 // chart). The other vertices move with their values unchanged: moving the values along the
 // gradients of their attribute quadrics measured the same to four digits (docs/attributes.md).
 // `out.output_vertex_of_input`: each input vertex's output vertex (the refit's first guess of
-// each point's closest face); `locked`: per output vertex (empty: none), held too.
+// each point's closest face); `locked`: per output vertex (empty: none), held too;
+// `closest_faces` as refit_to_points' (the welded mesh has the output's faces).
 RefitResult refit_with_seams(const refit_detail::FitPoints& points, SimplifyResult& out, RefitOptions options,
                              const std::vector<std::uint8_t>& locked, const core::WedgeRefitData& data,
-                             const core::SurfaceDistance* surface);
+                             const core::SurfaceDistance* surface, std::vector<std::uint32_t>* closest_faces);
 
 }  // namespace qem

@@ -66,15 +66,18 @@ std::vector<std::uint8_t> border_points_for(const Mesh& mesh, std::span<const st
 }
 
 // The far-place repair of `mesh` with `options`' turn limit and threads (core/far_repair.h), against
-// the input (`positions`) as `points` and `surface`, `on_border` per point (border_points_for). A
+// the input (`positions`) as `points` and `surface`, `on_border` per point (border_points_for),
+// `closest_faces` per point (empty: none) as FarRepairOptions::point_faces. A
 // relocated vertex that stands at an input vertex takes its exact coordinates (on a border: on the
 // input's border, as exact borders promise).
 core::FarRepairResult repair_mesh(Mesh& mesh, const SimplifyOptions& options, MeshView input,
                                   std::span<const std::uint8_t> on_border, const refit_detail::FitPoints& points,
-                                  const core::SurfaceDistance& surface, std::span<const std::uint8_t> held) {
+                                  const core::SurfaceDistance& surface, std::span<const std::uint8_t> held,
+                                  std::span<const std::uint32_t> closest_faces) {
   const std::span<const double> positions = input.positions;
   core::FarRepairOptions repair_options;
   repair_options.held = held;
+  repair_options.point_faces = closest_faces;
   repair_options.input_attributes = input.attributes;
   repair_options.point_source = points.source;
   repair_options.input_faces = input.indices;
@@ -133,7 +136,7 @@ void refit_levels(MeshView original, std::span<ReplayLevel> levels, const Simpli
       for (std::size_t v = 0; v < held.size(); ++v)
         held[v] = std::binary_search(locked.begin(), locked.end(),
                                      std::array<double, 3>{mesh->positions[3 * v], mesh->positions[3 * v + 1], mesh->positions[3 * v + 2]});
-      repair_mesh(*mesh, options, original, on_border, points, surface, held);
+      repair_mesh(*mesh, options, original, on_border, points, surface, held, {});
     }
 }
 
@@ -147,10 +150,10 @@ std::vector<std::uint8_t> seam_or_locked(std::span<const std::uint8_t> on_seam, 
 
 void repair_after_refit(SimplifyResult& result, const SimplifyOptions& options, MeshView input,
                         const refit_detail::FitPoints& points, const core::SurfaceDistance& surface,
-                        std::span<const std::uint8_t> held) {
+                        std::span<const std::uint8_t> held, std::span<const std::uint32_t> closest_faces) {
   const core::FarRepairResult made = repair_mesh(result.mesh, options, input,
                                                  border_points_for(result.mesh, input.indices, points, core::resolve_threads(options.threads)), points,
-                     surface, held);
+                     surface, held, closest_faces);
   result.edge_flips = made.flips;
   result.vertex_moves = made.moves;
   result.vertex_relocations = made.relocations.size();
@@ -282,6 +285,9 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
     fixed.assign(out.mesh.vertex_count(), 0);
     for (std::size_t v = 0; v < out.vertex_source.size(); ++v) fixed[v] = options.vertex_lock[out.vertex_source[v]];
   }
+  // Each input point's closest face of the refitted output, found by the refit's local searches:
+  // the repair's start, so that it does not search a tree of the output for every point.
+  std::vector<std::uint32_t> closest_faces;
   if (refitted) {
     RefitOptions refit_options = chosen;
     refit_options.max_distance = max_distance;
@@ -289,14 +295,17 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
     // Its first search for each input vertex's closest face starts at the vertex it went into.
     const RefitResult fit =
         out.mesh.attributes.empty()
-            ? refit_detail::refit_to_points(points, out.mesh, refit_options, out.output_vertex_of_input, &surface)
-            : refit_with_seams(points, out, refit_options, fixed, wedge_refit, &surface);
+            ? refit_detail::refit_to_points(points, out.mesh, refit_options, out.output_vertex_of_input, &surface,
+                                            repaired ? &closest_faces : nullptr)
+            : refit_with_seams(points, out, refit_options, fixed, wedge_refit, &surface,
+                               repaired ? &closest_faces : nullptr);
     out.refit_rms_before = fit.rms_before;
     out.refit_rms_after = fit.rms_after;
     out.refit_rounds = fit.rounds;
   }
   if (repaired)
-    repair_after_refit(out, options, input_surface, points, surface, seam_or_locked(wedge_refit.on_seam, fixed, out.mesh.vertex_count()));
+    repair_after_refit(out, options, input_surface, points, surface,
+                       seam_or_locked(wedge_refit.on_seam, fixed, out.mesh.vertex_count()), closest_faces);
   if (fit_values && out.contractions > 0 && out.stop_reason != StopReason::Cancelled) {
     // After the refit: the values fit the final positions. Seam and locked vertices keep theirs.
     const std::vector<std::uint8_t> held = seam_or_locked(wedge_refit.on_seam, fixed, out.mesh.vertex_count());

@@ -20,6 +20,7 @@
 #include "core/valid_pairs.h"
 #include "geometry/frame.h"
 #include "mesh_checks.h"
+#include "measure/bvh.h"
 #include "measure/point_triangle.h"
 #include "outofcore/mesh_generator.h"
 #include "qem/simplify.h"
@@ -296,6 +297,41 @@ TEST(FarRepair, SimplifyFlipsWithoutFoldsTopologyChangesOrFartherPoints) {
   EXPECT_GT(total_flips, 0u);
   EXPECT_GT(total_moves, 0u);
   EXPECT_GT(total_relocations, 0u);
+}
+
+// The faces a local search gave each point (FarRepairOptions::point_faces) stand in for the tree's
+// only near the output: given the tree's own answers, or for every point its farthest face (which
+// sends each one back to the tree), the repair makes what it makes without them.
+TEST(FarRepair, GivenFacesStandInForTheTreeOnlyNearTheOutput) {
+  const Mesh input = outofcore::bumpy_sphere(5000);
+  SimplifyOptions o;
+  o.target_faces = 300;
+  o.refit_rounds = 2;
+  o.threads = 1;
+  const Mesh start = simplify(input, o).mesh;
+  const measure_detail::TriangleBvh tree(corners_of(start));
+  std::vector<std::uint32_t> exact, farthest;
+  for (std::size_t p = 0; p < input.vertex_count(); ++p) {
+    const double* q = &input.positions[3 * p];
+    exact.push_back(tree.closest(q).triangle);
+    std::uint32_t far = 0;
+    for (std::uint32_t f = 1; f < start.face_count(); ++f)
+      if (tree.triangle_d2(q, f) > tree.triangle_d2(q, far)) far = f;
+    farthest.push_back(far);
+  }
+  Mesh plain = start;
+  const core::FarRepairResult r = flip(plain, input);
+  EXPECT_GT(r.flips + r.moves, 0u);
+  for (const std::vector<std::uint32_t>* given : {&exact, &farthest}) {
+    core::FarRepairOptions options;
+    options.point_faces = *given;
+    Mesh repaired = start;
+    const core::FarRepairResult g = flip(repaired, input, options);
+    EXPECT_EQ(g.flips, r.flips);
+    EXPECT_EQ(g.moves, r.moves);
+    EXPECT_EQ(repaired.indices, plain.indices);
+    EXPECT_EQ(repaired.positions, plain.positions);
+  }
 }
 
 // A bump cut off: the input is a 5x5 grid with its middle vertex raised, the approximation the

@@ -304,6 +304,43 @@ TEST(Refit, SimplifysWalkFromTheContractionMapFindsTheTreesFaces) {
   }
 }
 
+TEST(Refit, ClosestFacesAfterTheRefitAreTheTrees) {
+  // What the far-place repair starts from (refit_to_points' closest_faces): every point's face is
+  // as close as the tree's answer on the refitted output, both when the refit fitted every point
+  // (walked from its own last projection) and when it fitted a sample (walked from the vertex the
+  // point went into), on a mesh of two parts.
+  const Mesh input =
+      test::concatenated(test::icosphere(5), test::transformed(test::height_field(40, waves), 1, 3, 0, 0));
+  for (const double sample : {0.0, 2.0}) {
+    SCOPED_TRACE(sample);
+    SimplifyOptions o;
+    o.target_faces = 300;
+    o.threads = 2;
+    o.map_input_vertices = true;
+    const SimplifyResult plain = simplify(input, o);
+    o.refit_rounds = 2;
+    o.refit_points_per_vertex = sample;
+    const refit_detail::FitPoints points(input.positions, refit_detail::vertex_areas(input));
+    Mesh mesh = plain.mesh;
+    std::vector<std::uint32_t> closest;
+    const RefitResult r =
+        refit_detail::refit_to_points(points, mesh, refit_options_for(o), plain.output_vertex_of_input, nullptr, &closest);
+    EXPECT_GT(r.rounds, 0u);
+    ASSERT_EQ(closest.size(), points.weight.size());
+    std::vector<double> corners;
+    for (std::uint32_t v : mesh.indices) {
+      const Vec3 q = points.frame().to_frame({mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2]});
+      corners.insert(corners.end(), {q.x, q.y, q.z});
+    }
+    const measure_detail::TriangleBvh tree(corners);
+    for (std::size_t j = 0; j < closest.size(); ++j) {
+      ASSERT_LT(closest[j], mesh.face_count());
+      const double* p = &points.position[3 * j];
+      EXPECT_NEAR(tree.triangle_d2(p, closest[j]), tree.closest(p).d2, 1e-15) << "point " << j;
+    }
+  }
+}
+
 TEST(Refit, ThinnedPointsKeepTheFrameAndTheTotalWeight) {
   const Mesh original = test::icosphere(3);
   const std::vector<double> weights = refit_detail::vertex_areas(original);

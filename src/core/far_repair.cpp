@@ -1,6 +1,7 @@
 #include "core/far_repair.h"
 
 #include <algorithm>
+#include <atomic>
 #include <array>
 #include <cmath>
 #include <initializer_list>
@@ -105,8 +106,10 @@ class Repairer {
     faces_at_.assign(n, {});
     for (std::uint32_t f = 0; f < face_count(); ++f)
       for (int k = 0; k < 3; ++k) faces_at_[tri_[3 * f + k]].push_back(f);
-    assign_points();
     scan_faces();
+    assign_points();
+    largest_ = 0;
+    for (std::uint32_t f = 0; f < face_count(); ++f) largest_ = std::max(largest_, local(f));
   }
 
   FarRepairResult run() {
@@ -343,30 +346,55 @@ class Repairer {
     });
     for (std::size_t f = 0; f < nf; ++f)
       for (int k = 0; k < 3; ++k) near_[f] = std::max(near_[f], middle[owner[3 * f + k]]);
-    largest_ = 0;
-    for (std::uint32_t f = 0; f < nf; ++f) largest_ = std::max(largest_, local(f));
   }
 
   // Each input point goes to its closest output face (of two as close, the lower index): only the
-  // points of a flip's two faces can come farther from the output by it.
+  // points of a flip's two faces can come farther from the output by it. A point a local search
+  // already placed (FarRepairOptions::point_faces) within half the output's largest distance to the
+  // input (after scan_faces) keeps that face: the far faces are chosen from 3/4 of the largest, so
+  // such a point decides none of them whichever near face it goes to, and the tree's search, most of
+  // the set-up's work, is left to the points that could.
   void assign_points() {
-    std::vector<double> corners(9 * std::size_t(face_count()));
-    for (std::size_t f = 0; f < face_count(); ++f)
-      for (int k = 0; k < 3; ++k) {
-        const Vec3& p = x_[tri_[3 * f + k]];
-        corners[9 * f + 3 * k] = p.x, corners[9 * f + 3 * k + 1] = p.y, corners[9 * f + 3 * k + 2] = p.z;
-      }
-    const measure_detail::TriangleBvh tree(corners, resolve_threads(opt_.threads));
     const std::size_t count = weights_.size();
-    std::vector<std::uint32_t> face_of(count);
-    d2_.resize(count);
-    for_chunks(count, kChunk, resolve_threads(opt_.threads), [&](std::size_t, std::size_t begin, std::size_t end) {
-      std::uint32_t hint = UINT32_MAX;
-      for (std::size_t p = begin; p < end; ++p) {
-        const auto hit = tree.closest(&points_[3 * p], &hint);
-        face_of[p] = hit.triangle, d2_[p] = hit.d2;
-      }
-    });
+    const bool given = opt_.point_faces.size() == count;
+    const double keep = 0.5 * *std::max_element(near_.begin(), near_.end());
+    std::vector<std::uint32_t> face_of(count, UINT32_MAX);
+    d2_.assign(count, HUGE_VAL);
+    std::atomic<bool> need_tree = !given;
+    if (given)
+      for_chunks(count, kChunk, resolve_threads(opt_.threads), [&](std::size_t, std::size_t begin, std::size_t end) {
+        bool missed = false;
+        for (std::size_t p = begin; p < end; ++p) {
+          const std::uint32_t f = opt_.point_faces[p];
+          if (f >= face_count()) {
+            missed = true;
+            continue;
+          }
+          const auto [a, b, c] = face(f);
+          const Vec3 q = point(std::uint32_t(p));
+          const double d2 = measure_detail::squared_distance(q, measure_detail::closest_point_on_triangle(q, x_[a], x_[b], x_[c]));
+          if (d2 < keep * keep) face_of[p] = f, d2_[p] = d2;
+          else missed = true;
+        }
+        if (missed) need_tree = true;
+      });
+    if (need_tree) {
+      std::vector<double> corners(9 * std::size_t(face_count()));
+      for (std::size_t f = 0; f < face_count(); ++f)
+        for (int k = 0; k < 3; ++k) {
+          const Vec3& p = x_[tri_[3 * f + k]];
+          corners[9 * f + 3 * k] = p.x, corners[9 * f + 3 * k + 1] = p.y, corners[9 * f + 3 * k + 2] = p.z;
+        }
+      const measure_detail::TriangleBvh tree(corners, resolve_threads(opt_.threads));
+      for_chunks(count, kChunk, resolve_threads(opt_.threads), [&](std::size_t, std::size_t begin, std::size_t end) {
+        std::uint32_t hint = UINT32_MAX;
+        for (std::size_t p = begin; p < end; ++p) {
+          if (face_of[p] != UINT32_MAX) continue;
+          const auto hit = tree.closest(&points_[3 * p], &hint);
+          face_of[p] = hit.triangle, d2_[p] = hit.d2;
+        }
+      });
+    }
     points_of_.assign(face_count(), {});
     for (std::uint32_t p = 0; p < count; ++p)
       if (face_of[p] != UINT32_MAX) points_of_[face_of[p]].push_back(p);

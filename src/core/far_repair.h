@@ -94,6 +94,11 @@ struct FarRepairOptions {
   std::size_t relocations = 0;
   /// The relocations together may raise E (estimated) by at most this fraction.
   double relocation_budget = 0.005;
+  /// Per point: a face of `approx` a local search found closest (UINT32_MAX: none), such as the
+  /// refit's (refit_to_points' closest_faces). A point within half the largest distance from the
+  /// output's faces to the input (their centroids and edge midpoints) keeps it; the others, which
+  /// could be a far place's, ask a tree of the faces, as all do when this is empty.
+  std::span<const std::uint32_t> point_faces;
   /// Per point: 1 = on the input's border (points_on_border). Empty: no relocation at a border.
   std::span<const std::uint8_t> point_on_border;
   /// With attributes (approx.attributes, in the order of the input's): the input's per-vertex

@@ -44,8 +44,10 @@ std::vector<std::uint8_t> seam_or_locked(std::span<const std::uint8_t> on_seam, 
 /// positions and the faces the run used) as points and surface (those of the refit), `held`
 /// vertices left as they are; with the input's attributes (in `input`) no flip or move raises
 /// the error of appearance. Counts it in `result` and carries its provenance across relocations.
+/// `closest_faces`: per point, its closest face of `result.mesh` as the refit left it
+/// (refit_to_points'), where the repair's search for it starts; empty: none.
 void repair_after_refit(SimplifyResult& result, const SimplifyOptions& options, MeshView input,
                         const refit_detail::FitPoints& points, const core::SurfaceDistance& surface,
-                        std::span<const std::uint8_t> held);
+                        std::span<const std::uint8_t> held, std::span<const std::uint32_t> closest_faces);
 
 }  // namespace qem

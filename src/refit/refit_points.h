@@ -56,9 +56,13 @@ void check_options(const RefitOptions& options);
 /// `surface` (optional): the original's surface in the points' frame (surface_in_frame), for the
 /// guard that keeps the approximation as close to the original as it was (and within
 /// options.max_distance).
+/// `closest_faces` (optional): set to each point's closest face of the refitted approximation
+/// (UINT32_MAX: none found), walked to from the refit's last projection, for the far-place repair
+/// that follows: the tree's answer but where a closer face lies beyond a farther one.
 RefitResult refit_to_points(const FitPoints& points, Mesh& approx, const RefitOptions& options,
                             std::span<const std::uint32_t> near_vertex = {},
-                            const core::SurfaceDistance* surface = nullptr);
+                            const core::SurfaceDistance* surface = nullptr,
+                            std::vector<std::uint32_t>* closest_faces = nullptr);
 
 /// The surface of an original (positions, triangle indices) in `frame` (FitPoints::frame()), made
 /// on up to `threads` threads (the same surface on any number).
