@@ -7,7 +7,8 @@ namespace qem {
 
 RefitResult refit_with_seams(const refit_detail::FitPoints& points, SimplifyResult& out, RefitOptions options,
                              const std::vector<std::uint8_t>& locked, const core::WedgeRefitData& data,
-                             const core::SurfaceDistance* surface, std::vector<std::uint32_t>* closest_faces) {
+                             const core::SurfaceDistance* surface,
+                             std::vector<std::uint32_t>* closest_faces) {
   Mesh& mesh = out.mesh;
   const std::size_t n = mesh.vertex_count();
   std::vector<std::uint32_t> order(n);
@@ -41,7 +42,8 @@ RefitResult refit_with_seams(const refit_detail::FitPoints& points, SimplifyResu
   for (std::uint32_t& v : near)
     if (v != SimplifyResult::kUnmapped) v = welded_of[v];
   options.fixed_vertices = fixed;
-  const RefitResult fit = refit_detail::refit_to_points(points, welded, options, near, surface, closest_faces);
+  const RefitResult fit =
+      refit_detail::refit_to_points(points, welded, options, near, surface, closest_faces);
   for (std::uint32_t v = 0; v < n; ++v)
     std::copy_n(&welded.positions[3 * std::size_t(welded_of[v])], 3, &mesh.positions[3 * std::size_t(v)]);
   return fit;

@@ -71,8 +71,9 @@ std::vector<std::uint8_t> border_points_for(const Mesh& mesh, std::span<const st
 // relocated vertex that stands at an input vertex takes its exact coordinates (on a border: on the
 // input's border, as exact borders promise).
 core::FarRepairResult repair_mesh(Mesh& mesh, const SimplifyOptions& options, MeshView input,
-                                  std::span<const std::uint8_t> on_border, const refit_detail::FitPoints& points,
-                                  const core::SurfaceDistance& surface, std::span<const std::uint8_t> held,
+                                  std::span<const std::uint8_t> on_border,
+                                  const refit_detail::FitPoints& points, const core::SurfaceDistance& surface,
+                                  std::span<const std::uint8_t> held,
                                   std::span<const std::uint32_t> closest_faces) {
   const std::span<const double> positions = input.positions;
   core::FarRepairOptions repair_options;
@@ -151,9 +152,10 @@ std::vector<std::uint8_t> seam_or_locked(std::span<const std::uint8_t> on_seam, 
 void repair_after_refit(SimplifyResult& result, const SimplifyOptions& options, MeshView input,
                         const refit_detail::FitPoints& points, const core::SurfaceDistance& surface,
                         std::span<const std::uint8_t> held, std::span<const std::uint32_t> closest_faces) {
-  const core::FarRepairResult made = repair_mesh(result.mesh, options, input,
-                                                 border_points_for(result.mesh, input.indices, points, core::resolve_threads(options.threads)), points,
-                     surface, held, closest_faces);
+  const core::FarRepairResult made = repair_mesh(
+      result.mesh, options, input,
+      border_points_for(result.mesh, input.indices, points, core::resolve_threads(options.threads)), points,
+      surface, held, closest_faces);
   result.edge_flips = made.flips;
   result.vertex_moves = made.moves;
   result.vertex_relocations = made.relocations.size();
@@ -295,8 +297,8 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
     // Its first search for each input vertex's closest face starts at the vertex it went into.
     const RefitResult fit =
         out.mesh.attributes.empty()
-            ? refit_detail::refit_to_points(points, out.mesh, refit_options, out.output_vertex_of_input, &surface,
-                                            repaired ? &closest_faces : nullptr)
+            ? refit_detail::refit_to_points(points, out.mesh, refit_options, out.output_vertex_of_input,
+                                            &surface, repaired ? &closest_faces : nullptr)
             : refit_with_seams(points, out, refit_options, fixed, wedge_refit, &surface,
                                repaired ? &closest_faces : nullptr);
     out.refit_rms_before = fit.rms_before;

@@ -323,13 +323,14 @@ TEST(Refit, ClosestFacesAfterTheRefitAreTheTrees) {
     const refit_detail::FitPoints points(input.positions, refit_detail::vertex_areas(input));
     Mesh mesh = plain.mesh;
     std::vector<std::uint32_t> closest;
-    const RefitResult r =
-        refit_detail::refit_to_points(points, mesh, refit_options_for(o), plain.output_vertex_of_input, nullptr, &closest);
+    const RefitResult r = refit_detail::refit_to_points(points, mesh, refit_options_for(o),
+                                                        plain.output_vertex_of_input, nullptr, &closest);
     EXPECT_GT(r.rounds, 0u);
     ASSERT_EQ(closest.size(), points.weight.size());
     std::vector<double> corners;
     for (std::uint32_t v : mesh.indices) {
-      const Vec3 q = points.frame().to_frame({mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2]});
+      const Vec3 q = points.frame().to_frame(
+          {mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2]});
       corners.insert(corners.end(), {q.x, q.y, q.z});
     }
     const measure_detail::TriangleBvh tree(corners);

@@ -1,8 +1,8 @@
 #include "core/far_repair.h"
 
 #include <algorithm>
-#include <atomic>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <initializer_list>
 #include <iterator>
@@ -362,22 +362,26 @@ class Repairer {
     d2_.assign(count, HUGE_VAL);
     std::atomic<bool> need_tree = !given;
     if (given)
-      for_chunks(count, kChunk, resolve_threads(opt_.threads), [&](std::size_t, std::size_t begin, std::size_t end) {
-        bool missed = false;
-        for (std::size_t p = begin; p < end; ++p) {
-          const std::uint32_t f = opt_.point_faces[p];
-          if (f >= face_count()) {
-            missed = true;
-            continue;
-          }
-          const auto [a, b, c] = face(f);
-          const Vec3 q = point(std::uint32_t(p));
-          const double d2 = measure_detail::squared_distance(q, measure_detail::closest_point_on_triangle(q, x_[a], x_[b], x_[c]));
-          if (d2 < keep * keep) face_of[p] = f, d2_[p] = d2;
-          else missed = true;
-        }
-        if (missed) need_tree = true;
-      });
+      for_chunks(count, kChunk, resolve_threads(opt_.threads),
+                 [&](std::size_t, std::size_t begin, std::size_t end) {
+                   bool missed = false;
+                   for (std::size_t p = begin; p < end; ++p) {
+                     const std::uint32_t f = opt_.point_faces[p];
+                     if (f >= face_count()) {
+                       missed = true;
+                       continue;
+                     }
+                     const auto [a, b, c] = face(f);
+                     const Vec3 q = point(std::uint32_t(p));
+                     const double d2 = measure_detail::squared_distance(
+                         q, measure_detail::closest_point_on_triangle(q, x_[a], x_[b], x_[c]));
+                     if (d2 < keep * keep)
+                       face_of[p] = f, d2_[p] = d2;
+                     else
+                       missed = true;
+                   }
+                   if (missed) need_tree = true;
+                 });
     if (need_tree) {
       std::vector<double> corners(9 * std::size_t(face_count()));
       for (std::size_t f = 0; f < face_count(); ++f)
@@ -386,14 +390,15 @@ class Repairer {
           corners[9 * f + 3 * k] = p.x, corners[9 * f + 3 * k + 1] = p.y, corners[9 * f + 3 * k + 2] = p.z;
         }
       const measure_detail::TriangleBvh tree(corners, resolve_threads(opt_.threads));
-      for_chunks(count, kChunk, resolve_threads(opt_.threads), [&](std::size_t, std::size_t begin, std::size_t end) {
-        std::uint32_t hint = UINT32_MAX;
-        for (std::size_t p = begin; p < end; ++p) {
-          if (face_of[p] != UINT32_MAX) continue;
-          const auto hit = tree.closest(&points_[3 * p], &hint);
-          face_of[p] = hit.triangle, d2_[p] = hit.d2;
-        }
-      });
+      for_chunks(count, kChunk, resolve_threads(opt_.threads),
+                 [&](std::size_t, std::size_t begin, std::size_t end) {
+                   std::uint32_t hint = UINT32_MAX;
+                   for (std::size_t p = begin; p < end; ++p) {
+                     if (face_of[p] != UINT32_MAX) continue;
+                     const auto hit = tree.closest(&points_[3 * p], &hint);
+                     face_of[p] = hit.triangle, d2_[p] = hit.d2;
+                   }
+                 });
     }
     points_of_.assign(face_count(), {});
     for (std::uint32_t p = 0; p < count; ++p)

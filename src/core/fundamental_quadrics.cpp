@@ -25,11 +25,14 @@ FacePlane plane_of_face(const WorkingMesh& m, std::uint32_t f) {
 }
 
 // The plane's quadric as face f's corner k adds it (only angle weighting depends on the corner).
-Quadric corner_quadric(const WorkingMesh& m, std::uint32_t f, int k, const FacePlane& p, Weighting weighting) {
+Quadric corner_quadric(const WorkingMesh& m, std::uint32_t f, int k, const FacePlane& p,
+                       Weighting weighting) {
   if (!(p.twice_area > 0)) return Quadric{};
   switch (weighting) {
-    case Weighting::Area: return Quadric::plane(p.n, p.d, p.twice_area / 2);  // HG99 §2
-    case Weighting::Uniform: return Quadric::plane(p.n, p.d, 1);              // GH97 §5
+    case Weighting::Area:
+      return Quadric::plane(p.n, p.d, p.twice_area / 2);  // HG99 §2
+    case Weighting::Uniform:
+      return Quadric::plane(p.n, p.d, 1);  // GH97 §5
     case Weighting::Angle: break;
   }
   const std::uint32_t* t = m.face(f);

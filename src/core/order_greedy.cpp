@@ -55,7 +55,9 @@ void run_greedy(Context& c, const std::vector<std::uint8_t>* stale, double forge
   // (A stale pair's pair_cost would give the same key as it has: rounded to float already.)
   const auto fill_heap = [&](const std::vector<std::uint8_t>* stale) {
     const std::uint32_t n = std::uint32_t(ps.pairs.size());
-    const auto to_cost = [&](std::uint32_t p) { return ps.pairs[p].state == kCandidate && !(stale && !(*stale)[p]); };
+    const auto to_cost = [&](std::uint32_t p) {
+      return ps.pairs[p].state == kCandidate && !(stale && !(*stale)[p]);
+    };
     // The costs on the threads (pair_cost only reads; NaN: refused), as the passes' re-costs are
     // made; then the heap and the refusals in pair order, as one thread would.
     UnzeroedVector<double> cost(n);
@@ -68,9 +70,12 @@ void run_greedy(Context& c, const std::vector<std::uint8_t>* stale, double forge
     if (!stale) ps.cost.assign(n, 0);
     for (std::uint32_t p = 0; p < n; ++p) {
       if (ps.pairs[p].state != kCandidate) continue;
-      if (!to_cost(p)) heap.push_unordered(p, ps.cost[p]);
-      else if (!std::isnan(cost[p])) heap.push_unordered(p, cost[p]), ps.cost[p] = float(cost[p]);
-      else refuse(c, p);
+      if (!to_cost(p))
+        heap.push_unordered(p, ps.cost[p]);
+      else if (!std::isnan(cost[p]))
+        heap.push_unordered(p, cost[p]), ps.cost[p] = float(cost[p]);
+      else
+        refuse(c, p);
     }
     heap.heapify();
   };

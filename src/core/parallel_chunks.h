@@ -51,9 +51,8 @@ void for_chunks(std::size_t n, std::size_t chunk_size, unsigned threads, Fn&& fn
 template <class Fn>
 void for_vertex_ranges(std::size_t nv, unsigned threads, std::size_t per_range, Fn fn) {
   const std::size_t ranges = std::max<std::size_t>(1, std::min<std::size_t>(threads, nv / per_range + 1));
-  for_chunks(ranges, 1, unsigned(ranges), [&](std::size_t r, std::size_t, std::size_t) {
-    fn(nv * r / ranges, nv * (r + 1) / ranges);
-  });
+  for_chunks(ranges, 1, unsigned(ranges),
+             [&](std::size_t r, std::size_t, std::size_t) { fn(nv * r / ranges, nv * (r + 1) / ranges); });
 }
 
 /// n copies of `value`, written in fixed chunks on the threads: a large array's first writes are

@@ -287,15 +287,16 @@ SimplifyResult finish(MeshView input, const SimplifyOptions& options, std::span<
     std::vector<std::uint32_t>* closest = options.far_repair ? &closest_faces : nullptr;
     const RefitResult fit =
         result.mesh.attributes.empty()
-            ? refit_detail::refit_to_points(points, result.mesh, refit_options, result.output_vertex_of_input, &surface,
-                                            closest)
+            ? refit_detail::refit_to_points(points, result.mesh, refit_options, result.output_vertex_of_input,
+                                            &surface, closest)
             : refit_with_seams(points, result, refit_options, fixed, wedge_refit, &surface, closest);
     result.refit_rms_before = fit.rms_before;
     result.refit_rms_after = fit.rms_after;
     result.refit_rounds = fit.rounds;
     if (options.far_repair)  // after the refit, against the whole input, as simplify's
       repair_after_refit(result, options, input, points, surface,
-                         seam_or_locked(wedge_refit.on_seam, fixed, result.mesh.vertex_count()), closest_faces);
+                         seam_or_locked(wedge_refit.on_seam, fixed, result.mesh.vertex_count()),
+                         closest_faces);
   }
   if (fit_values && result.contractions > 0) {
     // After the refit: the values fit the final positions. Seam and locked vertices keep theirs.

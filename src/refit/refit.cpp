@@ -562,8 +562,8 @@ class Refitter {
     return walk_from(x, spheres, q, f);
   }
   // From face f to the closest face around the corners of the closest so far, until that stays.
-  measure_detail::TriangleBvh::Hit walk_from(const std::vector<double>& x, const Spheres& spheres, const double* q,
-                                             std::uint32_t f) const {
+  measure_detail::TriangleBvh::Hit walk_from(const std::vector<double>& x, const Spheres& spheres,
+                                             const double* q, std::uint32_t f) const {
     auto hit = closest_around(x, spheres, q, f);
     for (int step = 0; step < 64 && hit.triangle != f && hit.triangle != UINT32_MAX; ++step) {
       f = hit.triangle;
@@ -601,7 +601,6 @@ class Refitter {
   }
 
  private:
-
   // The least squares problem of one round, for all three coordinates at once (same matrix).
   bool solve(const Projection& proj, std::vector<double>& next) const {
     const std::size_t n = approx_.vertex_count(), nf = tri_.size() / 3;
