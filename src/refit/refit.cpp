@@ -112,7 +112,10 @@ struct Projection {
   Array<std::uint32_t> nearest;  ///< closest face, UINT32_MAX = none (where the next round looks)
   Array<std::uint32_t> face;     ///< the same face if it pulls the point (has area), else UINT32_MAX
   Array<double> bary;            ///< 3 per point, read only where face is set
-  double energy = 0;             ///< sum of w_i * squared distance
+  /// 1 where `nearest` is where a walk from it would stay: the tree's answer, or a local search's
+  /// that is its own start (closest_faces then needs no walk).
+  Array<std::uint8_t> settled;
+  double energy = 0;  ///< sum of w_i * squared distance
 };
 
 }  // namespace
@@ -337,8 +340,8 @@ class Refitter {
       std::vector<double> next;
       if (!solve(proj, next)) break;
       // What is read of this projection from here on is each point's closest face (where the
-      // next one starts) and its energy: the rest goes before the next is made (on a large input
-      // the points' arrays are the refit's largest).
+      // next one starts), whether it is settled, and its energy: the rest goes before the next is
+      // made (on a large input the points' arrays are the refit's largest).
       Projection::Array<std::uint32_t>().swap(proj.face);
       Projection::Array<double>().swap(proj.bary);
       std::size_t held = hold_turned_faces(next);
@@ -351,7 +354,9 @@ class Refitter {
       r.vertices_held += held;
       r.rms_after = std::sqrt(proj.energy / pts_.total_weight) * frame_.scale;
     }
-    last_nearest_ = std::move(proj.nearest);  // on x_ as it ends: where closest_faces starts
+    // On x_ as it ends: where closest_faces starts.
+    last_nearest_ = std::move(proj.nearest);
+    last_settled_ = std::move(proj.settled);
     // Back to model coordinates; a vertex that did not move keeps its exact input coordinates.
     for (std::size_t v = 0; v < approx_.vertex_count(); ++v) {
       const double *now = &x_[3 * v], *was = &start[3 * v];
@@ -394,6 +399,7 @@ class Refitter {
     if (before || !near_vertex_.empty()) spheres = bounding_spheres(x);
     Projection p;
     p.nearest.resize(count);
+    p.settled.resize(count);
     p.face.resize(count);
     p.bary.resize(3 * count);
     Projection::Array<double> d2(count);
@@ -408,6 +414,7 @@ class Refitter {
                          const auto hit = from == UINT32_MAX ? tree.closest(q, &hint)
                                           : before           ? closest_around(x, spheres, q, from)
                                                              : closest_by_walk(x, spheres, q, from);
+                         p.settled[j] = from == UINT32_MAX || (before && hit.triangle == from);
                          if (hit.triangle == UINT32_MAX) continue;
                          p.nearest[j] = hit.triangle;
                          d2[j] = hit.d2;  // counted in the error even when the face cannot pull
@@ -575,8 +582,9 @@ class Refitter {
  public:
   // After run(): per point of `all` (the points given to refit_to_points, of which the refit's
   // may be a thinned sample), its closest face of the approximation as it ends, walked to from
-  // the point's own last projection (when the refit fitted every point) or, as the first
-  // projection does, from the vertex the point went into; UINT32_MAX where neither is known. (A
+  // the point's own last projection (when the refit fitted every point; that face itself where
+  // its search ended where it began) or, as the first projection does, from the vertex the point
+  // went into; UINT32_MAX where neither is known. (A
   // walk from the last answer of the point's run in the Morton order was cheaper, but a run can
   // reach across a fold: on the bunny to 1 % one ended 0.25 of the diagonal from the answer.)
   std::vector<std::uint32_t> closest_faces(const FitPoints& all) const {
@@ -590,7 +598,8 @@ class Refitter {
                          const std::uint32_t j = all.order[k];
                          const double* q = &all.position[3 * j];
                          if (own && last_nearest_[j] != UINT32_MAX) {
-                           out[j] = walk_from(x_, spheres, q, last_nearest_[j]).triangle;
+                           out[j] = last_settled_[j] ? last_nearest_[j]
+                                                     : walk_from(x_, spheres, q, last_nearest_[j]).triangle;
                            continue;
                          }
                          const std::uint32_t v = vertex_of_source(all.source[j]);
@@ -856,6 +865,7 @@ class Refitter {
   std::vector<std::uint32_t> around_start_;  // per face: the faces around its corners (CSR)
   core::UnzeroedVector<std::uint32_t> around_faces_;
   Projection::Array<std::uint32_t> last_nearest_;  // per point: its closest face at the end of run()
+  Projection::Array<std::uint8_t> last_settled_;   // per point: whether a walk from there would stay
   bool ready_ = false;
 };
 
