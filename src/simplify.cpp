@@ -66,7 +66,8 @@ std::vector<std::uint8_t> border_points_for(const Mesh& mesh, std::span<const st
 }
 
 // The far-place repair of `mesh` with `options`' turn limit and threads (core/far_repair.h), against
-// the input (`positions`) as `points` and `surface`, `on_border` per point (border_points_for),
+// the input (`positions`) as `points` and `surface`, `on_border` per point (border_points_for;
+// empty: found by the repair when it needs them, unless the mesh has vertex properties),
 // `closest_faces` per point (empty: none) as FarRepairOptions::point_faces. A
 // relocated vertex that stands at an input vertex takes its exact coordinates (on a border: on the
 // input's border, as exact borders promise).
@@ -90,6 +91,8 @@ core::FarRepairResult repair_mesh(Mesh& mesh, const SimplifyOptions& options, Me
   repair_options.relocations = 256;
   repair_options.add_vertices = options.target_vertices == 0;  // a vertex target stays a bound
   repair_options.point_on_border = on_border;
+  // None given: the repair finds them if a relocation at a border comes (as border_points_for).
+  repair_options.find_border_points = on_border.empty() && mesh.vertex_properties.empty();
   core::FarRepairResult made =
       core::repair_far_places(mesh, points.frame(), surface, points.position, points.weight, repair_options);
   for (const core::Relocation& r : made.relocations)
@@ -152,10 +155,8 @@ std::vector<std::uint8_t> seam_or_locked(std::span<const std::uint8_t> on_seam, 
 void repair_after_refit(SimplifyResult& result, const SimplifyOptions& options, MeshView input,
                         const refit_detail::FitPoints& points, const core::SurfaceDistance& surface,
                         std::span<const std::uint8_t> held, std::span<const std::uint32_t> closest_faces) {
-  const core::FarRepairResult made = repair_mesh(
-      result.mesh, options, input,
-      border_points_for(result.mesh, input.indices, points, core::resolve_threads(options.threads)), points,
-      surface, held, closest_faces);
+  const core::FarRepairResult made =
+      repair_mesh(result.mesh, options, input, {}, points, surface, held, closest_faces);
   result.edge_flips = made.flips;
   result.vertex_moves = made.moves;
   result.vertex_relocations = made.relocations.size();

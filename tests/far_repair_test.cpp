@@ -437,6 +437,24 @@ TEST(FarRepair, ABorderBulgeGetsABorderVertexFromAStraightBorder) {
     if (p[1] == 0) p[1] = -0.03 * std::max(0.0, 1 - std::abs(p[0] - 0.3125) / 0.0625);
   }
   expect_relocated(input, test::grid(8));
+  // The border points found by the repair when it needs them (find_border_points), as simplify
+  // leaves it to do, are those given: the same relocations.
+  Mesh given = test::grid(8), found = test::grid(8);
+  const core::FarRepairResult r = relocate(given, input, 8);
+  std::vector<std::uint32_t> source(input.vertex_count());
+  for (std::uint32_t v = 0; v < source.size(); ++v) source[v] = v;
+  core::FarRepairOptions o;
+  o.relocations = 8;
+  o.find_border_points = true;
+  o.input_faces = input.indices;
+  o.point_source = source;
+  EXPECT_EQ(flip(found, input, o).relocations.size(), r.relocations.size());
+  EXPECT_EQ(found.indices, given.indices);
+  EXPECT_EQ(found.positions, given.positions);
+  // Neither given nor to be found: no relocation at the border.
+  Mesh none = test::grid(8);
+  o.find_border_points = false;
+  EXPECT_LT(flip(none, input, o).relocations.size(), r.relocations.size());
 }
 
 // A small part kept as one face, as a loose piece of a scan becomes: triangle A, B, C 0.01 above

@@ -443,6 +443,15 @@ class Repairer {
     return false;
   }
   bool held(std::uint32_t v) const { return held_[v] != 0; }
+  // Whether a relocation may split at a border: the input's border points are given or found.
+  bool border_allowed() const { return !opt_.point_on_border.empty() || opt_.find_border_points; }
+  // The input's border points (FarRepairOptions::point_on_border, or found at the first call).
+  std::span<const std::uint8_t> border_points() {
+    if (!opt_.point_on_border.empty()) return opt_.point_on_border;
+    if (found_border_.empty())
+      found_border_ = points_on_border(opt_.input_faces, opt_.point_source, resolve_threads(opt_.threads));
+    return found_border_;
+  }
   Vec3 normal(std::uint32_t a, std::uint32_t b, std::uint32_t c) const {
     return cross(x_[b] - x_[a], x_[c] - x_[a]);
   }
@@ -994,7 +1003,7 @@ class Repairer {
       // A border edge: split along the input's border, at its input point farthest from the
       // output edge (or, when the output is what is far, nearest the far sample), so that the
       // border stays on the input's (a split that adds one face, paired with a border collapse).
-      if (opt_.point_on_border.empty() || !border_edge(ea, eb)) return false;
+      if (!border_allowed() || !border_edge(ea, eb)) return false;
       // Held ends stay as they are, unless only their place holds them (other vertices share it:
       // the sides of a crack the input never welded): where another side has the same edge, a
       // crack's two sides split together (a vertex more); where none has, the sides already part
@@ -1037,17 +1046,18 @@ class Repairer {
         if (squared_distance(y, x_[ea]) <= at_end2 || squared_distance(y, x_[eb]) <= at_end2) return;
         if (keeps_facing(s, y)) best = q, key = d2;
       };
+      const std::span<const std::uint8_t> on_border = border_points();
       for (std::uint32_t h : around)
         for (std::uint32_t q : points_of_[h])
-          if (opt_.point_on_border[q])
+          if (on_border[q])
             consider(q, near_most_[f] >= score_[f].most ? -d2_[q] : squared_distance(point(q), near));
       // None there (a lone face standing for a small part, whose input points went to nearer faces
       // of other parts): the input border point nearest the far place, within kBorderReach times
       // its distance.
       if (best == UINT32_MAX) {
         if (border_by_x_.empty()) {
-          for (std::uint32_t q = 0; q < opt_.point_on_border.size(); ++q)
-            if (opt_.point_on_border[q]) border_by_x_.push_back({point(q).x, q});
+          for (std::uint32_t q = 0; q < on_border.size(); ++q)
+            if (on_border[q]) border_by_x_.push_back({point(q).x, q});
           std::sort(border_by_x_.begin(), border_by_x_.end());
         }
         const double reach = kBorderReach * local(f);
@@ -1311,7 +1321,7 @@ class Repairer {
           if (held(v) || faces_at_[v].empty()) continue;
           if (interior(v))
             kind[v] = 1, cost[v] = removal_cost(v);
-          else if (!opt_.point_on_border.empty() && border_removable(v))
+          else if (border_allowed() && border_removable(v))
             kind[v] = 2, cost[v] = border_removal_cost(v);
         }
       });
@@ -1516,6 +1526,7 @@ class Repairer {
   std::vector<Vec3> first_normal_;                   // per face slot, its line's normal when the relocations began
   std::vector<double> near_;                         // per face, its centroid's and edge midpoints' largest
   std::vector<std::uint32_t> hint_;                  // per face, a face of the input near it
+  std::vector<std::uint8_t> found_border_;           // border_points(), when the caller gave none
   double largest_ = 0;                               // the largest distance both ways, at the start (scanned)
   std::vector<std::vector<std::uint32_t>> points_of_;  // per face, the input points closest to it
   std::vector<double> near_most_;                    // per face, the largest of those points' distances
