@@ -104,8 +104,8 @@ struct FarRepairOptions {
   std::span<const std::uint8_t> point_on_border;
   /// With point_on_border empty: the repair finds the input's border points itself
   /// (points_on_border of input_faces and point_source) when a relocation at a border first needs
-  /// them, so a run whose output has no border never does (on a closed ten-million-face input, a
-  /// third of a second on two threads).
+  /// them, so a run whose output has no border never makes them (the input's face lists, on a
+  /// closed input the largest arrays of the repair's set-up, for nothing).
   bool find_border_points = false;
   /// With attributes (approx.attributes, in the order of the input's): the input's per-vertex
   /// attributes and each point's input vertex (FitPoints::source). A flip, a move or a
