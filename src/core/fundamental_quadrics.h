@@ -14,7 +14,8 @@ namespace qem::core {
 
 /// Per vertex, the sum of the plane quadrics K_p of its faces, weighted by area (HG99 §2: the
 /// quadric integrates squared distance over the surface), uniformly (GH97 §5) or by corner angle.
-/// Zero-area faces have no plane and add nothing. Reads the live faces through mesh.vertex_faces.
+/// Zero-area faces have no plane and add nothing. Reads the live faces (mesh.face_alive), each
+/// vertex's sum in face order.
 /// Written into `quadrics` (resized to the vertices; every entry overwritten), so that a renewal
 /// (core/forgetting.h) reuses the array it replaces instead of fresh, zeroed memory.
 void face_quadrics(const WorkingMesh& mesh, Weighting weighting, unsigned threads, std::vector<Quadric>& quadrics);

@@ -56,7 +56,7 @@ void run_greedy(Context& c, const std::vector<std::uint8_t>* stale, double forge
   const auto fill_heap = [&](const std::vector<std::uint8_t>* stale) {
     const std::uint32_t n = std::uint32_t(ps.pairs.size());
     const auto to_cost = [&](std::uint32_t p) {
-      return ps.pairs[p].state == kCandidate && !(stale && !(*stale)[p]);
+      return ps.pairs[p].state == kCandidate && (!stale || (*stale)[p]);
     };
     // The costs on the threads (pair_cost only reads; NaN: refused), as the passes' re-costs are
     // made; then the heap and the refusals in pair order, as one thread would.

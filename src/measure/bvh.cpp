@@ -329,7 +329,7 @@ TriangleBvh::Hit TriangleBvh::search(const double p[3], double best, std::uint32
     std::uint32_t node;
     double d2;
   };
-  Entry stack[kStack];  // holds at most depth + 1 entries; the build bounds the depth (kSahDepth)
+  Entry stack[kStack];  // at most one entry a level (a node's farther child): the build bounds the depth
   int top = 0;
   // The nearer child of a node is searched next without going through the stack; the farther
   // waits there.

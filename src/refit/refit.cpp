@@ -584,9 +584,9 @@ class Refitter {
   // may be a thinned sample), its closest face of the approximation as it ends, walked to from
   // the point's own last projection (when the refit fitted every point; that face itself where
   // its search ended where it began) or, as the first projection does, from the vertex the point
-  // went into; UINT32_MAX where neither is known. (A
-  // walk from the last answer of the point's run in the Morton order was cheaper, but a run can
-  // reach across a fold: on the bunny to 1 % one ended 0.25 of the diagonal from the answer.)
+  // went into; UINT32_MAX where neither is known. (A walk from the last answer of the point's run
+  // in the Morton order was cheaper, but a run can reach across a fold: on the bunny to 1 % one
+  // ended 0.25 of the diagonal from the answer.)
   std::vector<std::uint32_t> closest_faces(const FitPoints& all) const {
     std::vector<std::uint32_t> out(all.weight.size(), UINT32_MAX);
     if (!ready_) return out;
