@@ -143,10 +143,12 @@ double param_on(const BorderSpot& v, std::uint32_t x, std::uint32_t y) {
 struct BorderWalk {
   std::uint32_t x, y;
   double lo;
-  std::vector<Piece> pieces;
+  std::vector<Piece>& pieces;  // emptied: the caller's, so that its capacity is kept from walk to walk
   enum { Going, Found, Dead } state = Going;
 
-  BorderWalk(std::uint32_t from, std::uint32_t to, double at) : x(from), y(to), lo(at) {
+  BorderWalk(std::uint32_t from, std::uint32_t to, double at, std::vector<Piece>& out)
+      : x(from), y(to), lo(at), pieces(out) {
+    pieces.clear();
     if (y == kNoSlot) state = Dead;
   }
   void step(const BorderChains& ch, const BorderSpot& v, bool through_corners) {
@@ -180,9 +182,10 @@ bool piece_reaches(const Piece& p, const BorderSpot& v) {
 }
 
 // The shorter of the two ways from u to v along the input border (empty: neither found within
-// kMaxBorderWalk edges; of two as short, the first). A corner ends a way unless `through_corners`
-// (a soft corner the run removed still has its slot). The two ways are walked in step, so a
-// contraction near one end of a long border (a terrain's side) never walks the wrong way round.
+// kMaxBorderWalk edges; of two as short, the first), valid until the thread's next call. A corner
+// ends a way unless `through_corners` (a soft corner the run removed still has its slot). The two
+// ways are walked in step, so a contraction near one end of a long border (a terrain's side)
+// never walks the wrong way round.
 //
 // With `avoid`, only a way that does not pass that spot before v (at v's own place either way is
 // as good), for chord_error: u is a current border neighbour of a moving end, v that end's new
@@ -192,12 +195,17 @@ bool piece_reaches(const Piece& p, const BorderSpot& v) {
 // back round the loop is few), the shorter way runs through the part of the border that stays
 // and misses the part the contraction removes (the dragon at 10 %: a slit's bend 1.8e-4 from the
 // output).
-std::vector<Piece> border_between(const BorderChains& ch, const BorderSpot& u, const BorderSpot& v,
-                                  bool through_corners = false, const BorderSpot* avoid = nullptr) {
-  BorderWalk ways[2] = {u.to == kNoSlot ? BorderWalk(u.from, ch.neighbour[2 * std::size_t(u.from)], 0)
-                                        : BorderWalk(u.from, u.to, u.t),
-                        u.to == kNoSlot ? BorderWalk(u.from, ch.neighbour[2 * std::size_t(u.from) + 1], 0)
-                                        : BorderWalk(u.to, u.from, 1 - u.t)};
+const std::vector<Piece>& border_between(const BorderChains& ch, const BorderSpot& u, const BorderSpot& v,
+                                         bool through_corners = false, const BorderSpot* avoid = nullptr) {
+  // The two ways' pieces, per thread (the placements run on the re-costing threads): the answer
+  // is read before the next call, and no call allocates once they have grown.
+  thread_local std::vector<Piece> found[2];
+  static const std::vector<Piece> none;
+  BorderWalk ways[2] = {
+      u.to == kNoSlot ? BorderWalk(u.from, ch.neighbour[2 * std::size_t(u.from)], 0, found[0])
+                      : BorderWalk(u.from, u.to, u.t, found[0]),
+      u.to == kNoSlot ? BorderWalk(u.from, ch.neighbour[2 * std::size_t(u.from) + 1], 0, found[1])
+                      : BorderWalk(u.to, u.from, 1 - u.t, found[1])};
   for (std::size_t steps = 0; steps < kMaxBorderWalk; ++steps) {
     bool going = false;
     for (BorderWalk& w : ways) {
@@ -211,23 +219,72 @@ std::vector<Piece> border_between(const BorderChains& ch, const BorderSpot& u, c
           continue;
         }
       }
-      if (w.state == BorderWalk::Found) return std::move(w.pieces);
+      if (w.state == BorderWalk::Found) return w.pieces;
       going |= w.state == BorderWalk::Going;
     }
     if (!going) break;
   }
-  return {};
+  return none;
+}
+
+// Up to two neighbours of v along the current border other than `not_this`, in the order of v's
+// faces and their corners; kNoVertex for none. A neighbour is on the border with v when exactly one
+// live face of v's list has it (border_detail::is_border_edge): below the hub's size the faces are
+// counted from v's list, so one walk over it counts every neighbour at once (the test per
+// neighbour walked the list again for each). A hub's neighbours are tested one by one, as
+// is_border_edge counts them from the other end.
+void border_neighbours(const WorkingMesh& m, std::uint32_t v, std::uint32_t not_this, std::uint32_t out[2]) {
+  out[0] = out[1] = kNoVertex;
+  const auto faces = m.vertex_faces[v];
+  if (faces.size() > border_detail::kHubFaces) {
+    for (std::uint32_t f : faces) {
+      if (!m.face_alive[f]) continue;
+      const std::uint32_t* t = m.face(f);
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t n = t[k];
+        if (n == v || n == not_this || n == out[0] || n == out[1] || !border_detail::is_border_edge(m, v, n))
+          continue;
+        if (out[0] == kNoVertex)
+          out[0] = n;
+        else
+          out[1] = n;
+        if (out[1] != kNoVertex) return;
+      }
+    }
+    return;
+  }
+  // Each other corner once, in order of first appearance, with the number of faces it is on.
+  std::uint32_t corner[2 * border_detail::kHubFaces];
+  std::uint32_t count[2 * border_detail::kHubFaces];
+  std::size_t corners = 0;
+  for (std::uint32_t f : faces) {
+    if (!m.face_alive[f]) continue;
+    const std::uint32_t* t = m.face(f);
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t n = t[k];
+      if (n == v || (k > 0 && n == t[0]) || (k > 1 && n == t[1])) continue;  // each corner of a face once
+      std::size_t i = 0;
+      while (i < corners && corner[i] != n) ++i;
+      if (i == corners) corner[corners] = n, count[corners++] = 0;
+      ++count[i];
+    }
+  }
+  for (std::size_t i = 0; i < corners; ++i) {
+    if (count[i] != 1 || corner[i] == not_this) continue;
+    if (out[0] == kNoVertex)
+      out[0] = corner[i];
+    else {
+      out[1] = corner[i];
+      return;
+    }
+  }
 }
 
 // v's neighbour along the current border other than `not_this` (kNoVertex if none).
 std::uint32_t other_border_neighbour(const WorkingMesh& m, std::uint32_t v, std::uint32_t not_this) {
-  for (std::uint32_t f : m.vertex_faces[v]) {
-    if (!m.face_alive[f]) continue;
-    const std::uint32_t* t = m.face(f);
-    for (int k = 0; k < 3; ++k)
-      if (t[k] != v && t[k] != not_this && border_detail::is_border_edge(m, v, t[k])) return t[k];
-  }
-  return kNoVertex;
+  std::uint32_t out[2];
+  border_neighbours(m, v, not_this, out);
+  return out[0];
 }
 
 }  // namespace
@@ -246,60 +303,60 @@ double corner_error(const Context& c_, std::uint32_t a, std::uint32_t b, const V
   return (weight > 0 ? weight : 1) * size * size;
 }
 
-namespace {
-// Up to two neighbours of v along the current border other than `not_this`; kNoVertex for none.
-void border_neighbours(const WorkingMesh& m, std::uint32_t v, std::uint32_t not_this, std::uint32_t out[2]) {
-  out[0] = out[1] = kNoVertex;
-  for (std::uint32_t f : m.vertex_faces[v]) {
-    if (!m.face_alive[f]) continue;
-    const std::uint32_t* t = m.face(f);
-    for (int k = 0; k < 3; ++k) {
-      const std::uint32_t n = t[k];
-      if (n == v || n == not_this || n == out[0] || n == out[1] || !border_detail::is_border_edge(m, v, n)) continue;
-      if (out[0] == kNoVertex) out[0] = n;
-      else out[1] = n;
-      if (out[1] != kNoVertex) return;
-    }
-  }
-}
-}  // namespace
-
-double chord_error(const Context& c_, std::uint32_t a, std::uint32_t b, const Vec3& x, const BorderSpot& xs, double weight) {
+void ChordError::find_neighbours() {
   const WorkingMesh& m = c_.mesh;
+  found_ = true;
+  border_neighbours(m, a_, b_, nbr_[0]);
+  border_neighbours(m, b_, a_, nbr_[1]);
+  // A hole down to three vertices: the contraction closes it (hole_error), no border edge is left.
+  closes_hole_ = nbr_[0][0] != kNoVertex && (nbr_[0][0] == nbr_[1][0] || nbr_[0][0] == nbr_[1][1]);
+  for (int end = 0; end < 2; ++end)
+    for (int k = 0; k < 2; ++k) {
+      const std::uint32_t n = nbr_[end][k];
+      if (n == kNoVertex || m.border_spot[n].from == kNoSlot) continue;
+      // Through corners: a soft corner between n and x is gone if the way reaches x (a live one
+      // would be a vertex of the current border between them, which n and x are neighbours on).
+      // The way toward the end, not the one past n's other neighbour (border_between's `avoid`),
+      // where n is on a simple chain: one other border neighbour, no hard corner (where borders
+      // meet, the shorter way as before).
+      std::uint32_t beyond[2];
+      border_neighbours(m, n, end == 0 ? a_ : b_, beyond);
+      const bool simple = m.corner[n] != kHardCorner && beyond[0] != kNoVertex && beyond[1] == kNoVertex &&
+                          m.border_spot[beyond[0]].from != kNoSlot;
+      avoid_[end][k] = simple ? &m.border_spot[beyond[0]] : nullptr;
+    }
+}
+
+double ChordError::operator()(const Vec3& x, const BorderSpot& xs) {
+  const WorkingMesh& m = c_.mesh;
+  const std::uint32_t a = a_, b = b_;
   if (!c_.settings.exact_border || m.corner.empty() || xs.from == kNoSlot || !(m.boundary[a] || m.boundary[b])) return 0;
   const auto same = [](const Vec3& p, const Vec3& q) { return p.x == q.x && p.y == q.y && p.z == q.z; };
   // No border end moves (a held or locked end, such as a part's cut): no border edge changes.
   if (!(m.boundary[a] && !same(x, m.pos[a])) && !(m.boundary[b] && !same(x, m.pos[b]))) return 0;
-  std::uint32_t nbr[2][2];
-  border_neighbours(m, a, b, nbr[0]);
-  border_neighbours(m, b, a, nbr[1]);
-  // A hole down to three vertices: the contraction closes it (hole_error), no border edge is left.
-  if (nbr[0][0] != kNoVertex && (nbr[0][0] == nbr[1][0] || nbr[0][0] == nbr[1][1])) return 0;
+  if (!found_) find_neighbours();
+  if (closes_hole_) return 0;
   double d2 = 0;
   for (int end = 0; end < 2; ++end) {
     const std::uint32_t e = end == 0 ? a : b;
     if (!m.boundary[e] || same(x, m.pos[e])) continue;  // e stays: its border edges are as they were
-    for (std::uint32_t n : nbr[end]) {
+    for (int k = 0; k < 2; ++k) {
+      const std::uint32_t n = nbr_[end][k];
       if (n == kNoVertex || m.border_spot[n].from == kNoSlot) continue;
       const Vec3& s = m.pos[n];
-      // Through corners: a soft corner between n and x is gone if the way reaches x (a live one
-      // would be a vertex of the current border between them, which n and x are neighbours on).
-      // The way toward e, not the one past n's other neighbour (border_between's `avoid`), where
-      // n is on a simple chain: one other border neighbour, no hard corner (where borders meet,
-      // the shorter way as before).
-      std::uint32_t beyond[2];
-      border_neighbours(m, n, e, beyond);
-      const bool simple = m.corner[n] != kHardCorner && beyond[0] != kNoVertex && beyond[1] == kNoVertex &&
-                          m.border_spot[beyond[0]].from != kNoSlot;
-      const std::vector<Piece> way =
-          border_between(m.chains, m.border_spot[n], xs, true, simple ? &m.border_spot[beyond[0]] : nullptr);
+      const std::vector<Piece>& way = border_between(m.chains, m.border_spot[n], xs, true, avoid_[end][k]);
       for (const Piece& p : way) {
         const Vec3 o = m.chains.pos[p.x], d = m.chains.pos[p.y] - o;
         d2 = std::max({d2, squared_distance_to_segment(o + d * p.lo, s, x), squared_distance_to_segment(o + d * p.hi, s, x)});
       }
     }
   }
-  return (weight > 0 ? weight : 1) * d2;
+  return (weight_ > 0 ? weight_ : 1) * d2;
+}
+
+double chord_error(const Context& c, std::uint32_t a, std::uint32_t b, const Vec3& x, const BorderSpot& xs,
+                   double weight) {
+  return ChordError(c, a, b, weight)(x, xs);
 }
 
 std::uint32_t hole_closed_by(const WorkingMesh& m, std::uint32_t a, std::uint32_t b) {
@@ -390,7 +447,8 @@ void place_along_border(const Context& c, std::uint32_t a, std::uint32_t b, cons
   const BorderSpot& u = m.border_spot[a];
   const BorderSpot& v = m.border_spot[b];
   if (u.from != kNoSlot && v.from != kNoSlot) add_piece_minima(m.chains, border_between(m.chains, u, v), q, error_at, cand);
-  for (Placed& k : cand) k.error = std::max(k.error, chord_error(c, a, b, k.position, k.spot, q.weight));
+  ChordError chord(c, a, b, q.weight);
+  for (Placed& k : cand) k.error = std::max(k.error, chord(k.position, k.spot));
   choose(c, a, b, cand, placed);
 }
 
@@ -416,7 +474,8 @@ void place_on_own_border(const Context& c, std::uint32_t a, std::uint32_t b, con
       if (n != kNoVertex && m.border_spot[n].from != kNoSlot)
         add_piece_minima(m.chains, border_between(m.chains, u, m.border_spot[n]), q, error_at, cand);
     // A slide moves a's two border edges (a's own place, cand[0], moves none).
-    for (Placed& k : cand) k.error = std::max(k.error, chord_error(c, a, b, k.position, k.spot, q.weight));
+    ChordError chord(c, a, b, q.weight);
+    for (Placed& k : cand) k.error = std::max(k.error, chord(k.position, k.spot));
   }
   choose(c, a, b, cand, placed);
 }

@@ -84,12 +84,12 @@ inline Role role(const Context& c, std::uint32_t v) {
   return m.boundary[v] ? Role::Border : Role::Free;
 }
 /// Exactly one live face has both a and b: (a, b) is an edge of the current border.
+/// A fan's hub (a triangulated n-gon: any number of faces) is counted from its other end, so its
+/// faces are not walked on every re-cost of its pairs (that made a 30k fan cubic in its valence).
+/// Only there: within a pass (order_passes.h) a survivor's list lacks the faces it absorbed, and
+/// below the hub's size the end counted from stays a, as it always was.
+inline constexpr std::size_t kHubFaces = 64;
 inline bool is_border_edge(const WorkingMesh& m, std::uint32_t a, std::uint32_t b) {
-  // A fan's hub (a triangulated n-gon: any number of faces) is counted from its other end, so its
-  // faces are not walked on every re-cost of its pairs (that made a 30k fan cubic in its valence).
-  // Only there: within a pass (order_passes.h) a survivor's list lacks the faces it absorbed, and
-  // below the hub's size the end counted from stays a, as it always was.
-  constexpr std::size_t kHubFaces = 64;
   if (m.vertex_faces[a].size() > kHubFaces && m.vertex_faces[b].size() < m.vertex_faces[a].size()) std::swap(a, b);
   int shared = 0;
   for (std::uint32_t f : m.vertex_faces[a])
@@ -138,6 +138,26 @@ double corner_error(const Context& c, std::uint32_t a, std::uint32_t b, const Ve
 /// 1.31x meshoptimizer's). 0 when no border edge changes (x is a border end's own place and the
 /// other end is interior), when the contraction closes a hole, or when x is not on a border.
 double chord_error(const Context& c, std::uint32_t a, std::uint32_t b, const Vec3& x, const BorderSpot& xs, double weight);
+
+/// chord_error of one contraction (a, b) at several places, as the border placements weigh their
+/// candidates: the current border neighbours of a and b, and of those neighbours, do not depend on
+/// the place, so they are found once (at the first place that moves a border end), not per place.
+class ChordError {
+ public:
+  ChordError(const Context& c, std::uint32_t a, std::uint32_t b, double weight)
+      : c_(c), a_(a), b_(b), weight_(weight) {}
+  double operator()(const Vec3& x, const BorderSpot& xs);
+
+ private:
+  void find_neighbours();
+  const Context& c_;
+  std::uint32_t a_, b_;
+  double weight_;
+  bool found_ = false;
+  bool closes_hole_ = false;
+  std::uint32_t nbr_[2][2];             // per end (a, b): its current border neighbours but the other end
+  const BorderSpot* avoid_[2][2] = {};  // per such neighbour: the spot its way to the place must not pass
+};
 
 /// Small holes close at the scale of the error (as --prune removes parts in distance units): when
 /// an input hole (a simple closed border loop) is down to three vertices a, b, c, contracting its

@@ -58,6 +58,24 @@ bool Regions::make_region(Context& c, PassLists& lists, const std::vector<std::u
   return true;
 }
 
+// At most the faces contraction p may remove when it is made in this band. Where no two faces can
+// land on the same three vertices (contract's merge_faces without duplicates), it removes the faces
+// that have both ends, and no contraction before it in the band adds one: each vertex is in one
+// pair of a pass, so another contraction only renames a third corner (a face on a, b and c stays
+// one face on a, b and d), and a face of a and x that becomes one of b would need x to contract
+// into b. So those faces counted now bound it, two on a manifold edge. Otherwise, every face of
+// either end.
+std::size_t Regions::faces_it_may_remove(const Context& c, std::uint32_t p) {
+  const WorkingMesh& m = c.mesh;
+  const PairRecord& r = c.pairs.pairs[p];
+  const std::uint32_t a = r.v[0], b = r.v[1];
+  if (m.aggregated[a] || m.aggregated[b] || r.is_virtual || !c.settings.preserve_topology)
+    return m.vertex_faces[a].size() + m.vertex_faces[b].size();
+  std::size_t shared = 0;
+  for (std::uint32_t f : m.vertex_faces[a]) shared += m.face_alive[f] && m.face_has(f, b);
+  return shared;
+}
+
 bool Regions::make_band(Context& c, PassLists& lists, const std::uint32_t* band, std::size_t count) {
   // Each pair to its region or to the border group.
   for (auto& pairs : inside_) pairs.clear();
@@ -74,8 +92,7 @@ bool Regions::make_band(Context& c, PassLists& lists, const std::uint32_t* band,
       continue;
     }
     inside_[region].push_back(p);
-    // It removes only faces of its ends.
-    faces_at_stake += c.mesh.vertex_faces[a].size() + c.mesh.vertex_faces[b].size();
+    faces_at_stake += faces_it_may_remove(c, p);
   }
   // Disjoint stamp ranges (each contraction takes 3 stamps), so every stamp stays unique.
   std::array<std::uint32_t, kRegions> first_stamp;

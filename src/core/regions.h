@@ -34,6 +34,7 @@ class Regions {
   bool make_band(Context& c, PassLists& lists, const std::uint32_t* band, std::size_t count);
 
  private:
+  static std::size_t faces_it_may_remove(const Context& c, std::uint32_t p);
   std::uint32_t region_of(std::uint32_t v) const { return std::uint32_t((v * region_scale_) >> 40); }
   void mark_cut(const PassLists& lists, std::uint32_t v);
   void mark_neighbours_near(const PassLists& lists, std::uint32_t v);

@@ -57,23 +57,41 @@ std::vector<std::uint8_t> border_vertices(std::span<const std::uint32_t> triangl
   std::vector<std::uint8_t> border(vertex_count);
   constexpr std::size_t kChunk = std::size_t(1) << 14;
   for_chunks(vertex_count, kChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> other;  // v's neighbours, how many faces each
+    // v's neighbours and how many faces each: in arrays on the stack for an ordinary vertex (the
+    // lookups are most of the work), in a vector round a large fan's hub.
+    constexpr std::size_t kSmall = 64;
+    std::uint32_t other[kSmall], count[kSmall];
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> many;
     for (std::size_t v = begin; v < end; ++v) {
-      other.clear();
+      const auto at = faces.at(v);
       // A face listed k times at v (k corners at v) counts each other corner k times, as
       // unique_edges counts it from the edge's lower end.
-      for (std::uint32_t f : faces.at(v))
+      if (2 * at.size() <= kSmall) {
+        std::size_t n = 0;
+        for (std::uint32_t f : at)
+          for (int k = 0; k < 3; ++k) {
+            const std::uint32_t w = triangles[3 * std::size_t(f) + k];
+            if (w == v) continue;
+            std::size_t i = 0;
+            while (i < n && other[i] != w) ++i;
+            if (i == n) other[n] = w, count[n++] = 0;
+            ++count[i];
+          }
+        border[v] = std::find(count, count + n, 1u) != count + n;
+        continue;
+      }
+      many.clear();
+      for (std::uint32_t f : at)
         for (int k = 0; k < 3; ++k) {
           const std::uint32_t w = triangles[3 * std::size_t(f) + k];
           if (w == v) continue;
-          auto it = std::find_if(other.begin(), other.end(), [w](const auto& o) { return o.first == w; });
-          if (it == other.end())
-            other.push_back({w, 1});
+          auto it = std::find_if(many.begin(), many.end(), [w](const auto& o) { return o.first == w; });
+          if (it == many.end())
+            many.push_back({w, 1});
           else
             ++it->second;
         }
-      const bool single = std::any_of(other.begin(), other.end(), [](const auto& o) { return o.second == 1; });
-      border[v] = single;
+      border[v] = std::any_of(many.begin(), many.end(), [](const auto& o) { return o.second == 1; });
     }
   });
   return border;
