@@ -43,6 +43,29 @@ std::vector<Edge> unique_edges(std::span<const std::uint32_t> triangles, const V
   return edges;
 }
 
+std::vector<Edge> single_face_edges(std::span<const std::uint32_t> triangles, const VertexLists& vertex_faces,
+                                    std::span<const std::uint8_t> from) {
+  std::vector<Edge> edges, here;
+  for (std::uint32_t v = 0; v < from.size(); ++v) {
+    if (!from[v]) continue;
+    here.clear();
+    for (std::uint32_t f : vertex_faces[v])
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t w = triangles[3 * std::size_t(f) + k];
+        if (w <= v) continue;  // from its lower end, as unique_edges
+        auto it = std::find_if(here.begin(), here.end(), [w](const Edge& e) { return e.hi == w; });
+        if (it == here.end())
+          here.push_back({v, w, 1});
+        else
+          ++it->faces;
+      }
+    sort_small(here.begin(), here.end(), [](const Edge& a, const Edge& b) { return a.hi < b.hi; });
+    for (const Edge& e : here)
+      if (e.faces == 1) edges.push_back(e);
+  }
+  return edges;
+}
+
 std::vector<Edge> unique_edges(std::span<const std::uint32_t> triangles, std::size_t vertex_count) {
   VertexLists faces;
   faces.rebuild(vertex_count, [&](auto emit) {

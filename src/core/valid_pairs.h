@@ -23,6 +23,12 @@ std::vector<Edge> unique_edges(std::span<const std::uint32_t> triangles, const V
 /// The same from the triangle list alone (its face lists made here), for callers that have none.
 std::vector<Edge> unique_edges(std::span<const std::uint32_t> triangles, std::size_t vertex_count);
 
+/// The edges of unique_edges with `faces == 1` (in its order, counted as it counts them), found
+/// only from the vertices flagged in `from` (a superset of their lower ends): a renewal's border
+/// planes on a mesh whose border vertices are known need not list every edge.
+std::vector<Edge> single_face_edges(std::span<const std::uint32_t> triangles, const VertexLists& vertex_faces,
+                                    std::span<const std::uint8_t> from);
+
 /// Per vertex of a triangle list, 1 where one of its edges has a single face: the ends of the edges
 /// of unique_edges with `faces == 1`, without making the edge list (12 bytes an edge, all
 /// fresh pages, on the serial path of a large run's repair). Each vertex is decided from its own
