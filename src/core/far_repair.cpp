@@ -471,10 +471,20 @@ class Repairer {
 
   // Each input point of `pts` to the nearest of `count` faces (face k's corners by corners(k); of
   // two as near, the lower k): k in nearest[i], the squared distance in d2[i]. Returns the largest
-  // squared distance and adds the points' weighted squared distances to `energy`.
+  // squared distance.
+  //
+  // A change (flip, move, split or collapse) is refused when a point or a sample of its new faces
+  // comes too far; both are tested, in either order with the same answer. The points need no
+  // search of the input, a face's samples one each, so where a face has few points (fine outputs)
+  // the points go first and refuse many changes before any search; where it has many (coarse
+  // outputs) the samples go first, since the first sample of a refused change is usually too far.
+  static bool points_first(std::size_t points, std::size_t faces) {
+    return points <= kPointsFirstPerFace * faces;
+  }
+  static constexpr std::size_t kPointsFirstPerFace = 16;
   template <class CornersOf>
   double to_nearest_faces(std::span<const std::uint32_t> pts, std::size_t count, CornersOf corners,
-                          std::vector<std::uint32_t>& nearest, std::vector<double>& d2, double& energy) const {
+                          std::vector<std::uint32_t>& nearest, std::vector<double>& d2) const {
     nearest.resize(pts.size());
     d2.resize(pts.size());
     double most2 = 0;
@@ -488,9 +498,14 @@ class Repairer {
       }
       d2[i] = best;
       most2 = std::max(most2, best);
-      energy += weights_[pts[i]] * weight_scale_ * best;
     }
     return most2;
+  }
+  // Adds the points' weighted squared distances to `energy`, in their order (after the faces'
+  // samples: the sum of a change's share of E is made in one order).
+  void add_points_energy(std::span<const std::uint32_t> pts, std::span<const double> d2,
+                         double& energy) const {
+    for (std::size_t i = 0; i < pts.size(); ++i) energy += weights_[pts[i]] * weight_scale_ * d2[i];
   }
 
   // Tries the flip of edge k of face f1; returns the other face of the flip, or UINT32_MAX when
@@ -523,23 +538,28 @@ class Repairer {
     ensure_scored(f1), ensure_scored(f2);
     const double old_most = std::max(local(f1), local(f2));
     const Vec3 g1[3] = {x_[a], x_[d], x_[c]}, g2[3] = {x_[b], x_[c], x_[d]};
-    const FaceScore s1 = score(g1[0], g1[1], g1[2], score_[f1].hint, old_most);
-    if (s1.most >= old_most) return UINT32_MAX;
-    const FaceScore s2 = score(g2[0], g2[1], g2[2], score_[f2].hint, old_most);
-    if (s2.most >= old_most) return UINT32_MAX;
-    double old_energy = score_[f1].energy + score_[f2].energy;
-    for (std::uint32_t f : {f1, f2})
-      for (std::uint32_t p : points_of_[f]) old_energy += weights_[p] * weight_scale_ * d2_[p];
     std::vector<std::uint32_t>& pts = scratch_points_;
     pts.assign(points_of_[f1].begin(), points_of_[f1].end());
     pts.insert(pts.end(), points_of_[f2].begin(), points_of_[f2].end());
-    double energy = s1.energy + s2.energy;
     const auto corners = [&](std::size_t k) {
       const Vec3* g = k == 0 ? g1 : g2;
       return std::array<Vec3, 3>{g[0], g[1], g[2]};
     };
-    const double most2 = to_nearest_faces(pts, 2, corners, scratch_nearest_, scratch_d2_, energy);
-    if (std::max({s1.most, s2.most, std::sqrt(most2)}) >= old_most) return UINT32_MAX;
+    const bool early = points_first(pts.size(), 2);
+    const auto points_near = [&] {
+      return std::sqrt(to_nearest_faces(pts, 2, corners, scratch_nearest_, scratch_d2_)) < old_most;
+    };
+    if (early && !points_near()) return UINT32_MAX;
+    const FaceScore s1 = score(g1[0], g1[1], g1[2], score_[f1].hint, old_most);
+    if (s1.most >= old_most) return UINT32_MAX;
+    const FaceScore s2 = score(g2[0], g2[1], g2[2], score_[f2].hint, old_most);
+    if (s2.most >= old_most) return UINT32_MAX;
+    if (!early && !points_near()) return UINT32_MAX;
+    double old_energy = score_[f1].energy + score_[f2].energy;
+    for (std::uint32_t f : {f1, f2})
+      for (std::uint32_t p : points_of_[f]) old_energy += weights_[p] * weight_scale_ * d2_[p];
+    double energy = s1.energy + s2.energy;
+    add_points_energy(pts, scratch_d2_, energy);
     if (energy > old_energy * (1 + opt_.error_margin)) return UINT32_MAX;
     if (!channels_.empty()) {
       // The values at the points and between them, on the faces as they are and as they would be.
@@ -593,16 +613,13 @@ class Repairer {
       for (std::uint32_t p : points_of_[f]) old_energy += weights_[p] * weight_scale_ * d2_[p];
     }
     const Vec3 x = x_[v];
-    std::vector<FaceScore> scores(fan.size());
-    for (std::size_t i = 0; i < fan.size(); ++i) {
-      const std::uint32_t* t = &tri_[3 * fan[i]];
+    for (std::uint32_t f : fan) {
+      const std::uint32_t* t = &tri_[3 * f];
       const Vec3 n = normalized(normal(t[0], t[1], t[2]));
       x_[v] = y;
       const Vec3 m = normalized(normal(t[0], t[1], t[2]));
-      if (dot(m, m) == 0 || dot(n, m) < cos_turn_) return x_[v] = x, false;
-      scores[i] = score(x_[t[0]], x_[t[1]], x_[t[2]], score_[fan[i]].hint, old_most);
       x_[v] = x;
-      if (scores[i].most >= old_most) return false;
+      if (dot(m, m) == 0 || dot(n, m) < cos_turn_) return false;
     }
     // The fan's points, each to the nearest of the fan's faces after the move.
     std::vector<std::uint32_t>& pts = scratch_points_;
@@ -612,6 +629,27 @@ class Repairer {
       pts.insert(pts.end(), points_of_[fan[k]].begin(), points_of_[fan[k]].end());
       on.resize(pts.size(), std::uint32_t(k));
     }
+    const auto corners = [&](std::size_t k) {
+      const std::uint32_t* t = &tri_[3 * fan[k]];
+      return std::array<Vec3, 3>{x_[t[0]], x_[t[1]], x_[t[2]]};
+    };
+    const bool early = points_first(pts.size(), fan.size());
+    const auto points_near = [&] {
+      x_[v] = y;
+      const double most2 = to_nearest_faces(pts, fan.size(), corners, scratch_nearest_, scratch_d2_);
+      x_[v] = x;
+      return std::sqrt(most2) < old_most;
+    };
+    if (early && !points_near()) return false;
+    std::vector<FaceScore> scores(fan.size());
+    for (std::size_t i = 0; i < fan.size(); ++i) {
+      const std::uint32_t* t = &tri_[3 * fan[i]];
+      x_[v] = y;
+      scores[i] = score(x_[t[0]], x_[t[1]], x_[t[2]], score_[fan[i]].hint, old_most);
+      x_[v] = x;
+      if (scores[i].most >= old_most) return false;
+    }
+    if (!early && !points_near()) return false;
     // The values at the points and between them, round the fan where it is and where it goes.
     const auto fan_face = [&](std::size_t k) { return face(fan[k]); };
     double values_before = 0;
@@ -622,12 +660,8 @@ class Repairer {
     x_[v] = y;
     double energy = 0;
     for (std::size_t i = 0; i < fan.size(); ++i) energy += scores[i].energy;
-    const auto corners = [&](std::size_t k) {
-      const std::uint32_t* t = &tri_[3 * fan[k]];
-      return std::array<Vec3, 3>{x_[t[0]], x_[t[1]], x_[t[2]]};
-    };
-    const double most2 = to_nearest_faces(pts, fan.size(), corners, scratch_nearest_, scratch_d2_, energy);
-    if (std::sqrt(most2) >= old_most || energy > old_energy * (1 + opt_.error_margin)) return x_[v] = x, false;
+    add_points_energy(pts, scratch_d2_, energy);
+    if (energy > old_energy * (1 + opt_.error_margin)) return x_[v] = x, false;
     if (!channels_.empty() &&
         appearance_error(pts, scratch_nearest_, scratch_samples_, fan.size(), fan_face) > values_before)
       return x_[v] = x, false;
@@ -857,15 +891,6 @@ class Repairer {
   bool score_plan(Plan& p, const Vec3& y, double limit) const {
     p.scores.resize(p.faces.size());
     p.most = 0, p.energy = 0, p.old_energy = 0;
-    for (std::size_t i = 0; i < p.faces.size(); ++i) {
-      const Corners& t = p.faces[i];
-      p.scores[i] = score(at(t[0], y), at(t[1], y), at(t[2], y), score_[p.parent[i]].hint, limit);
-      if (p.scores[i].most >= limit) return false;
-      climb(at(t[0], y), at(t[1], y), at(t[2], y), p.scores[i]);
-      if (p.scores[i].most >= limit) return false;
-      p.most = std::max(p.most, p.scores[i].most);
-      p.energy += p.scores[i].energy;
-    }
     p.points.clear();
     for (std::uint32_t f : p.old) {
       p.old_energy += score_[f].energy;
@@ -875,7 +900,24 @@ class Repairer {
       const Corners& t = p.faces[k];
       return std::array<Vec3, 3>{at(t[0], y), at(t[1], y), at(t[2], y)};
     };
-    const double most2 = to_nearest_faces(p.points, p.faces.size(), corners, p.nearest, p.d2, p.energy);
+    const bool early = points_first(p.points.size(), p.faces.size());
+    double most2 = 0;
+    const auto points_near = [&] {
+      most2 = to_nearest_faces(p.points, p.faces.size(), corners, p.nearest, p.d2);
+      return std::sqrt(most2) < limit;
+    };
+    if (early && !points_near()) return false;
+    for (std::size_t i = 0; i < p.faces.size(); ++i) {
+      const Corners& t = p.faces[i];
+      p.scores[i] = score(at(t[0], y), at(t[1], y), at(t[2], y), score_[p.parent[i]].hint, limit);
+      if (p.scores[i].most >= limit) return false;
+      climb(at(t[0], y), at(t[1], y), at(t[2], y), p.scores[i]);
+      if (p.scores[i].most >= limit) return false;
+      p.most = std::max(p.most, p.scores[i].most);
+      p.energy += p.scores[i].energy;
+    }
+    if (!early && !points_near()) return false;
+    add_points_energy(p.points, p.d2, p.energy);
     p.most = std::max(p.most, std::sqrt(most2));
     return p.most < limit;
   }
