@@ -425,14 +425,43 @@ void add_piece_minima(const BorderChains& ch, const std::vector<Piece>& pieces, 
 
 // The lowest-error candidate that keeps every face's side (GH97 §6); if none does, the lowest
 // (refused later). Stable: ties go to the earlier.
-void choose(const Context& c, std::uint32_t a, std::uint32_t b, std::vector<Placed>& cand, Placed& placed) {
-  std::stable_sort(cand.begin(), cand.end(), [](const Placed& l, const Placed& r) { return l.error < r.error; });
-  for (const Placed& k : cand)
-    if (!flips(c.mesh, a, b, k.position, c.settings.cos_max_turn)) {
-      placed = k;
-      return;
+// The first candidate in the order of the errors with their chords (chord_error; of two as
+// large, the earlier in `cand`) that flips no face, else the first. A chord only adds to a
+// candidate's own error, so the candidates are priced in the order of their own errors, and one
+// whose priced error is below every unpriced one's own comes before all of those: it is tested
+// then, and most contractions price one or two of their candidates instead of all (on a terrain,
+// whose slides along long borders have many). The same choice as pricing all, then testing them
+// in order.
+void choose(const Context& c, std::uint32_t a, std::uint32_t b, std::vector<Placed>& cand, ChordError* chord,
+            Placed& placed) {
+  const std::size_t n = cand.size();
+  std::vector<std::uint32_t> by_own(n);
+  for (std::uint32_t i = 0; i < n; ++i) by_own[i] = i;
+  std::stable_sort(by_own.begin(), by_own.end(),
+                   [&](std::uint32_t l, std::uint32_t r) { return cand[l].error < cand[r].error; });
+  std::vector<std::uint32_t> priced;  // not yet tested
+  const Placed* least = nullptr;      // the first in the order: the choice if every one flips
+  for (std::size_t next = 0;;) {
+    // Out come the priced ones below every unpriced one (all of them once every one is priced).
+    for (;;) {
+      const auto it = std::min_element(priced.begin(), priced.end(), [&](std::uint32_t l, std::uint32_t r) {
+        return cand[l].error < cand[r].error || (cand[l].error == cand[r].error && l < r);
+      });
+      if (it == priced.end() || (next < n && !(cand[*it].error < cand[by_own[next]].error))) break;
+      const Placed& k = cand[*it];
+      priced.erase(it);
+      if (!least) least = &k;
+      if (!flips(c.mesh, a, b, k.position, c.settings.cos_max_turn)) {
+        placed = k;
+        return;
+      }
     }
-  placed = cand.front();
+    if (next == n) break;
+    Placed& k = cand[by_own[next]];
+    if (chord) k.error = std::max(k.error, (*chord)(k.position, k.spot));
+    priced.push_back(by_own[next++]);
+  }
+  placed = *least;
 }
 
 }  // namespace
@@ -448,8 +477,7 @@ void place_along_border(const Context& c, std::uint32_t a, std::uint32_t b, cons
   const BorderSpot& v = m.border_spot[b];
   if (u.from != kNoSlot && v.from != kNoSlot) add_piece_minima(m.chains, border_between(m.chains, u, v), q, error_at, cand);
   ChordError chord(c, a, b, q.weight);
-  for (Placed& k : cand) k.error = std::max(k.error, chord(k.position, k.spot));
-  choose(c, a, b, cand, placed);
+  choose(c, a, b, cand, &chord, placed);
 }
 
 void place_on_own_border(const Context& c, std::uint32_t a, std::uint32_t b, const Quadric& q, Placed& placed) {
@@ -475,9 +503,10 @@ void place_on_own_border(const Context& c, std::uint32_t a, std::uint32_t b, con
         add_piece_minima(m.chains, border_between(m.chains, u, m.border_spot[n]), q, error_at, cand);
     // A slide moves a's two border edges (a's own place, cand[0], moves none).
     ChordError chord(c, a, b, q.weight);
-    for (Placed& k : cand) k.error = std::max(k.error, chord(k.position, k.spot));
+    choose(c, a, b, cand, &chord, placed);
+    return;
   }
-  choose(c, a, b, cand, placed);
+  choose(c, a, b, cand, nullptr, placed);
 }
 
 }  // namespace qem::core
