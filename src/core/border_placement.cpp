@@ -423,15 +423,13 @@ void add_piece_minima(const BorderChains& ch, const std::vector<Piece>& pieces, 
   }
 }
 
-// The lowest-error candidate that keeps every face's side (GH97 §6); if none does, the lowest
-// (refused later). Stable: ties go to the earlier.
-// The first candidate in the order of the errors with their chords (chord_error; of two as
-// large, the earlier in `cand`) that flips no face, else the first. A chord only adds to a
-// candidate's own error, so the candidates are priced in the order of their own errors, and one
-// whose priced error is below every unpriced one's own comes before all of those: it is tested
-// then, and most contractions price one or two of their candidates instead of all (on a terrain,
-// whose slides along long borders have many). The same choice as pricing all, then testing them
-// in order.
+// The lowest-error candidate, its chord (chord_error) included, that keeps every face's side
+// (GH97 §6); if none does, the lowest (refused later). Ties go to the earlier in `cand`.
+// A chord only adds to a candidate's own error, so the candidates are priced in the order of
+// their own errors, and one whose priced error is below every unpriced one's own comes before all
+// of those: it is tested then, and most contractions price one or two of their candidates instead
+// of all (a terrain's slides along long borders have many). The same choice, and the same flip
+// tests, as pricing all and then testing them in order.
 void choose(const Context& c, std::uint32_t a, std::uint32_t b, std::vector<Placed>& cand, ChordError* chord,
             Placed& placed) {
   const std::size_t n = cand.size();
