@@ -22,6 +22,7 @@
 #include <sstream>
 
 #include "io/gltf_accessors.h"
+#include "io/gltf_draco.h"
 #include "io/io_common.h"
 #include "qem/gltf.h"
 
@@ -32,9 +33,10 @@ namespace {
 using io::gltf::append_accessor;
 using io::gltf::read_accessor;
 
-// Extensions that change how geometry is stored: reading them as plain accessors would give
-// garbage, so they are refused by name (decoding them is not implemented).
-constexpr const char* kCompressed[] = {"KHR_draco_mesh_compression", "EXT_meshopt_compression"};
+// Extensions that change how geometry is stored and that qem does not decode (Draco is decoded at
+// load, io/gltf_draco.h): reading them as plain accessors would give garbage, so they are refused
+// by name.
+constexpr const char* kCompressed[] = {"EXT_meshopt_compression"};
 
 // Extensions known to hold no accessor index: with any other extension in use, accessors that a
 // replaced primitive leaves unused are kept as they are, since the extension may refer to them.
@@ -206,6 +208,7 @@ struct GltfDocument::Impl {
   std::vector<GltfPrimitiveInfo> primitives;
   std::map<std::size_t, Mesh> replaced;
   std::vector<std::string> notes;
+  std::set<std::size_t> compressed_views;  // the Draco bitstreams decoded at load: not written
 
   std::string where(std::size_t i) const {
     const GltfPrimitiveInfo& p = primitives[i];
@@ -239,7 +242,6 @@ void refuse_compression(const tinygltf::Model& model, const std::string& name) {
 }  // namespace
 
 void GltfDocument::Impl::check_and_list() {
-  refuse_compression(model, name);
   // Every buffer view inside its buffer, so that saving (which copies them all) cannot fail.
   for (std::size_t v = 0; v < model.bufferViews.size(); ++v) {
     const tinygltf::BufferView& view = model.bufferViews[v];
@@ -252,6 +254,8 @@ void GltfDocument::Impl::check_and_list() {
                   ", " + std::to_string(view.byteLength) + " long) lies outside its buffer of " +
                   std::to_string(size) + " bytes");
   }
+  io::gltf::decode_draco(model, name, compressed_views);
+  refuse_compression(model, name);
   for (std::size_t m = 0; m < model.meshes.size(); ++m)
     for (std::size_t k = 0; k < model.meshes[m].primitives.size(); ++k) {
       const tinygltf::Primitive& p = model.meshes[m].primitives[k];
@@ -451,6 +455,8 @@ GltfDocument GltfDocument::from_bytes(std::string_view bytes, const std::string&
   std::string err, warn;
   bool ok = false;
   try {
+    const std::string draco_aside = io::gltf::set_draco_indices_aside(bytes);
+    if (!draco_aside.empty()) bytes = draco_aside;
     if (is_glb(bytes))
       ok = loader.LoadBinaryFromMemory(&d.model, &err, &warn,
                                        reinterpret_cast<const unsigned char*>(bytes.data()),
@@ -659,13 +665,14 @@ tinygltf::Model GltfDocument::Impl::rebuilt() const {
       }
 
   // 3. Buffer views: drop those only released data used (a view nothing used before, perhaps an
-  // extension's, stays), renumber, and re-pack all bytes into buffer 0.
+  // extension's, stays) and the decoded Draco bitstreams, renumber, and re-pack all bytes into
+  // buffer 0.
   const std::vector<char> used_before = view_uses(model, old_views), used_after = view_uses(m, old_views);
   std::vector<int> new_index(m.bufferViews.size(), -1);
   std::vector<tinygltf::BufferView> views;
   std::vector<unsigned char> bin;
   for (std::size_t v = 0; v < m.bufferViews.size(); ++v) {
-    if (v < old_views && used_before[v] && !used_after[v]) continue;
+    if (v < old_views && ((used_before[v] && !used_after[v]) || compressed_views.count(v))) continue;
     tinygltf::BufferView view = m.bufferViews[v];
     const std::vector<unsigned char>* source = &fresh;
     if (v < old_views) {

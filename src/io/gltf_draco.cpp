@@ -1,0 +1,227 @@
+#include "io/gltf_draco.h"
+
+#include <draco/compression/decode.h>
+#include <draco/core/decoder_buffer.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <vector>
+
+#include "io/gltf_accessors.h"
+#include "qem/error.h"
+
+namespace qem::io::gltf {
+
+namespace {
+
+constexpr const char* kDraco = "KHR_draco_mesh_compression";
+constexpr const char* kIndicesAside = "qem_indices";  // set_draco_indices_aside's key
+
+std::uint32_t read_u32(std::string_view bytes, std::size_t at) {
+  std::uint32_t v;
+  std::memcpy(&v, bytes.data() + at, 4);
+  return v;
+}
+
+void append_u32(std::string& out, std::uint32_t v) {
+  char b[4];
+  std::memcpy(b, &v, 4);
+  out.append(b, 4);
+}
+
+// Every point's value of `attribute` converted to T (draco checks that each fits), appended to
+// `bytes`; false when one does not fit.
+template <class T>
+bool append_values(const draco::Mesh& mesh, const draco::PointAttribute& attribute, std::vector<unsigned char>& bytes) {
+  const int n = attribute.num_components();
+  T values[4] = {};
+  for (draco::PointIndex i(0); i < mesh.num_points(); ++i) {
+    if (!attribute.ConvertValue<T>(attribute.mapped_index(i), static_cast<std::int8_t>(n), values)) return false;
+    const auto* p = reinterpret_cast<const unsigned char*>(values);
+    bytes.insert(bytes.end(), p, p + sizeof(T) * static_cast<std::size_t>(n));
+  }
+  return true;
+}
+
+bool append_values(int component_type, const draco::Mesh& mesh, const draco::PointAttribute& attribute,
+                   std::vector<unsigned char>& bytes) {
+  switch (component_type) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE: return append_values<std::int8_t>(mesh, attribute, bytes);
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return append_values<std::uint8_t>(mesh, attribute, bytes);
+    case TINYGLTF_COMPONENT_TYPE_SHORT: return append_values<std::int16_t>(mesh, attribute, bytes);
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return append_values<std::uint16_t>(mesh, attribute, bytes);
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return append_values<std::uint32_t>(mesh, attribute, bytes);
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return append_values<float>(mesh, attribute, bytes);
+    default: return false;
+  }
+}
+
+// The faces' corners in the index accessor's component type; false when an index does not fit it.
+bool append_indices(int component_type, const draco::Mesh& mesh, std::vector<unsigned char>& bytes) {
+  const std::size_t size = component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE    ? 1
+                           : component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? 2
+                           : component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT   ? 4
+                                                                                       : 0;
+  if (size == 0) return false;
+  const std::uint64_t limit = size == 4 ? UINT32_MAX : (std::uint64_t(1) << (8 * size)) - 1;
+  for (draco::FaceIndex f(0); f < mesh.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t index = mesh.face(f)[k].value();
+      if (index >= mesh.num_points() || index > limit) return false;
+      unsigned char b[4];
+      std::memcpy(b, &index, 4);  // little endian, as glTF is
+      bytes.insert(bytes.end(), b, b + size);
+    }
+  return true;
+}
+
+// `bytes` as a new buffer and buffer view; accessor `a` reads it from its start.
+void attach(tinygltf::Model& model, tinygltf::Accessor& a, std::vector<unsigned char>&& bytes, std::size_t count,
+            int target) {
+  tinygltf::BufferView view;
+  view.buffer = static_cast<int>(model.buffers.size());
+  view.byteLength = bytes.size();
+  view.target = target;
+  tinygltf::Buffer buffer;
+  buffer.data = std::move(bytes);
+  model.buffers.push_back(std::move(buffer));
+  model.bufferViews.push_back(std::move(view));
+  a.bufferView = static_cast<int>(model.bufferViews.size() - 1);
+  a.byteOffset = 0;
+  a.count = count;
+  a.sparse.isSparse = false;
+}
+
+void decode_primitive(tinygltf::Model& model, tinygltf::Primitive& p, const std::string& where,
+                      std::set<std::size_t>& compressed_views) {
+  const tinygltf::Value& ext = p.extensions.at(kDraco);
+  const tinygltf::Value& view_value = ext.Get("bufferView");
+  const tinygltf::Value& names = ext.Get("attributes");
+  if (!view_value.IsInt() || !names.IsObject())
+    throw Error(where + ": " + kDraco + " needs an integer bufferView and an attributes object");
+  const int v = view_value.GetNumberAsInt();
+  if (v < 0 || static_cast<std::size_t>(v) >= model.bufferViews.size())
+    throw Error(where + ": " + kDraco + " names buffer view " + std::to_string(v) + ", which does not exist");
+  const tinygltf::BufferView& view = model.bufferViews[static_cast<std::size_t>(v)];
+  const std::vector<unsigned char>& data = model.buffers[static_cast<std::size_t>(view.buffer)].data;
+
+  draco::DecoderBuffer stream;
+  stream.Init(reinterpret_cast<const char*>(data.data() + view.byteOffset), view.byteLength);
+  draco::Decoder decoder;
+  auto decoded = decoder.DecodeMeshFromBuffer(&stream);
+  if (!decoded.ok())
+    throw Error(where + ": the Draco data in buffer view " + std::to_string(v) +
+                " cannot be decoded: " + decoded.status().error_msg_string());
+  const draco::Mesh& mesh = *decoded.value();
+  if (mesh.num_faces() == 0 || mesh.num_points() == 0)
+    throw Error(where + ": the Draco data in buffer view " + std::to_string(v) + " holds no triangles");
+  compressed_views.insert(static_cast<std::size_t>(v));
+
+  auto accessor_of = [&](int index, const std::string& what) -> tinygltf::Accessor& {
+    if (index < 0 || static_cast<std::size_t>(index) >= model.accessors.size())
+      throw Error(where + " (" + what + "): accessor " + std::to_string(index) + " does not exist");
+    return model.accessors[static_cast<std::size_t>(index)];
+  };
+  for (const std::string& semantic : names.Keys()) {
+    const tinygltf::Value& id = names.Get(semantic);
+    const auto named = p.attributes.find(semantic);
+    if (!id.IsInt() || named == p.attributes.end())
+      throw Error(where + ": " + kDraco + " names " + semantic +
+                  (id.IsInt() ? ", which the primitive does not have" : " without an integer id"));
+    tinygltf::Accessor& a = accessor_of(named->second, semantic);
+    const draco::PointAttribute* attribute =
+        id.GetNumberAsInt() < 0 ? nullptr : mesh.GetAttributeByUniqueId(static_cast<std::uint32_t>(id.GetNumberAsInt()));
+    if (!attribute)
+      throw Error(where + " (" + semantic + "): the Draco data has no attribute " +
+                  std::to_string(id.GetNumberAsInt()));
+    if (attribute->num_components() != components_of(a.type) || attribute->num_components() > 4)
+      throw Error(where + " (" + semantic + "), accessor " + std::to_string(named->second) + ": the Draco attribute has " +
+                  std::to_string(attribute->num_components()) + " components, the accessor's type " +
+                  std::to_string(components_of(a.type)));
+    std::vector<unsigned char> bytes;
+    if (!append_values(a.componentType, mesh, *attribute, bytes))
+      throw Error(where + " (" + semantic + "), accessor " + std::to_string(named->second) +
+                  ": a decoded value does not fit the accessor's component type " + std::to_string(a.componentType));
+    attach(model, a, std::move(bytes), mesh.num_points(), TINYGLTF_TARGET_ARRAY_BUFFER);
+  }
+  if (ext.Has(kIndicesAside) && ext.Get(kIndicesAside).IsInt()) p.indices = ext.Get(kIndicesAside).GetNumberAsInt();
+  // Draco always stores faces: a primitive without indices gets an index accessor of its own.
+  if (p.indices < 0) {
+    tinygltf::Accessor indices;
+    indices.type = TINYGLTF_TYPE_SCALAR;
+    indices.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+    model.accessors.push_back(std::move(indices));
+    p.indices = static_cast<int>(model.accessors.size() - 1);
+  }
+  tinygltf::Accessor& ia = accessor_of(p.indices, "indices");
+  std::vector<unsigned char> bytes;
+  if (!append_indices(ia.componentType, mesh, bytes))
+    throw Error(where + " (indices), accessor " + std::to_string(p.indices) + ": component type " +
+                std::to_string(ia.componentType) + " cannot hold the decoded indices");
+  attach(model, ia, std::move(bytes), 3 * std::size_t(mesh.num_faces()), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+  p.extensions.erase(kDraco);
+}
+
+}  // namespace
+
+std::string set_draco_indices_aside(std::string_view bytes) {
+  // The JSON: the whole text, or a .glb's first chunk (header: magic, version, length; chunk:
+  // length, type "JSON", data).
+  const bool glb = bytes.size() >= 4 && bytes.substr(0, 4) == "glTF";
+  std::string_view text = bytes;
+  if (glb) {
+    if (bytes.size() < 20 || bytes.substr(16, 4) != "JSON" || read_u32(bytes, 12) > bytes.size() - 20) return "";
+    text = bytes.substr(20, read_u32(bytes, 12));
+  }
+  if (text.find(kDraco) == std::string_view::npos) return "";
+  nlohmann::json doc = nlohmann::json::parse(text, nullptr, false);
+  if (doc.is_discarded() || !doc.is_object() || !doc.contains("meshes") || !doc["meshes"].is_array()) return "";
+  const nlohmann::json* accessors = doc.contains("accessors") && doc["accessors"].is_array() ? &doc["accessors"] : nullptr;
+  bool moved = false;
+  for (nlohmann::json& mesh : doc["meshes"]) {
+    if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
+    for (nlohmann::json& p : mesh["primitives"]) {
+      if (!p.is_object() || !p.contains("extensions") || !p["extensions"].is_object() ||
+          !p["extensions"].contains(kDraco) || !p["extensions"][kDraco].is_object() || !p.contains("indices") ||
+          !p["indices"].is_number_unsigned())
+        continue;
+      const std::size_t a = p["indices"].get<std::size_t>();
+      if (!accessors || a >= accessors->size() || !(*accessors)[a].is_object() || (*accessors)[a].contains("bufferView"))
+        continue;
+      p["extensions"][kDraco][kIndicesAside] = p["indices"];
+      p.erase("indices");
+      moved = true;
+    }
+  }
+  if (!moved) return "";
+  std::string json = doc.dump();
+  if (!glb) return json;
+  json.resize((json.size() + 3) & ~std::size_t(3), ' ');  // chunks are 4-byte aligned, JSON padded with spaces
+  const std::string_view rest = bytes.substr(20 + text.size());
+  std::string out = "glTF";
+  append_u32(out, read_u32(bytes, 4));
+  append_u32(out, static_cast<std::uint32_t>(12 + 8 + json.size() + rest.size()));
+  append_u32(out, static_cast<std::uint32_t>(json.size()));
+  out += "JSON";
+  out += json;
+  out += rest;
+  return out;
+}
+
+void decode_draco(tinygltf::Model& model, const std::string& name, std::set<std::size_t>& compressed_views) {
+  for (std::size_t m = 0; m < model.meshes.size(); ++m)
+    for (std::size_t k = 0; k < model.meshes[m].primitives.size(); ++k) {
+      tinygltf::Primitive& p = model.meshes[m].primitives[k];
+      if (!p.extensions.count(kDraco)) continue;
+      decode_primitive(model, p, name + ": mesh " + std::to_string(m) + ", primitive " + std::to_string(k),
+                       compressed_views);
+    }
+  // No primitive is compressed now (a list naming an extension nothing uses is dropped too).
+  for (std::vector<std::string>* list : {&model.extensionsUsed, &model.extensionsRequired})
+    list->erase(std::remove(list->begin(), list->end(), kDraco), list->end());
+}
+
+}  // namespace qem::io::gltf

@@ -1,0 +1,33 @@
+// KHR_draco_mesh_compression: primitives whose geometry is a Draco bitstream are decoded with
+// Debian's libdraco (Google's reference decoder) into plain accessors when a glTF document is
+// loaded, so that everything after the load (reading, simplifying, writing) sees an ordinary
+// document. The output is written uncompressed: qem re-packs every buffer it writes, and
+// compressing again is a separate, lossy choice (gltfpack, gltf-transform) left to the user.
+#pragma once
+
+#include <tiny_gltf.h>
+
+#include <cstddef>
+#include <set>
+#include <string>
+#include <string_view>
+
+namespace qem::io::gltf {
+
+/// tinygltf refuses a primitive whose index accessor has no buffer view, which is how a Draco
+/// primitive's indices are written (the bitstream holds them). Given a document's bytes (.gltf JSON
+/// or .glb), returns them with each such primitive's `indices` moved into its extension object (as
+/// `qem_indices`, where decode_draco takes it back), or "" when nothing needs to move (no Draco
+/// primitive, or bytes that tinygltf will refuse with its own message anyway).
+std::string set_draco_indices_aside(std::string_view bytes);
+
+/// Decodes every primitive that carries KHR_draco_mesh_compression: each accessor the extension
+/// names (and the indices) gets the decoded values in a new buffer and buffer view, in its own
+/// component type; the extension leaves the primitives and the document's extension lists. The
+/// buffer views that held the bitstreams are added to `compressed_views` (the writer drops them).
+/// Throws qem::Error naming `name`, the mesh and the primitive when the bitstream or the extension
+/// is malformed or does not match the accessors (an attribute's component count, a value that
+/// does not fit the accessor's type).
+void decode_draco(tinygltf::Model& model, const std::string& name, std::set<std::size_t>& compressed_views);
+
+}  // namespace qem::io::gltf

@@ -1,0 +1,214 @@
+// KHR_draco_mesh_compression (io/gltf_draco.h): documents whose primitives are Draco bitstreams,
+// made in code with libdraco's encoder, read as the same triangles with the same attributes, written
+// back uncompressed, simplified through the command line; malformed ones refused by name.
+#include <draco/compression/encode.h>
+#include <draco/mesh/triangle_soup_mesh_builder.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "qem/error.h"
+#include "qem/gltf.h"
+#include "qem/io.h"
+#include "test_meshes.h"
+
+namespace {
+
+using json = nlohmann::json;
+
+/// A corner as the test compares it: position, then UV, then normal.
+using Corner = std::array<float, 8>;
+/// A face's corners from its smallest, so that the same oriented triangle compares equal whatever
+/// corner a file starts it at.
+using Face = std::array<Corner, 3>;
+
+std::vector<Face> faces_of(const qem::Mesh& m) {
+  const qem::VertexAttribute& uv = qem::test::attribute(m, qem::AttributeKind::TexCoord);
+  const qem::VertexAttribute& normal = qem::test::attribute(m, qem::AttributeKind::Normal);
+  std::vector<Face> faces;
+  for (std::size_t f = 0; f < m.face_count(); ++f) {
+    Face face;
+    for (int k = 0; k < 3; ++k) {
+      const std::size_t v = m.indices[3 * f + k];
+      face[k] = {float(m.positions[3 * v]),     float(m.positions[3 * v + 1]), float(m.positions[3 * v + 2]),
+                 float(uv.values[2 * v]),       float(uv.values[2 * v + 1]),   float(normal.values[3 * v]),
+                 float(normal.values[3 * v + 1]), float(normal.values[3 * v + 2])};
+    }
+    std::rotate(face.begin(), std::min_element(face.begin(), face.end()), face.end());
+    faces.push_back(face);
+  }
+  std::sort(faces.begin(), faces.end());
+  return faces;
+}
+
+/// `m` (positions, TEXCOORD_0, NORMAL) as one Draco-compressed primitive: the bitstream is the only
+/// buffer view, the accessors have none (as the extension writes them), the indices unsigned shorts.
+/// Draco ids: POSITION 0, TEXCOORD_0 1, NORMAL 2 (the builder's attribute order).
+json draco_document(const qem::Mesh& m, std::string& bin) {
+  const qem::VertexAttribute& uv = qem::test::attribute(m, qem::AttributeKind::TexCoord);
+  const qem::VertexAttribute& normal = qem::test::attribute(m, qem::AttributeKind::Normal);
+  draco::TriangleSoupMeshBuilder builder;
+  builder.Start(static_cast<int>(m.face_count()));
+  const int pos = builder.AddAttribute(draco::GeometryAttribute::POSITION, 3, draco::DT_FLOAT32);
+  const int tex = builder.AddAttribute(draco::GeometryAttribute::TEX_COORD, 2, draco::DT_FLOAT32);
+  const int nor = builder.AddAttribute(draco::GeometryAttribute::NORMAL, 3, draco::DT_FLOAT32);
+  std::vector<float> p(m.positions.begin(), m.positions.end()), t(uv.values.begin(), uv.values.end()),
+      n(normal.values.begin(), normal.values.end());
+  for (std::size_t f = 0; f < m.face_count(); ++f) {
+    const std::uint32_t* c = &m.indices[3 * f];
+    const draco::FaceIndex face(static_cast<std::uint32_t>(f));
+    builder.SetAttributeValuesForFace(pos, face, &p[3 * c[0]], &p[3 * c[1]], &p[3 * c[2]]);
+    builder.SetAttributeValuesForFace(tex, face, &t[2 * c[0]], &t[2 * c[1]], &t[2 * c[2]]);
+    builder.SetAttributeValuesForFace(nor, face, &n[3 * c[0]], &n[3 * c[1]], &n[3 * c[2]]);
+  }
+  std::unique_ptr<draco::Mesh> mesh = builder.Finalize();
+  EXPECT_TRUE(mesh);
+  draco::Encoder encoder;  // no quantization: the values come back exactly
+  draco::EncoderBuffer stream;
+  EXPECT_TRUE(encoder.EncodeMeshToBuffer(*mesh, &stream).ok());
+  bin.assign(stream.data(), stream.size());
+  std::array<float, 3> lo{1e30f, 1e30f, 1e30f}, hi{-1e30f, -1e30f, -1e30f};
+  for (std::size_t v = 0; v < m.vertex_count(); ++v)
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[3 * v + k]), hi[k] = std::max(hi[k], p[3 * v + k]);
+  json doc = {
+      {"asset", {{"version", "2.0"}}},
+      {"extensionsUsed", {"KHR_draco_mesh_compression"}},
+      {"extensionsRequired", {"KHR_draco_mesh_compression"}},
+      {"scene", 0},
+      {"scenes", {{{"nodes", {0}}}}},
+      {"nodes", {{{"mesh", 0}}}},
+      {"meshes",
+       {{{"primitives",
+          {{{"attributes", {{"POSITION", 0}, {"TEXCOORD_0", 1}, {"NORMAL", 2}}},
+            {"indices", 3},
+            {"extensions",
+             {{"KHR_draco_mesh_compression",
+               {{"bufferView", 0}, {"attributes", {{"POSITION", 0}, {"TEXCOORD_0", 1}, {"NORMAL", 2}}}}}}}}}}}}},
+      {"accessors",
+       {{{"componentType", 5126}, {"count", m.vertex_count()}, {"type", "VEC3"}, {"min", lo}, {"max", hi}},
+        {{"componentType", 5126}, {"count", m.vertex_count()}, {"type", "VEC2"}},
+        {{"componentType", 5126}, {"count", m.vertex_count()}, {"type", "VEC3"}},
+        {{"componentType", 5123}, {"count", m.indices.size()}, {"type", "SCALAR"}}}},
+      {"bufferViews", {{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", bin.size()}}}},
+      {"buffers", {{{"byteLength", 0}}}}};
+  return doc;
+}
+
+/// `doc` and `bin` as a .glb: the JSON chunk, then `bin` as the BIN chunk (buffer 0).
+std::string glb_of(json doc, std::string bin) {
+  doc["buffers"] = {{{"byteLength", bin.size()}}};
+  std::string text = doc.dump();
+  text.resize((text.size() + 3) & ~std::size_t(3), ' ');
+  bin.resize((bin.size() + 3) & ~std::size_t(3), '\0');
+  std::string out = "glTF";
+  const auto u32 = [&](std::size_t v) {
+    const std::uint32_t w = static_cast<std::uint32_t>(v);
+    out.append(reinterpret_cast<const char*>(&w), 4);
+  };
+  u32(2), u32(12 + 8 + text.size() + 8 + bin.size());
+  u32(text.size()), out += "JSON", out += text;
+  u32(bin.size()), out += "BIN", out += '\0', out += bin;
+  return out;
+}
+
+/// The error of reading `doc` with `bin` as its buffer (its one view made to fit), "" if none.
+std::string error_of(json doc, const std::string& bin) {
+  doc["bufferViews"][0]["byteLength"] = bin.size();
+  try {
+    qem::GltfDocument::parse(qem::test::gltf_text(doc, bin), "d.gltf");
+  } catch (const qem::Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(GltfDraco, DecodesTheSameTrianglesAndAttributes) {
+  const qem::Mesh sphere = qem::test::uv_sphere(12, 24);
+  std::string bin;
+  const json doc = draco_document(sphere, bin);
+  const qem::GltfDocument d = qem::GltfDocument::parse(qem::test::gltf_text(doc, bin), "d.gltf");
+  ASSERT_EQ(d.primitives().size(), 1u);
+  EXPECT_TRUE(d.primitives()[0].simplifiable);
+  const qem::Mesh m = d.mesh(0);
+  EXPECT_EQ(m.face_count(), sphere.face_count());
+  EXPECT_EQ(faces_of(m), faces_of(sphere));
+  // The same in a .glb, whose JSON chunk the loader rewrites before tinygltf reads it.
+  const qem::GltfDocument b = qem::GltfDocument::parse(glb_of(doc, bin), "d.glb");
+  EXPECT_EQ(faces_of(b.mesh(0)), faces_of(sphere));
+}
+
+TEST(GltfDraco, IsWrittenUncompressedAndReadsBackTheSame) {
+  const qem::Mesh sphere = qem::test::uv_sphere(8, 16);
+  std::string bin;
+  const json doc = draco_document(sphere, bin);
+  const qem::GltfDocument d = qem::GltfDocument::parse(qem::test::gltf_text(doc, bin), "d.gltf");
+  const std::string written = d.serialize(false);
+  const json out = json::parse(written);
+  EXPECT_FALSE(out.contains("extensionsUsed")) << out.dump();
+  EXPECT_FALSE(out.contains("extensionsRequired"));
+  EXPECT_FALSE(out["meshes"][0]["primitives"][0].contains("extensions"));
+  // Three attributes and the indices, each in a view of its own: the bitstream's view is gone.
+  EXPECT_EQ(out["bufferViews"].size(), 4u);
+  EXPECT_EQ(out["accessors"].size(), 4u);
+  const qem::GltfDocument again = qem::GltfDocument::parse(written, "again.gltf");
+  EXPECT_EQ(faces_of(again.mesh(0)), faces_of(sphere));
+}
+
+TEST(GltfDraco, CommandLineSimplifiesACompressedFile) {
+  const qem::Mesh sphere = qem::test::uv_sphere(24, 48);
+  std::string bin;
+  const json doc = draco_document(sphere, bin);
+  const std::string dir = qem::test::temp_dir();
+  const std::string in = dir + "/draco_sphere.gltf", out = dir + "/draco_sphere_simplified.glb";
+  std::ofstream(in, std::ios::binary) << qem::test::gltf_text(doc, bin);
+  ASSERT_EQ(qem::test::run_qem_quietly("simplify '" + in + "' '" + out + "' --ratio 0.2"), 0);
+  const qem::GltfDocument d = qem::GltfDocument::load(out);
+  ASSERT_EQ(d.primitives().size(), 1u);
+  EXPECT_LE(d.primitives()[0].face_count, sphere.face_count() / 5 + 2);
+  EXPECT_GT(d.primitives()[0].face_count, 0u);
+  EXPECT_EQ(qem::test::open_edges_welded(d.mesh(0)), 0u);
+}
+
+TEST(GltfDraco, MalformedDataIsRefusedByWhatIsWrong) {
+  const qem::Mesh sphere = qem::test::uv_sphere(4, 8);
+  std::string bin;
+  const json good = draco_document(sphere, bin);
+  ASSERT_EQ(error_of(good, bin), "");
+
+  const std::string broken = bin.substr(0, bin.size() / 2);  // cut off
+  EXPECT_NE(error_of(good, broken).find("d.gltf: mesh 0, primitive 0: the Draco data in buffer view 0 cannot be decoded"),
+            std::string::npos)
+      << error_of(good, broken);
+  EXPECT_NE(error_of(good, "not a draco stream at all").find("cannot be decoded"), std::string::npos);
+
+  json doc = good;
+  doc["meshes"][0]["primitives"][0]["extensions"]["KHR_draco_mesh_compression"]["attributes"]["NORMAL"] = 7;
+  EXPECT_NE(error_of(doc, bin).find("d.gltf: mesh 0, primitive 0 (NORMAL): the Draco data has no attribute 7"),
+            std::string::npos)
+      << error_of(doc, bin);
+
+  doc = good;
+  doc["accessors"][1]["type"] = "VEC3";
+  EXPECT_NE(error_of(doc, bin).find("(TEXCOORD_0), accessor 1: the Draco attribute has 2 components, the accessor's type 3"),
+            std::string::npos)
+      << error_of(doc, bin);
+
+  doc = good;
+  doc["meshes"][0]["primitives"][0]["extensions"]["KHR_draco_mesh_compression"]["bufferView"] = 5;
+  EXPECT_NE(error_of(doc, bin).find("names buffer view 5, which does not exist"), std::string::npos);
+
+  doc = good;
+  doc["accessors"][3]["componentType"] = 5126;  // float indices
+  EXPECT_NE(error_of(doc, bin).find("(indices), accessor 3: component type 5126 cannot hold the decoded indices"),
+            std::string::npos)
+      << error_of(doc, bin);
+}
+
+}  // namespace
