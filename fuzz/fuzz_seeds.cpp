@@ -6,6 +6,10 @@
 //
 //   OUTDIR/{obj,ply,stl,off,gltf,simplify}/seed_*   one file per seed
 //   OUTDIR/{obj,ply,stl,off,gltf}.dict              libFuzzer dictionaries (-dict=)
+#include <draco/compression/encode.h>
+#include <draco/mesh/triangle_soup_mesh_builder.h>
+#include <meshoptimizer.h>
+
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -226,6 +230,73 @@ void handwritten_seeds(const fs::path& out) {
   write_file(out / "gltf" / "hand_attributes.glb", qem::serialize_mesh(m, qem::FileFormat::Gltf, true));
 }
 
+// A .glb: `json` (padded with spaces) and `bin` as buffer 0's BIN chunk.
+std::string glb(std::string json, std::string bin) {
+  json.resize((json.size() + 3) & ~std::size_t(3), ' ');
+  bin.resize((bin.size() + 3) & ~std::size_t(3), '\0');
+  std::string out = "glTF";
+  auto u32 = [&out](std::size_t v) {
+    const std::uint32_t w = std::uint32_t(v);
+    out.append(reinterpret_cast<const char*>(&w), 4);
+  };
+  u32(2), u32(28 + json.size() + bin.size()), u32(json.size()), out += "JSON", out += json;
+  u32(bin.size()), out += "BIN", out += '\0', out += bin;
+  return out;
+}
+
+// glTF whose geometry is compressed: a tetrahedron as a Draco bitstream, and as meshoptimizer's
+// vertex and index codecs in a fallback buffer (the decoders of io/gltf_draco.h, io/gltf_meshopt.h).
+void compressed_gltf_seeds(const fs::path& out) {
+  const qem::Mesh t = tetrahedron();
+  const std::vector<float> p(t.positions.begin(), t.positions.end());
+  draco::TriangleSoupMeshBuilder builder;
+  builder.Start(int(t.face_count()));
+  const int pos = builder.AddAttribute(draco::GeometryAttribute::POSITION, 3, draco::DT_FLOAT32);
+  for (std::uint32_t f = 0; f < t.face_count(); ++f)
+    builder.SetAttributeValuesForFace(pos, draco::FaceIndex(f), &p[3 * t.indices[3 * f]],
+                                      &p[3 * t.indices[3 * f + 1]], &p[3 * t.indices[3 * f + 2]]);
+  draco::Encoder encoder;
+  draco::EncoderBuffer stream;
+  if (!encoder.EncodeMeshToBuffer(*builder.Finalize(), &stream).ok()) std::exit(1);
+  const std::string draco_length = std::to_string(stream.size());
+  write_file(
+      out / "gltf" / "hand_draco.glb",
+      glb(R"({"asset":{"version":"2.0"},"extensionsUsed":["KHR_draco_mesh_compression"],)"
+          R"("meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1,"extensions":)"
+          R"({"KHR_draco_mesh_compression":{"bufferView":0,"attributes":{"POSITION":0}}}}]}],)"
+          R"("accessors":[{"componentType":5126,"count":4,"type":"VEC3","min":[-1,-1,-1],"max":[1,1,1]},)"
+          R"({"componentType":5123,"count":12,"type":"SCALAR"}],"bufferViews":[{"buffer":0,"byteLength":)" +
+              draco_length + R"(}],"buffers":[{"byteLength":)" + draco_length + "}]}",
+          std::string(stream.data(), stream.size())));
+
+  std::string vertices(meshopt_encodeVertexBufferBound(4, 12), '\0'),
+      indices(meshopt_encodeIndexBufferBound(12, 4), '\0');
+  vertices.resize(meshopt_encodeVertexBuffer(reinterpret_cast<unsigned char*>(vertices.data()),
+                                             vertices.size(), p.data(), 4, 12));
+  indices.resize(meshopt_encodeIndexBuffer(reinterpret_cast<unsigned char*>(indices.data()), indices.size(),
+                                           t.indices.data(), 12));
+  const std::string vn = std::to_string(vertices.size()), in = std::to_string(indices.size());
+  vertices.resize((vertices.size() + 3) & ~std::size_t(3), '\0');  // the indices' data 4-byte aligned
+  const std::string at = std::to_string(vertices.size());
+  write_file(
+      out / "gltf" / "hand_meshopt.glb",
+      glb(R"({"asset":{"version":"2.0"},"extensionsUsed":["EXT_meshopt_compression"],)"
+          R"("meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],)"
+          R"("accessors":[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[-1,-1,-1],"max":[1,1,1]},)"
+          R"({"bufferView":1,"componentType":5123,"count":12,"type":"SCALAR"}],"bufferViews":[)"
+          R"({"buffer":1,"byteLength":48,"byteStride":12,"extensions":{"EXT_meshopt_compression":)"
+          R"({"buffer":0,"byteLength":)" +
+              vn +
+              R"(,"byteStride":12,"count":4,"mode":"ATTRIBUTES"}}},)"
+              R"({"buffer":1,"byteOffset":48,"byteLength":24,"extensions":{"EXT_meshopt_compression":)"
+              R"({"buffer":0,"byteOffset":)" +
+              at + R"(,"byteLength":)" + in +
+              R"(,"byteStride":2,"count":12,"mode":"TRIANGLES"}}}],"buffers":[{"byteLength":)" +
+              std::to_string(vertices.size() + indices.size()) +
+              R"(},{"byteLength":72,"extensions":{"EXT_meshopt_compression":{"fallback":true}}}]})",
+          vertices + indices));
+}
+
 void simplify_seeds(const fs::path& out) {
   // The simplify fuzzer decodes any bytes into a case, so varied random bytes are valid seeds.
   std::mt19937 rng(20240601);
@@ -269,7 +340,14 @@ void dictionaries(const fs::path& out) {
                      "\\\"matrix\\\"",
                      "\\\"VEC3\\\"",
                      "\\\"SCALAR\\\"",
-                     "data:application/octet-stream;base64,"});
+                     "data:application/octet-stream;base64,",
+                     "KHR_draco_mesh_compression",
+                     "EXT_meshopt_compression",
+                     "\\\"fallback\\\"",
+                     "ATTRIBUTES",
+                     "TRIANGLES",
+                     "OCTAHEDRAL",
+                     "EXPONENTIAL"});
   dict("obj.dict", {"v ", "vt ", "vn ", "f ", "/", "//", "-1", "#", "\\\\\\x0a", "g ", "o ", "usemtl ",
                     "mtllib ", "1e308", "nan", "inf", "\\x0d\\x0a", "/1/", "/-1"});
   dict("ply.dict", {"ply\\x0a",
@@ -327,6 +405,7 @@ int main(int argc, char** argv) {
   for (const char* dir : {"obj", "ply", "stl", "off", "gltf", "simplify"}) fs::create_directories(out / dir);
   serialised_seeds(out);
   handwritten_seeds(out);
+  compressed_gltf_seeds(out);
   simplify_seeds(out);
   dictionaries(out);
   return 0;

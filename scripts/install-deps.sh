@@ -9,7 +9,8 @@ $SUDO apt-get update
 # CLI11 (command line), fast_float (number parsing in the text readers), nanoflann (k-d tree for
 # threshold pairs), cpp-httplib (the viewer's local HTTP server), libpng (`qem render`'s PNGs),
 # nlohmann/json (the viewer's LOD manifests and scene description, and tinygltf's JSON), tinygltf
-# (glTF 2.0 read and write with pass-through), libdraco (decodes Draco-compressed glTF geometry);
+# (glTF 2.0 read and write with pass-through), libdraco and libmeshoptimizer (decode glTF geometry compressed by Draco or
+# EXT_meshopt_compression);
 # tests: GoogleTest, Google Benchmark; clang + libclang-rt for the libFuzzer targets; chromium for
 # the viewer's browser test; the Python module: Python headers, pybind11, numpy, setuptools and pip
 # (`pip install --no-build-isolation .`), pytest, Open3D (interoperability test, bench/python_peers.py);
@@ -17,7 +18,7 @@ $SUDO apt-get update
 $SUDO apt-get install -y --no-install-recommends \
   build-essential cmake g++ python3 pkg-config \
   libeigen3-dev libcli11-dev libfast-float-dev libnanoflann-dev \
-  libcpp-httplib-dev libpng-dev nlohmann-json3-dev libtinygltf-dev libdraco-dev \
+  libcpp-httplib-dev libpng-dev nlohmann-json3-dev libtinygltf-dev libdraco-dev libmeshoptimizer-dev \
   libgtest-dev libgmock-dev libbenchmark-dev \
   clang libclang-rt-14-dev \
   python3-dev pybind11-dev python3-pybind11 python3-numpy python3-setuptools python3-pip \

@@ -37,8 +37,9 @@ std::vector<Face> faces_of(const qem::Mesh& m) {
     Face face;
     for (int k = 0; k < 3; ++k) {
       const std::size_t v = m.indices[3 * f + k];
-      face[k] = {float(m.positions[3 * v]),     float(m.positions[3 * v + 1]), float(m.positions[3 * v + 2]),
-                 float(uv.values[2 * v]),       float(uv.values[2 * v + 1]),   float(normal.values[3 * v]),
+      face[k] = {float(m.positions[3 * v]),       float(m.positions[3 * v + 1]),
+                 float(m.positions[3 * v + 2]),   float(uv.values[2 * v]),
+                 float(uv.values[2 * v + 1]),     float(normal.values[3 * v]),
                  float(normal.values[3 * v + 1]), float(normal.values[3 * v + 2])};
     }
     std::rotate(face.begin(), std::min_element(face.begin(), face.end()), face.end());
@@ -90,7 +91,8 @@ json draco_document(const qem::Mesh& m, std::string& bin) {
             {"indices", 3},
             {"extensions",
              {{"KHR_draco_mesh_compression",
-               {{"bufferView", 0}, {"attributes", {{"POSITION", 0}, {"TEXCOORD_0", 1}, {"NORMAL", 2}}}}}}}}}}}}},
+               {{"bufferView", 0},
+                {"attributes", {{"POSITION", 0}, {"TEXCOORD_0", 1}, {"NORMAL", 2}}}}}}}}}}}}},
       {"accessors",
        {{{"componentType", 5126}, {"count", m.vertex_count()}, {"type", "VEC3"}, {"min", lo}, {"max", hi}},
         {{"componentType", 5126}, {"count", m.vertex_count()}, {"type", "VEC2"}},
@@ -183,20 +185,23 @@ TEST(GltfDraco, MalformedDataIsRefusedByWhatIsWrong) {
   ASSERT_EQ(error_of(good, bin), "");
 
   const std::string broken = bin.substr(0, bin.size() / 2);  // cut off
-  EXPECT_NE(error_of(good, broken).find("d.gltf: mesh 0, primitive 0: the Draco data in buffer view 0 cannot be decoded"),
+  EXPECT_NE(error_of(good, broken)
+                .find("d.gltf: mesh 0, primitive 0: the Draco data in buffer view 0 cannot be decoded"),
             std::string::npos)
       << error_of(good, broken);
   EXPECT_NE(error_of(good, "not a draco stream at all").find("cannot be decoded"), std::string::npos);
 
   json doc = good;
   doc["meshes"][0]["primitives"][0]["extensions"]["KHR_draco_mesh_compression"]["attributes"]["NORMAL"] = 7;
-  EXPECT_NE(error_of(doc, bin).find("d.gltf: mesh 0, primitive 0 (NORMAL): the Draco data has no attribute 7"),
-            std::string::npos)
+  EXPECT_NE(
+      error_of(doc, bin).find("d.gltf: mesh 0, primitive 0 (NORMAL): the Draco data has no attribute 7"),
+      std::string::npos)
       << error_of(doc, bin);
 
   doc = good;
   doc["accessors"][1]["type"] = "VEC3";
-  EXPECT_NE(error_of(doc, bin).find("(TEXCOORD_0), accessor 1: the Draco attribute has 2 components, the accessor's type 3"),
+  EXPECT_NE(error_of(doc, bin).find(
+                "(TEXCOORD_0), accessor 1: the Draco attribute has 2 components, the accessor's type 3"),
             std::string::npos)
       << error_of(doc, bin);
 
@@ -206,8 +211,9 @@ TEST(GltfDraco, MalformedDataIsRefusedByWhatIsWrong) {
 
   doc = good;
   doc["accessors"][3]["componentType"] = 5126;  // float indices
-  EXPECT_NE(error_of(doc, bin).find("(indices), accessor 3: component type 5126 cannot hold the decoded indices"),
-            std::string::npos)
+  EXPECT_NE(
+      error_of(doc, bin).find("(indices), accessor 3: component type 5126 cannot hold the decoded indices"),
+      std::string::npos)
       << error_of(doc, bin);
 }
 

@@ -23,6 +23,8 @@
 
 #include "io/gltf_accessors.h"
 #include "io/gltf_draco.h"
+#include "io/gltf_meshopt.h"
+#include "io/gltf_prepass.h"
 #include "io/io_common.h"
 #include "qem/gltf.h"
 
@@ -33,10 +35,11 @@ namespace {
 using io::gltf::append_accessor;
 using io::gltf::read_accessor;
 
-// Extensions that change how geometry is stored and that qem does not decode (Draco is decoded at
-// load, io/gltf_draco.h): reading them as plain accessors would give garbage, so they are refused
-// by name.
-constexpr const char* kCompressed[] = {"EXT_meshopt_compression"};
+// Extensions that change how geometry is stored and that qem does not decode (Draco and
+// EXT_meshopt_compression are decoded at load, io/gltf_draco.h and io/gltf_meshopt.h; the Khronos
+// successor of the latter allows a vertex codec that Debian's meshoptimizer 0.18 predates): reading
+// them as plain accessors would give garbage, so they are refused by name.
+constexpr const char* kCompressed[] = {"KHR_meshopt_compression"};
 
 // Extensions known to hold no accessor index: with any other extension in use, accessors that a
 // replaced primitive leaves unused are kept as they are, since the extension may refer to them.
@@ -242,6 +245,7 @@ void refuse_compression(const tinygltf::Model& model, const std::string& name) {
 }  // namespace
 
 void GltfDocument::Impl::check_and_list() {
+  io::gltf::decode_meshopt(model, name);
   // Every buffer view inside its buffer, so that saving (which copies them all) cannot fail.
   for (std::size_t v = 0; v < model.bufferViews.size(); ++v) {
     const tinygltf::BufferView& view = model.bufferViews[v];
@@ -455,8 +459,8 @@ GltfDocument GltfDocument::from_bytes(std::string_view bytes, const std::string&
   std::string err, warn;
   bool ok = false;
   try {
-    const std::string draco_aside = io::gltf::set_draco_indices_aside(bytes);
-    if (!draco_aside.empty()) bytes = draco_aside;
+    const std::string prepared = io::gltf::prepare_for_tinygltf(bytes);
+    if (!prepared.empty()) bytes = prepared;
     if (is_glb(bytes))
       ok = loader.LoadBinaryFromMemory(&d.model, &err, &warn,
                                        reinterpret_cast<const unsigned char*>(bytes.data()),

@@ -20,26 +20,16 @@ namespace {
 constexpr const char* kDraco = "KHR_draco_mesh_compression";
 constexpr const char* kIndicesAside = "qem_indices";  // set_draco_indices_aside's key
 
-std::uint32_t read_u32(std::string_view bytes, std::size_t at) {
-  std::uint32_t v;
-  std::memcpy(&v, bytes.data() + at, 4);
-  return v;
-}
-
-void append_u32(std::string& out, std::uint32_t v) {
-  char b[4];
-  std::memcpy(b, &v, 4);
-  out.append(b, 4);
-}
-
 // Every point's value of `attribute` converted to T (draco checks that each fits), appended to
 // `bytes`; false when one does not fit.
 template <class T>
-bool append_values(const draco::Mesh& mesh, const draco::PointAttribute& attribute, std::vector<unsigned char>& bytes) {
+bool append_values(const draco::Mesh& mesh, const draco::PointAttribute& attribute,
+                   std::vector<unsigned char>& bytes) {
   const int n = attribute.num_components();
   T values[4] = {};
   for (draco::PointIndex i(0); i < mesh.num_points(); ++i) {
-    if (!attribute.ConvertValue<T>(attribute.mapped_index(i), static_cast<std::int8_t>(n), values)) return false;
+    if (!attribute.ConvertValue<T>(attribute.mapped_index(i), static_cast<std::int8_t>(n), values))
+      return false;
     const auto* p = reinterpret_cast<const unsigned char*>(values);
     bytes.insert(bytes.end(), p, p + sizeof(T) * static_cast<std::size_t>(n));
   }
@@ -49,13 +39,20 @@ bool append_values(const draco::Mesh& mesh, const draco::PointAttribute& attribu
 bool append_values(int component_type, const draco::Mesh& mesh, const draco::PointAttribute& attribute,
                    std::vector<unsigned char>& bytes) {
   switch (component_type) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE: return append_values<std::int8_t>(mesh, attribute, bytes);
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return append_values<std::uint8_t>(mesh, attribute, bytes);
-    case TINYGLTF_COMPONENT_TYPE_SHORT: return append_values<std::int16_t>(mesh, attribute, bytes);
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return append_values<std::uint16_t>(mesh, attribute, bytes);
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return append_values<std::uint32_t>(mesh, attribute, bytes);
-    case TINYGLTF_COMPONENT_TYPE_FLOAT: return append_values<float>(mesh, attribute, bytes);
-    default: return false;
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+      return append_values<std::int8_t>(mesh, attribute, bytes);
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+      return append_values<std::uint8_t>(mesh, attribute, bytes);
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+      return append_values<std::int16_t>(mesh, attribute, bytes);
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+      return append_values<std::uint16_t>(mesh, attribute, bytes);
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+      return append_values<std::uint32_t>(mesh, attribute, bytes);
+    case TINYGLTF_COMPONENT_TYPE_FLOAT:
+      return append_values<float>(mesh, attribute, bytes);
+    default:
+      return false;
   }
 }
 
@@ -64,7 +61,7 @@ bool append_indices(int component_type, const draco::Mesh& mesh, std::vector<uns
   const std::size_t size = component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE    ? 1
                            : component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? 2
                            : component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT   ? 4
-                                                                                       : 0;
+                                                                                      : 0;
   if (size == 0) return false;
   const std::uint64_t limit = size == 4 ? UINT32_MAX : (std::uint64_t(1) << (8 * size)) - 1;
   for (draco::FaceIndex f(0); f < mesh.num_faces(); ++f)
@@ -79,8 +76,8 @@ bool append_indices(int component_type, const draco::Mesh& mesh, std::vector<uns
 }
 
 // `bytes` as a new buffer and buffer view; accessor `a` reads it from its start.
-void attach(tinygltf::Model& model, tinygltf::Accessor& a, std::vector<unsigned char>&& bytes, std::size_t count,
-            int target) {
+void attach(tinygltf::Model& model, tinygltf::Accessor& a, std::vector<unsigned char>&& bytes,
+            std::size_t count, int target) {
   tinygltf::BufferView view;
   view.buffer = static_cast<int>(model.buffers.size());
   view.byteLength = bytes.size();
@@ -133,21 +130,25 @@ void decode_primitive(tinygltf::Model& model, tinygltf::Primitive& p, const std:
                   (id.IsInt() ? ", which the primitive does not have" : " without an integer id"));
     tinygltf::Accessor& a = accessor_of(named->second, semantic);
     const draco::PointAttribute* attribute =
-        id.GetNumberAsInt() < 0 ? nullptr : mesh.GetAttributeByUniqueId(static_cast<std::uint32_t>(id.GetNumberAsInt()));
+        id.GetNumberAsInt() < 0
+            ? nullptr
+            : mesh.GetAttributeByUniqueId(static_cast<std::uint32_t>(id.GetNumberAsInt()));
     if (!attribute)
       throw Error(where + " (" + semantic + "): the Draco data has no attribute " +
                   std::to_string(id.GetNumberAsInt()));
     if (attribute->num_components() != components_of(a.type) || attribute->num_components() > 4)
-      throw Error(where + " (" + semantic + "), accessor " + std::to_string(named->second) + ": the Draco attribute has " +
-                  std::to_string(attribute->num_components()) + " components, the accessor's type " +
-                  std::to_string(components_of(a.type)));
+      throw Error(where + " (" + semantic + "), accessor " + std::to_string(named->second) +
+                  ": the Draco attribute has " + std::to_string(attribute->num_components()) +
+                  " components, the accessor's type " + std::to_string(components_of(a.type)));
     std::vector<unsigned char> bytes;
     if (!append_values(a.componentType, mesh, *attribute, bytes))
       throw Error(where + " (" + semantic + "), accessor " + std::to_string(named->second) +
-                  ": a decoded value does not fit the accessor's component type " + std::to_string(a.componentType));
+                  ": a decoded value does not fit the accessor's component type " +
+                  std::to_string(a.componentType));
     attach(model, a, std::move(bytes), mesh.num_points(), TINYGLTF_TARGET_ARRAY_BUFFER);
   }
-  if (ext.Has(kIndicesAside) && ext.Get(kIndicesAside).IsInt()) p.indices = ext.Get(kIndicesAside).GetNumberAsInt();
+  if (ext.Has(kIndicesAside) && ext.Get(kIndicesAside).IsInt())
+    p.indices = ext.Get(kIndicesAside).GetNumberAsInt();
   // Draco always stores faces: a primitive without indices gets an index accessor of its own.
   if (p.indices < 0) {
     tinygltf::Accessor indices;
@@ -161,54 +162,35 @@ void decode_primitive(tinygltf::Model& model, tinygltf::Primitive& p, const std:
   if (!append_indices(ia.componentType, mesh, bytes))
     throw Error(where + " (indices), accessor " + std::to_string(p.indices) + ": component type " +
                 std::to_string(ia.componentType) + " cannot hold the decoded indices");
-  attach(model, ia, std::move(bytes), 3 * std::size_t(mesh.num_faces()), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+  attach(model, ia, std::move(bytes), 3 * std::size_t(mesh.num_faces()),
+         TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
   p.extensions.erase(kDraco);
 }
 
 }  // namespace
 
-std::string set_draco_indices_aside(std::string_view bytes) {
-  // The JSON: the whole text, or a .glb's first chunk (header: magic, version, length; chunk:
-  // length, type "JSON", data).
-  const bool glb = bytes.size() >= 4 && bytes.substr(0, 4) == "glTF";
-  std::string_view text = bytes;
-  if (glb) {
-    if (bytes.size() < 20 || bytes.substr(16, 4) != "JSON" || read_u32(bytes, 12) > bytes.size() - 20) return "";
-    text = bytes.substr(20, read_u32(bytes, 12));
-  }
-  if (text.find(kDraco) == std::string_view::npos) return "";
-  nlohmann::json doc = nlohmann::json::parse(text, nullptr, false);
-  if (doc.is_discarded() || !doc.is_object() || !doc.contains("meshes") || !doc["meshes"].is_array()) return "";
-  const nlohmann::json* accessors = doc.contains("accessors") && doc["accessors"].is_array() ? &doc["accessors"] : nullptr;
+bool set_draco_indices_aside(nlohmann::json& doc) {
+  if (!doc.contains("meshes") || !doc["meshes"].is_array()) return false;
+  const nlohmann::json* accessors =
+      doc.contains("accessors") && doc["accessors"].is_array() ? &doc["accessors"] : nullptr;
   bool moved = false;
   for (nlohmann::json& mesh : doc["meshes"]) {
     if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
     for (nlohmann::json& p : mesh["primitives"]) {
       if (!p.is_object() || !p.contains("extensions") || !p["extensions"].is_object() ||
-          !p["extensions"].contains(kDraco) || !p["extensions"][kDraco].is_object() || !p.contains("indices") ||
-          !p["indices"].is_number_unsigned())
+          !p["extensions"].contains(kDraco) || !p["extensions"][kDraco].is_object() ||
+          !p.contains("indices") || !p["indices"].is_number_unsigned())
         continue;
       const std::size_t a = p["indices"].get<std::size_t>();
-      if (!accessors || a >= accessors->size() || !(*accessors)[a].is_object() || (*accessors)[a].contains("bufferView"))
+      if (!accessors || a >= accessors->size() || !(*accessors)[a].is_object() ||
+          (*accessors)[a].contains("bufferView"))
         continue;
       p["extensions"][kDraco][kIndicesAside] = p["indices"];
       p.erase("indices");
       moved = true;
     }
   }
-  if (!moved) return "";
-  std::string json = doc.dump();
-  if (!glb) return json;
-  json.resize((json.size() + 3) & ~std::size_t(3), ' ');  // chunks are 4-byte aligned, JSON padded with spaces
-  const std::string_view rest = bytes.substr(20 + text.size());
-  std::string out = "glTF";
-  append_u32(out, read_u32(bytes, 4));
-  append_u32(out, static_cast<std::uint32_t>(12 + 8 + json.size() + rest.size()));
-  append_u32(out, static_cast<std::uint32_t>(json.size()));
-  out += "JSON";
-  out += json;
-  out += rest;
-  return out;
+  return moved;
 }
 
 void decode_draco(tinygltf::Model& model, const std::string& name, std::set<std::size_t>& compressed_views) {

@@ -8,18 +8,17 @@
 #include <tiny_gltf.h>
 
 #include <cstddef>
+#include <nlohmann/json_fwd.hpp>
 #include <set>
 #include <string>
-#include <string_view>
 
 namespace qem::io::gltf {
 
 /// tinygltf refuses a primitive whose index accessor has no buffer view, which is how a Draco
-/// primitive's indices are written (the bitstream holds them). Given a document's bytes (.gltf JSON
-/// or .glb), returns them with each such primitive's `indices` moved into its extension object (as
-/// `qem_indices`, where decode_draco takes it back), or "" when nothing needs to move (no Draco
-/// primitive, or bytes that tinygltf will refuse with its own message anyway).
-std::string set_draco_indices_aside(std::string_view bytes);
+/// primitive's indices are written (the bitstream holds them). In a document's JSON, before
+/// tinygltf reads it (io/gltf_prepass.h), moves each such primitive's `indices` into its extension
+/// object (as `qem_indices`, where decode_draco takes it back). True when it moved one.
+bool set_draco_indices_aside(nlohmann::json& doc);
 
 /// Decodes every primitive that carries KHR_draco_mesh_compression: each accessor the extension
 /// names (and the indices) gets the decoded values in a new buffer and buffer view, in its own

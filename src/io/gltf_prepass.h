@@ -1,0 +1,17 @@
+// Changes made to a glTF document's JSON before tinygltf parses it, for the two kinds of valid
+// file that tinygltf cannot read as written: Draco primitives (index accessors without a buffer
+// view, io/gltf_draco.h) and EXT_meshopt_compression's fallback buffers (no data, io/gltf_meshopt.h).
+// Each change is undone by the decoder that follows the load.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+namespace qem::io::gltf {
+
+/// A document's bytes (.gltf JSON or .glb) with those changes made, or "" when none is needed (the
+/// document uses neither extension, or its bytes are for tinygltf to refuse with its own message).
+/// A .glb keeps its BIN chunk as it is; its JSON chunk is rewritten.
+std::string prepare_for_tinygltf(std::string_view bytes);
+
+}  // namespace qem::io::gltf
