@@ -156,6 +156,38 @@ TEST(Gltf, LoadMeshMergesTheSceneInWorldSpace) {
   EXPECT_EQ(m.attributes.size(), 3u);
 }
 
+TEST(Gltf, SkinnedMeshIsMergedInItsBindPose) {
+  // Two joints: one moved up by 5, one scaling by 2 with an inverse bind matrix that moves by -1 in
+  // x. The mesh node's own translation is ignored (glTF 2.0 §3.7.3); the last vertex's weights sum
+  // to 0.99 (a quantized file) and are normalised.
+  Tiny t;
+  for (int v = 0; v < 4; ++v) t.bin += std::string("\0\1\0\0", 4);  // 156: JOINTS_0
+  const float weights[] = {1, 0, 0, 0, 0, 1, 0, 0, 0.5f, 0.5f, 0, 0, 0.495f, 0.495f, 0, 0};
+  for (float w : weights) put(t.bin, w);  // 172: WEIGHTS_0
+  const float ibm[] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -1, 0, 0, 1};
+  for (float x : ibm) put(t.bin, x);  // 236: inverse bind matrices
+  json& p = t.doc["meshes"][0]["primitives"][0];
+  p["attributes"]["JOINTS_0"] = 5;
+  p["attributes"]["WEIGHTS_0"] = 6;
+  t.doc["accessors"].push_back({{"bufferView", 5}, {"componentType", 5121}, {"count", 4}, {"type", "VEC4"}});
+  t.doc["accessors"].push_back({{"bufferView", 6}, {"componentType", 5126}, {"count", 4}, {"type", "VEC4"}});
+  t.doc["accessors"].push_back({{"bufferView", 7}, {"componentType", 5126}, {"count", 2}, {"type", "MAT4"}});
+  t.doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", 156}, {"byteLength", 16}});
+  t.doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", 172}, {"byteLength", 64}});
+  t.doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", 236}, {"byteLength", 128}});
+  t.doc["nodes"][0]["skin"] = 0;
+  t.doc["nodes"].push_back({{"translation", {0, 0, 5}}});
+  t.doc["nodes"].push_back({{"scale", {2, 2, 2}}});
+  t.doc["scenes"][0]["nodes"] = {0, 1, 2};
+  t.doc["skins"] = {{{"joints", {1, 2}}, {"inverseBindMatrices", 7}}};
+  const qem::Mesh m = qem::parse_mesh(t.text(), qem::FileFormat::Auto, "skin.gltf");
+  const std::vector<double> expected = {0, 0, 5, 0, 0, 0, 0.5, 1.5, 2.5, -1, 1.5, 2.5};
+  ASSERT_EQ(m.positions.size(), expected.size());
+  for (std::size_t i = 0; i < expected.size(); ++i) EXPECT_NEAR(m.positions[i], expected[i], 1e-6) << i;
+  // The world scale of the shared error budget is the joints' (2), not the node's (1).
+  EXPECT_DOUBLE_EQ(qem::GltfDocument::parse(t.text(), "skin.gltf").primitives()[0].world_scale, 2.0);
+}
+
 TEST(Gltf, MirroringNodeKeepsTheOutwardWinding) {
   Tiny t;
   t.doc["nodes"][0]["scale"] = {-1, 1, 1};

@@ -187,6 +187,84 @@ std::vector<int> scene_roots(const tinygltf::Model& m) {
   return roots;
 }
 
+/// World matrices of the nodes the scene draws (depth first from scene_roots, the current path
+/// marked so that a cyclic, invalid hierarchy cannot loop); `reached` marks them.
+std::vector<Mat4> node_world_matrices(const tinygltf::Model& m, std::vector<char>& reached) {
+  std::vector<Mat4> world(m.nodes.size(), identity());
+  std::vector<char> on_path(m.nodes.size(), 0);
+  reached.assign(m.nodes.size(), 0);
+  auto visit = [&](auto&& self, int node, const Mat4& parent) -> void {
+    if (node < 0 || static_cast<std::size_t>(node) >= m.nodes.size() || on_path[static_cast<std::size_t>(node)])
+      return;
+    const auto n = static_cast<std::size_t>(node);
+    on_path[n] = 1;
+    world[n] = multiply(parent, local_matrix(m.nodes[n]));
+    reached[n] = 1;
+    for (int c : m.nodes[n].children) self(self, c, world[n]);
+    on_path[n] = 0;
+  };
+  for (int r : scene_roots(m)) visit(visit, r, identity());
+  return world;
+}
+
+/// Per joint of skin `s`: the matrix that takes the bind-space mesh to the world, joint world x
+/// inverse bind matrix (glTF 2.0 §3.7.3: a skinned mesh is drawn by its joints; its node's own
+/// transform is ignored). A joint that names no node gets the identity.
+std::vector<Mat4> skin_matrices(const tinygltf::Model& m, int s, const std::vector<Mat4>& world,
+                                const std::string& name) {
+  const tinygltf::Skin& skin = m.skins[static_cast<std::size_t>(s)];
+  std::vector<double> ibm;
+  std::uint32_t components = 0;
+  if (skin.inverseBindMatrices >= 0)
+    ibm = read_accessor(m, skin.inverseBindMatrices, name + ": skin " + std::to_string(s) + " (inverseBindMatrices)",
+                        &components);
+  if (!ibm.empty() && (components != 16 || ibm.size() < 16 * skin.joints.size()))
+    throw Error(name + ": skin " + std::to_string(s) + ": inverseBindMatrices is not one MAT4 per joint");
+  std::vector<Mat4> out(skin.joints.size(), identity());
+  for (std::size_t j = 0; j < skin.joints.size(); ++j) {
+    const int joint = skin.joints[j];
+    if (joint < 0 || static_cast<std::size_t>(joint) >= m.nodes.size()) continue;
+    Mat4 inverse_bind = identity();
+    if (!ibm.empty()) std::copy(ibm.begin() + 16 * j, ibm.begin() + 16 * (j + 1), inverse_bind.begin());
+    out[j] = multiply(world[static_cast<std::size_t>(joint)], inverse_bind);
+  }
+  return out;
+}
+
+/// Per vertex of a skinned part: its bind pose's matrix, the sum of its joints' matrices (from
+/// skin_matrices) by its weights (linear blend skinning, as renderers draw it; the weights
+/// normalised). Empty when the part
+/// has no JOINTS_0 and WEIGHTS_0 of four components (it is then placed by its node's matrix).
+/// A vertex whose weights sum to zero keeps `fallback`.
+std::vector<Mat4> blended_matrices(const Mesh& part, const std::vector<Mat4>& joints, const Mat4& fallback,
+                                   const std::string& where) {
+  const VertexAttribute *jw = nullptr, *ww = nullptr;
+  for (const VertexAttribute& a : part.attributes) {
+    if (a.name == "JOINTS_0" && a.components == 4) jw = &a;
+    if (a.name == "WEIGHTS_0" && a.components == 4) ww = &a;
+  }
+  if (!jw || !ww) return {};
+  std::vector<Mat4> out(part.vertex_count(), fallback);
+  for (std::size_t v = 0; v < part.vertex_count(); ++v) {
+    Mat4 sum{};
+    double total = 0;
+    for (int k = 0; k < 4; ++k) {
+      const double w = ww->values[4 * v + k], j = jw->values[4 * v + k];
+      if (w == 0) continue;
+      if (!(j >= 0 && j < double(joints.size())))
+        throw Error(where + " (JOINTS_0): vertex " + std::to_string(v) + " names joint " + std::to_string(j) +
+                    " of a skin with " + std::to_string(joints.size()));
+      for (int e = 0; e < 16; ++e) sum[e] += w * joints[static_cast<std::size_t>(j)][e];
+      total += w;
+    }
+    // Weights sum to 1 in a valid file up to their quantization (8-bit weights to within 1/255): the
+    // sum is divided out, so that a file quantized or compressed draws the same as its original.
+    if (total > 0)
+      for (int e = 0; e < 16; ++e) out[v][e] = sum[e] / total;
+  }
+  return out;
+}
+
 /// Throws unless every coordinate and attribute value fits in single precision, which glTF
 /// stores (converting a double beyond the float range is undefined behaviour, and a file with
 /// infinities is one no reader takes).
@@ -299,47 +377,15 @@ void GltfDocument::Impl::check_and_list() {
 
 void GltfDocument::Impl::measure_world_scales() {
   const tinygltf::Model& m = model;
-  // World matrices of the nodes the scene reaches (depth first, the current path marked so that a
-  // cyclic, invalid hierarchy cannot loop).
-  std::vector<Mat4> world(m.nodes.size(), identity());
-  std::vector<char> reached(m.nodes.size(), 0), on_path(m.nodes.size(), 0);
-  auto visit = [&](auto&& self, int node, const Mat4& parent) -> void {
-    if (node < 0 || static_cast<std::size_t>(node) >= m.nodes.size() ||
-        on_path[static_cast<std::size_t>(node)])
-      return;
-    const auto n = static_cast<std::size_t>(node);
-    on_path[n] = 1;
-    world[n] = multiply(parent, local_matrix(m.nodes[n]));
-    reached[n] = 1;
-    for (int c : m.nodes[n].children) self(self, c, world[n]);
-    on_path[n] = 0;
-  };
-  for (int r : scene_roots(m)) visit(visit, r, identity());
+  std::vector<char> reached;
+  const std::vector<Mat4> world = node_world_matrices(m, reached);
   std::vector<double> mesh_scale(m.meshes.size(), 0);
   for (std::size_t n = 0; n < m.nodes.size(); ++n) {
     const tinygltf::Node& node = m.nodes[n];
     if (!reached[n] || node.mesh < 0 || static_cast<std::size_t>(node.mesh) >= m.meshes.size()) continue;
     double scale = 0;
     if (node.skin >= 0 && static_cast<std::size_t>(node.skin) < m.skins.size()) {
-      // A skinned mesh is drawn by its joints in the bind pose: joint world x inverse bind matrix.
-      const tinygltf::Skin& skin = m.skins[static_cast<std::size_t>(node.skin)];
-      std::vector<double> ibm;
-      std::uint32_t components = 0;
-      if (skin.inverseBindMatrices >= 0)
-        ibm = read_accessor(m, skin.inverseBindMatrices,
-                            name + ": skin " + std::to_string(node.skin) + " (inverseBindMatrices)",
-                            &components);
-      if (!ibm.empty() && (components != 16 || ibm.size() < 16 * skin.joints.size()))
-        throw Error(name + ": skin " + std::to_string(node.skin) +
-                    ": inverseBindMatrices is not one MAT4 per joint");
-      for (std::size_t j = 0; j < skin.joints.size(); ++j) {
-        const int joint = skin.joints[j];
-        if (joint < 0 || static_cast<std::size_t>(joint) >= m.nodes.size()) continue;
-        Mat4 inverse_bind = identity();
-        if (!ibm.empty()) std::copy(ibm.begin() + 16 * j, ibm.begin() + 16 * (j + 1), inverse_bind.begin());
-        scale =
-            std::max(scale, largest_scale(multiply(world[static_cast<std::size_t>(joint)], inverse_bind)));
-      }
+      for (const Mat4& joint : skin_matrices(m, node.skin, world, name)) scale = std::max(scale, largest_scale(joint));
     } else {
       scale = largest_scale(world[n]);
     }
@@ -792,21 +838,23 @@ Mesh GltfDocument::scene_mesh() const {
   for (std::size_t i = 0; i < d.primitives.size(); ++i)
     index_of[{d.primitives[i].mesh, d.primitives[i].primitive}] = i;
 
-  // (primitive, world matrix, node instance) for every triangle primitive the scene instances.
+  // (primitive, world matrix, node instance, skin) for every triangle primitive the scene instances.
   struct Part {
     std::size_t primitive;
     Mat4 world;
     std::size_t instance;
+    int skin;
   };
   std::vector<Part> parts;
   std::size_t instances = 0;
-  auto add_mesh = [&](int mesh, const Mat4& world) {
+  auto add_mesh = [&](int mesh, const Mat4& world, int skin) {
     ++instances;
     if (mesh < 0 || static_cast<std::size_t>(mesh) >= m.meshes.size()) return;
+    if (skin >= 0 && static_cast<std::size_t>(skin) >= m.skins.size()) skin = -1;
     for (std::size_t k = 0; k < m.meshes[static_cast<std::size_t>(mesh)].primitives.size(); ++k) {
       std::size_t i = index_of.at({static_cast<std::size_t>(mesh), k});
       if (d.primitives[i].mode == TINYGLTF_MODE_TRIANGLES && d.primitives[i].vertex_count > 0)
-        parts.push_back({i, world, instances});
+        parts.push_back({i, world, instances, skin});
     }
   };
   const std::vector<int> roots = scene_roots(m);
@@ -819,13 +867,13 @@ Mesh GltfDocument::scene_mesh() const {
     on_path[static_cast<std::size_t>(node)] = 1;
     const tinygltf::Node& n = m.nodes[static_cast<std::size_t>(node)];
     const Mat4 world = multiply(parent, local_matrix(n));
-    add_mesh(n.mesh, world);
+    add_mesh(n.mesh, world, n.skin);
     for (int c : n.children) self(self, c, world);
     on_path[static_cast<std::size_t>(node)] = 0;
   };
   for (int r : roots) visit(visit, r, identity());
   if (parts.empty() && m.nodes.empty())  // meshes that no node places: take them as they are
-    for (std::size_t mesh = 0; mesh < m.meshes.size(); ++mesh) add_mesh(static_cast<int>(mesh), identity());
+    for (std::size_t mesh = 0; mesh < m.meshes.size(); ++mesh) add_mesh(static_cast<int>(mesh), identity(), -1);
 
   Mesh out;
   for (std::size_t mi = 0; mi < m.materials.size(); ++mi)
@@ -835,6 +883,9 @@ Mesh GltfDocument::scene_mesh() const {
   // Primitives of one node instance that share their vertex accessors (one primitive per
   // material over the same vertices, as save_mesh writes) share their vertices here too.
   std::map<std::pair<std::size_t, std::map<std::string, int>>, std::uint32_t> shared_base;
+  std::vector<Mat4> skin_world;  // the nodes' world matrices, when a part is skinned
+  std::vector<char> reached;
+  std::map<int, std::vector<Mat4>> skin_joints;  // per skin: skin_matrices
   for (const Part& part_ref : parts) {
     const std::size_t i = part_ref.primitive;
     const Mat4& world = part_ref.world;
@@ -861,12 +912,22 @@ Mesh GltfDocument::scene_mesh() const {
       }
       shared_base[key] = base;
     }
+    // A skinned part is placed in its bind pose, each vertex by its joints' blended matrix (the
+    // node's matrix when it has no joints and weights).
+    std::vector<Mat4> blended;
+    if (part_ref.skin >= 0) {
+      if (skin_world.empty()) skin_world = node_world_matrices(m, reached);
+      auto [it, fresh] = skin_joints.try_emplace(part_ref.skin);
+      if (fresh) it->second = skin_matrices(m, part_ref.skin, skin_world, d.name);
+      blended = blended_matrices(part, it->second, world, d.where(i));
+    }
+    const auto matrix_of = [&](std::size_t v) -> const Mat4& { return blended.empty() ? world : blended[v]; };
     for (std::size_t v = 0; v < part.vertex_count(); ++v) {
       const double* p = &part.positions[3 * v];
-      for (int r = 0; r < 3; ++r)
-        out.positions.push_back(world[r] * p[0] + world[4 + r] * p[1] + world[8 + r] * p[2] + world[12 + r]);
+      const Mat4& w = matrix_of(v);
+      for (int r = 0; r < 3; ++r) out.positions.push_back(w[r] * p[0] + w[4 + r] * p[1] + w[8 + r] * p[2] + w[12 + r]);
     }
-    const std::array<double, 9> nm = normal_matrix(world);
+    const std::array<double, 9> world_nm = normal_matrix(world);
     for (VertexAttribute& a : out.attributes) {
       const VertexAttribute& b = *std::find_if(part.attributes.begin(), part.attributes.end(),
                                                [&](const VertexAttribute& x) { return x.name == a.name; });
@@ -875,17 +936,21 @@ Mesh GltfDocument::scene_mesh() const {
       if ((a.kind != AttributeKind::Normal && a.kind != AttributeKind::Tangent) || a.components < 3) continue;
       // Normals take the inverse transpose, tangents the matrix itself; both renormalised.
       for (std::size_t v = start; v < a.values.size(); v += a.components) {
+        const Mat4& w = matrix_of((v - start) / a.components);
+        const std::array<double, 9> nm = blended.empty() ? world_nm : normal_matrix(w);
         const double x = a.values[v], y = a.values[v + 1], z = a.values[v + 2];
         double t[3];
         for (int r = 0; r < 3; ++r)
           t[r] = a.kind == AttributeKind::Normal ? nm[r * 3] * x + nm[r * 3 + 1] * y + nm[r * 3 + 2] * z
-                                                 : world[r] * x + world[4 + r] * y + world[8 + r] * z;
+                                                 : w[r] * x + w[4 + r] * y + w[8 + r] * z;
         const double len = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
         if (len > 0)
           for (std::size_t r = 0; r < 3; ++r) a.values[v + r] = t[r] / len;
       }
     }
-    add_faces(out, part, base, world, d.primitives[i].material, m.materials.size(), uses_default);
+    // The winding follows the sign of the part's matrix (of its first vertex, when skinned).
+    add_faces(out, part, base, part.vertex_count() > 0 ? matrix_of(0) : world, d.primitives[i].material,
+              m.materials.size(), uses_default);
   }
   if (uses_default) out.material_names.push_back("(default)");
   // Node matrices are unchecked numbers: a huge scale can push a coordinate to infinity.
