@@ -75,7 +75,7 @@ int run_simplify_gltf(const SimplifyArgs& a, const SimplifyOptions& opt) {
   Stopwatch t_write;
   doc.save(a.output);
   const double write_s = t_write.seconds();
-  // What was kept or dropped (morph-target primitives, TANGENT...): about the input, so not
+  // What was kept or dropped (primitives not of triangles, TANGENT...): about the input, so not
   // silenced by --quiet, like the readers' warnings.
   for (const std::string& n : doc.notes()) std::fprintf(stderr, "qem: note: %s\n", n.c_str());
   std::size_t out_vertices = 0;

@@ -285,27 +285,35 @@ TEST(GltfSimplify, PrimitivesOfOneMeshStayJoined) {
   }
 }
 
-TEST(GltfSimplify, MorphTargetPrimitiveIsKeptUnchanged) {
+TEST(GltfSimplify, MorphTargetsFollowTheSimplification) {
   Scene s = two_spheres();
-  // Mesh 0 gets a morph target (its normals' accessor serves as the offsets).
+  // Mesh 0 gets a morph target whose offsets are its normals' accessor: on the unit sphere each
+  // vertex's offset is its position, a linear field that the attribute fit reproduces at any place.
   s.doc["meshes"][0]["primitives"][0]["targets"] = json::array({{{"POSITION", 1}}});
+  s.doc["meshes"][0]["weights"] = {0.5};
   qem::GltfDocument doc = qem::GltfDocument::parse(s.text(), "morph.gltf");
-  const std::string before = doc.serialize(false);
+  EXPECT_TRUE(doc.primitives()[0].simplifiable);
   qem::SimplifyOptions opt;
   opt.target_ratio = 0.2;
   const qem::GltfSimplifyReport r = qem::simplify_document(doc, opt);
-  EXPECT_EQ(r.kept, 1u);
-  EXPECT_EQ(r.simplified, 1u);
-  EXPECT_EQ(r.primitives[0].status, qem::GltfPrimitiveOutcome::Status::Kept);
-  EXPECT_NE(r.primitives[0].note.find("morph"), std::string::npos);
-  EXPECT_EQ(r.primitives[0].faces_out, 5120u);
-  EXPECT_LE(r.primitives[1].faces_out, 1024u);  // the target counts the simplifiable faces only
-  json a = json::parse(before), b = json::parse(doc.serialize(false));
-  EXPECT_EQ(a["meshes"][0], b["meshes"][0]);
-  for (int k : {0, 1, 2}) EXPECT_EQ(a["accessors"][k], b["accessors"][k]) << k;
-  bool noted = false;
-  for (const std::string& n : doc.notes()) noted = noted || n.find("morph") != std::string::npos;
-  EXPECT_TRUE(noted);
+  EXPECT_EQ(r.simplified, 2u);
+  EXPECT_LT(r.primitives[0].faces_out, 5120u);
+  const json out = json::parse(doc.serialize(false));
+  const json& p = out["meshes"][0]["primitives"][0];
+  ASSERT_EQ(p["targets"].size(), 1u);
+  const json& offsets = out["accessors"][p["targets"][0]["POSITION"].get<int>()];
+  const json& positions = out["accessors"][p["attributes"]["POSITION"].get<int>()];
+  EXPECT_EQ(offsets["count"], positions["count"]);
+  EXPECT_TRUE(offsets.contains("min") && offsets.contains("max"));  // glTF requires them on POSITION
+  EXPECT_EQ(out["meshes"][0]["weights"], json::array({0.5}));
+  const qem::GltfDocument again = qem::GltfDocument::parse(doc.serialize(true), "again.glb");
+  const qem::Mesh m = again.mesh(0);
+  const qem::VertexAttribute* target = nullptr;
+  for (const qem::VertexAttribute& a : m.attributes)
+    if (a.name == "target0/POSITION") target = &a;
+  ASSERT_TRUE(target);
+  for (std::size_t i = 0; i < m.positions.size(); ++i)
+    EXPECT_NEAR(target->values[i], m.positions[i], 1e-5) << i;
 }
 
 // --- through the command line -------------------------------------------------------------------
@@ -328,16 +336,16 @@ int run_qem(const std::string& args, std::string* err) {
 
 TEST(GltfSimplifyCli, KeepsTheDocumentAndNotesKeptPrimitives) {
   Scene s = two_spheres();
-  s.doc["meshes"][0]["primitives"][0]["targets"] = json::array({{{"POSITION", 1}}});
+  s.doc["meshes"][0]["primitives"][0]["mode"] = 1;  // lines: kept as they are
   s.doc["nodes"][0]["extras"] = {{"tag", "kept"}};
   const std::string dir = qem::test::temp_dir();
-  const std::string in = write(dir + "/morph.gltf", s.text()), out = dir + "/out.glb";
+  const std::string in = write(dir + "/lines.gltf", s.text()), out = dir + "/out.glb";
   std::string err;
   ASSERT_EQ(run_qem("simplify '" + in + "' '" + out + "' --ratio 0.2", &err), 0) << err;
-  EXPECT_NE(err.find("morph targets"), std::string::npos) << err;
+  EXPECT_NE(err.find("mode 1 is not TRIANGLES"), std::string::npos) << err;
   EXPECT_NE(err.find("1 simplified"), std::string::npos) << err;
   qem::GltfDocument doc = qem::GltfDocument::load(out);
-  EXPECT_EQ(doc.primitives()[0].face_count, 5120u);
+  EXPECT_EQ(doc.primitives()[0].mode, 1);
   EXPECT_LE(doc.primitives()[1].face_count, 1024u);
   EXPECT_FALSE(doc.primitives()[0].simplifiable);
   // --json: the counts, and each primitive.
@@ -350,8 +358,8 @@ TEST(GltfSimplifyCli, KeepsTheDocumentAndNotesKeptPrimitives) {
   EXPECT_EQ(report["format"], "gltf");
   EXPECT_EQ(report["simplified"], 1);
   EXPECT_EQ(report["kept"], 1);
-  EXPECT_EQ(report["in_faces"], 10240);
-  EXPECT_EQ(report["out_faces"].get<std::size_t>(), 5120 + doc.primitives()[1].face_count);
+  EXPECT_EQ(report["in_faces"], 5120);
+  EXPECT_EQ(report["out_faces"].get<std::size_t>(), doc.primitives()[1].face_count);
   ASSERT_EQ(report["each"].size(), 2u);
   EXPECT_EQ(report["each"][0]["status"], "kept");
   EXPECT_EQ(report["each"][1]["status"], "simplified");

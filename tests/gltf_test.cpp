@@ -286,16 +286,22 @@ TEST(Gltf, TangentIsDroppedOnReplacedPrimitives) {
   EXPECT_FALSE(doc.notes().empty());
 }
 
-TEST(Gltf, MorphTargetsMakeAPrimitiveNotSimplifiable) {
+TEST(Gltf, MorphTargetsAreReadAsOffsetAttributes) {
   Tiny t;
-  t.doc["meshes"][0]["primitives"][0]["targets"] = json::array({{{"POSITION", 1}}});
+  t.doc["meshes"][0]["primitives"][0]["targets"] = json::array({{{"POSITION", 1}}});  // the normals' data
   qem::GltfDocument doc = qem::GltfDocument::parse(t.text(), "tiny.gltf");
-  EXPECT_FALSE(doc.primitives()[0].simplifiable);
-  EXPECT_NE(doc.primitives()[0].why_not.find("morph"), std::string::npos);
-  EXPECT_THROW(doc.mesh(0), qem::Error);
-  EXPECT_THROW(doc.replace(0, qem::test::cube()), qem::Error);
-  // The scene mesh still shows it (base shape).
-  EXPECT_EQ(qem::parse_mesh(t.text(), qem::FileFormat::Gltf, "tiny.gltf").face_count(), 2u);
+  EXPECT_TRUE(doc.primitives()[0].simplifiable);
+  EXPECT_EQ(doc.primitives()[0].morph_targets, 1u);
+  const qem::Mesh m = doc.mesh(0);
+  const qem::VertexAttribute* offsets = attribute(m, "target0/POSITION");
+  ASSERT_TRUE(offsets);
+  EXPECT_EQ(offsets->kind, qem::AttributeKind::Scalar);
+  EXPECT_EQ(offsets->values, attribute(m, "NORMAL")->values);
+  // The scene mesh is the rest pose: no offsets.
+  EXPECT_EQ(qem::parse_mesh(t.text(), qem::FileFormat::Gltf, "tiny.gltf").attributes.size(), 3u);
+  // A file's own attribute may not take that form of name.
+  t.doc["meshes"][0]["primitives"][0]["attributes"]["target0/POSITION"] = 1;
+  EXPECT_NE(error_of(t.text()).find("attribute target0/POSITION is no glTF semantic"), std::string::npos);
 }
 
 TEST(Gltf, OtherModesArePassedThrough) {

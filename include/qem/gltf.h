@@ -36,8 +36,7 @@ struct GltfPrimitiveInfo {
   std::size_t face_count = 0;           ///< triangles (0 when mode is not TRIANGLES)
   std::vector<std::string> attributes;  ///< the glTF semantics present, POSITION first
   std::size_t morph_targets = 0;        ///< number of morph targets
-  /// True when `mesh()` and `replace()` may be used: mode TRIANGLES and no morph targets (the
-  /// targets' per-vertex offsets cannot be kept consistent with new vertices yet).
+  /// True when `mesh()` and `replace()` may be used: mode TRIANGLES with a POSITION.
   bool simplifiable = false;
   std::string why_not;  ///< why it is not simplifiable ("" when it is)
   /// The largest factor by which the default scene's nodes that place this primitive's mesh scale
@@ -73,7 +72,9 @@ class GltfDocument {
   /// Primitive `i` as a Mesh: positions from POSITION, indices (0..n-1 when not indexed), and
   /// the attributes NORMAL -> Normal, TEXCOORD_n -> TexCoord, COLOR_n -> Color (normalised
   /// integers decoded to [0, 1]), JOINTS_0 -> JointIndices, WEIGHTS_0 -> JointWeights,
-  /// TANGENT -> Tangent, anything else -> Scalar, each named by its semantic. Quantized
+  /// TANGENT -> Tangent, anything else -> Scalar, each named by its semantic; morph target k's
+  /// offsets as Scalar attributes named "target<k>/<SEMANTIC>" (POSITION, NORMAL; a TANGENT
+  /// offset is dropped with the TANGENT), which `replace` writes back into the targets. Quantized
   /// (KHR_mesh_quantization) and sparse accessors are decoded. The node transform is not applied.
   /// Throws when the primitive is not simplifiable (see GltfPrimitiveInfo).
   Mesh mesh(std::size_t i) const;
@@ -97,12 +98,13 @@ class GltfDocument {
   /// world space (node transforms applied; normals with the inverse transpose), with
   /// face_materials = the glTF material of each face and material_names the glTF material names
   /// (a face with no material gets the extra name "(default)" after them), and the attributes
-  /// that every merged primitive carries. What load_mesh returns for glTF. Skinning and morph
-  /// targets are not applied (the bind pose).
+  /// that every merged primitive carries. What load_mesh returns for glTF. A skinned mesh is
+  /// placed in its bind pose (its joints' matrices blended by its weights); morph targets are not
+  /// applied (the rest shape) and their offsets are not merged.
   Mesh scene_mesh() const;
 
   /// What was read leniently or will be written differently (TANGENT dropped on a replaced
-  /// primitive, primitives left untouched because of morph targets...), one sentence each.
+  /// primitive, primitives left untouched because their mode is not TRIANGLES...), one sentence each.
   std::vector<std::string> notes() const;
 
  private:

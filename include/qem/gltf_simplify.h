@@ -42,7 +42,7 @@ struct GltfPrimitiveOutcome {
   enum class Status {
     Simplified,  ///< replaced by its simplification
     Unchanged,   ///< simplifiable, but the target needed no contraction on it: left as it was
-    Kept,        ///< not simplifiable (morph targets, not TRIANGLES, no faces): passed through
+    Kept,        ///< not simplifiable (not TRIANGLES, no POSITION, no faces): passed through
   };
   std::size_t primitive = 0;  ///< index in GltfDocument::primitives()
   Status status = Status::Kept;

@@ -283,6 +283,26 @@ void check_fits_in_float(const Mesh& mesh, const std::string& where) {
 
 }  // namespace
 
+// A morph target's values ride along as a vertex attribute of the primitive's Mesh: named
+// "target<k>/<SEMANTIC>" (no glTF semantic has a '/'), of kind Scalar (interpolated like any
+// other value), and written back into the primitive's target k.
+std::string morph_name(std::size_t target, const std::string& semantic) {
+  return "target" + std::to_string(target) + "/" + semantic;
+}
+
+bool is_morph_name(const std::string& name) {
+  const std::size_t slash = name.find('/');
+  return name.rfind("target", 0) == 0 && slash != std::string::npos && slash > 6 && slash - 6 <= 9 &&
+         std::all_of(name.begin() + 6, name.begin() + static_cast<std::ptrdiff_t>(slash),
+                     [](char c) { return c >= '0' && c <= '9'; });
+}
+
+/// The target and semantic of a morph_name.
+std::pair<std::size_t, std::string> parse_morph_name(const std::string& name) {
+  const std::size_t slash = name.find('/');
+  return {static_cast<std::size_t>(std::stoul(name.substr(6, slash - 6))), name.substr(slash + 1)};
+}
+
 struct GltfDocument::Impl {
   std::string name;
   tinygltf::Model model;
@@ -357,10 +377,6 @@ void GltfDocument::Impl::check_and_list() {
             "mode " + std::to_string(info.mode) + " is not TRIANGLES (passed through untouched)";
       } else if (!p.attributes.count("POSITION")) {
         primitives[i].why_not = "no POSITION attribute (passed through untouched)";
-      } else if (!p.targets.empty()) {
-        primitives[i].why_not =
-            std::to_string(p.targets.size()) +
-            " morph targets, which cannot follow new vertices yet (passed through untouched)";
       }
       // Every triangle primitive is decoded now, so that a bad file fails at load, not at save.
       if (info.mode == TINYGLTF_MODE_TRIANGLES && p.attributes.count("POSITION")) {
@@ -407,23 +423,33 @@ Mesh GltfDocument::Impl::read(std::size_t i) const {
   const std::size_t vertices = mesh.vertex_count();
   for (double v : mesh.positions)
     if (!std::isfinite(v)) throw Error(at + " (POSITION): a coordinate is not finite");
-  for (const auto& [semantic, accessor] : p.attributes) {
-    if (semantic == "POSITION") continue;
+  auto read_attribute = [&](const std::string& name, AttributeKind kind, int accessor) {
     VertexAttribute a;
-    a.name = semantic;
-    a.kind = kind_of(semantic);
-    a.values = read_accessor(model, accessor, at + " (" + semantic + ")", &a.components);
+    a.name = name;
+    a.kind = kind;
+    a.values = read_accessor(model, accessor, at + " (" + name + ")", &a.components);
     if (a.components > 4)
-      throw Error(at + " (" + semantic + "), accessor " + std::to_string(accessor) +
+      throw Error(at + " (" + name + "), accessor " + std::to_string(accessor) +
                   ": a matrix, which is no vertex attribute type");
     if (a.values.size() != vertices * a.components)
-      throw Error(at + " (" + semantic + "), accessor " + std::to_string(accessor) + ": count " +
+      throw Error(at + " (" + name + "), accessor " + std::to_string(accessor) + ": count " +
                   std::to_string(a.values.size() / a.components) + " differs from POSITION's " +
                   std::to_string(vertices));
     for (double v : a.values)
-      if (!std::isfinite(v)) throw Error(at + " (" + semantic + "): a value is not finite");
+      if (!std::isfinite(v)) throw Error(at + " (" + name + "): a value is not finite");
     mesh.attributes.push_back(std::move(a));
+  };
+  for (const auto& [semantic, accessor] : p.attributes) {
+    // glTF's own semantics are upper case and an application's start with '_' (glTF 2.0 §3.7.2.1).
+    if (is_morph_name(semantic))
+      throw Error(at + ": attribute " + semantic +
+                  " is no glTF semantic (qem names morph target offsets so)");
+    if (semantic != "POSITION") read_attribute(semantic, kind_of(semantic), accessor);
   }
+  // Morph targets' offsets (a TANGENT offset goes with the TANGENT it moves, dropped on replacing).
+  for (std::size_t k = 0; k < p.targets.size(); ++k)
+    for (const auto& [semantic, accessor] : p.targets[k])
+      if (semantic != "TANGENT") read_attribute(morph_name(k, semantic), AttributeKind::Scalar, accessor);
   std::vector<double> idx;
   if (p.indices >= 0) {
     std::uint32_t ni = 0;
@@ -651,7 +677,7 @@ tinygltf::Model GltfDocument::Impl::rebuilt() const {
       for (const auto& entry : p.attributes) gone ? (void)released.insert(entry.second) : ref(entry.second);
       gone ? (void)released.insert(p.indices) : ref(p.indices);
       for (const auto& target : p.targets)
-        for (const auto& entry : target) ref(entry.second);
+        for (const auto& entry : target) gone ? (void)released.insert(entry.second) : ref(entry.second);
     }
   for (const tinygltf::Skin& s : m.skins) ref(s.inverseBindMatrices);
   for (const tinygltf::Animation& an : m.animations)
@@ -686,7 +712,18 @@ tinygltf::Model GltfDocument::Impl::rebuilt() const {
     attributes["POSITION"] = place(append_accessor(m, fresh, mesh.positions, 3, TINYGLTF_COMPONENT_TYPE_FLOAT,
                                                    false, true, TINYGLTF_TARGET_ARRAY_BUFFER),
                                    old_of("POSITION"));
+    std::vector<std::map<std::string, int>> targets(p.targets.size());
     for (const VertexAttribute& va : mesh.attributes) {
+      if (is_morph_name(va.name)) {  // offsets: floats (POSITION's with bounds, as glTF requires)
+        const auto [k, semantic] = parse_morph_name(va.name);
+        if (k >= targets.size()) continue;
+        const auto old = p.targets[k].find(semantic);
+        targets[k][semantic] =
+            place(append_accessor(m, fresh, va.values, va.components, TINYGLTF_COMPONENT_TYPE_FLOAT, false,
+                                  semantic == "POSITION", TINYGLTF_TARGET_ARRAY_BUFFER),
+                  old == p.targets[k].end() ? -1 : old->second);
+        continue;
+      }
       bool normalized = false;
       const int type = new_component_type(model, old_of(va.name), va.kind, normalized);
       attributes[va.name] = place(append_accessor(m, fresh, va.values, va.components, type, normalized, false,
@@ -697,6 +734,7 @@ tinygltf::Model GltfDocument::Impl::rebuilt() const {
                                       false, false, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
                       p.indices);
     p.attributes = std::move(attributes);
+    p.targets = std::move(targets);
     p.mode = TINYGLTF_MODE_TRIANGLES;
   }
   // Accessors that only the replaced primitives used and no new data took over (TANGENT): glTF
@@ -891,8 +929,8 @@ Mesh GltfDocument::scene_mesh() const {
     const Mat4& world = part_ref.world;
     const Mesh part = d.replaced.count(i) ? d.replaced.at(i) : d.read(i);
     if (first) {
-      for (const VertexAttribute& a : part.attributes)
-        out.attributes.push_back({a.name, a.kind, a.components, {}});
+      for (const VertexAttribute& a : part.attributes)  // the rest pose: no morph offsets
+        if (!is_morph_name(a.name)) out.attributes.push_back({a.name, a.kind, a.components, {}});
       first = false;
     }
     // Only the attributes every part has, with the same width, survive the merge.
