@@ -3,11 +3,13 @@
 // back uncompressed, simplified through the command line; malformed ones refused by name.
 #include <draco/compression/encode.h>
 #include <draco/mesh/triangle_soup_mesh_builder.h>
+#include <draco/point_cloud/point_cloud_builder.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <array>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -176,6 +178,60 @@ TEST(GltfDraco, CommandLineSimplifiesACompressedFile) {
   EXPECT_LE(d.primitives()[0].face_count, sphere.face_count() / 5 + 2);
   EXPECT_GT(d.primitives()[0].face_count, 0u);
   EXPECT_EQ(qem::test::open_edges_welded(d.mesh(0)), 0u);
+}
+
+TEST(GltfDraco, AStripIsReadAsATriangleList) {
+  const qem::Mesh sphere = qem::test::uv_sphere(6, 12);
+  std::string bin;
+  json doc = draco_document(sphere, bin);
+  doc["meshes"][0]["primitives"][0]["mode"] = 5;  // Draco decodes faces whatever the mode says
+  const qem::GltfDocument d = qem::GltfDocument::parse(qem::test::gltf_text(doc, bin), "d.gltf");
+  EXPECT_EQ(d.primitives()[0].mode, 4);
+  EXPECT_EQ(faces_of(d.mesh(0)), faces_of(sphere));
+}
+
+TEST(GltfDraco, APointCloudIsDecodedAndPassedThrough) {
+  const std::vector<float> p = {0, 0, 0, 1, 0, 0, 0, 2, 0, 0, 0, 3, 1, 1, 1};
+  draco::PointCloudBuilder builder;
+  builder.Start(5);
+  const int pos = builder.AddAttribute(draco::GeometryAttribute::POSITION, 3, draco::DT_FLOAT32);
+  for (std::uint32_t i = 0; i < 5; ++i)
+    builder.SetAttributeValueForPoint(pos, draco::PointIndex(i), &p[3 * i]);
+  const std::unique_ptr<draco::PointCloud> cloud = builder.Finalize(false);
+  draco::Encoder encoder;
+  draco::EncoderBuffer stream;
+  ASSERT_TRUE(encoder.EncodePointCloudToBuffer(*cloud, &stream).ok());
+  const std::string bin(stream.data(), stream.size());
+  const json doc = {
+      {"asset", {{"version", "2.0"}}},
+      {"extensionsUsed", {"KHR_draco_mesh_compression"}},
+      {"meshes",
+       {{{"primitives",
+          {{{"attributes", {{"POSITION", 0}}},
+            {"mode", 0},
+            {"extensions",
+             {{"KHR_draco_mesh_compression", {{"bufferView", 0}, {"attributes", {{"POSITION", 0}}}}}}}}}}}}},
+      {"accessors",
+       {{{"componentType", 5126}, {"count", 5}, {"type", "VEC3"}, {"min", {0, 0, 0}}, {"max", {1, 2, 3}}}}},
+      {"bufferViews", {{{"buffer", 0}, {"byteLength", bin.size()}}}},
+      {"buffers", {{{"byteLength", 0}}}}};
+  const qem::GltfDocument d = qem::GltfDocument::parse(qem::test::gltf_text(doc, bin), "points.gltf");
+  EXPECT_FALSE(d.primitives()[0].simplifiable);  // points: passed through, decoded
+  const json out = json::parse(d.serialize(false));
+  EXPECT_FALSE(out.contains("extensionsUsed"));
+  ASSERT_EQ(out["bufferViews"].size(), 1u);
+  EXPECT_EQ(out["accessors"][0]["count"], 5);
+  EXPECT_EQ(out["accessors"][0]["bufferView"], 0);
+  // The decoded points, as a set (Draco may reorder them), from the .glb's BIN chunk.
+  const std::string glb = d.serialize(true);
+  std::uint32_t json_length;
+  std::memcpy(&json_length, glb.data() + 12, 4);
+  std::vector<std::array<float, 3>> read(5), expected(5);
+  std::memcpy(read.data(), glb.data() + 20 + json_length + 8, sizeof(float) * 15);
+  std::memcpy(expected.data(), p.data(), sizeof(float) * 15);
+  std::sort(read.begin(), read.end());
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(read, expected);
 }
 
 TEST(GltfDraco, MalformedDataIsRefusedByWhatIsWrong) {

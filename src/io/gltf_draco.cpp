@@ -23,7 +23,7 @@ constexpr const char* kIndicesAside = "qem_indices";  // set_draco_indices_aside
 // Every point's value of `attribute` converted to T (draco checks that each fits), appended to
 // `bytes`; false when one does not fit.
 template <class T>
-bool append_values(const draco::Mesh& mesh, const draco::PointAttribute& attribute,
+bool append_values(const draco::PointCloud& mesh, const draco::PointAttribute& attribute,
                    std::vector<unsigned char>& bytes) {
   const int n = attribute.num_components();
   T values[4] = {};
@@ -36,7 +36,7 @@ bool append_values(const draco::Mesh& mesh, const draco::PointAttribute& attribu
   return true;
 }
 
-bool append_values(int component_type, const draco::Mesh& mesh, const draco::PointAttribute& attribute,
+bool append_values(int component_type, const draco::PointCloud& mesh, const draco::PointAttribute& attribute,
                    std::vector<unsigned char>& bytes) {
   switch (component_type) {
     case TINYGLTF_COMPONENT_TYPE_BYTE:
@@ -56,22 +56,25 @@ bool append_values(int component_type, const draco::Mesh& mesh, const draco::Poi
   }
 }
 
-// The faces' corners in the index accessor's component type; false when an index does not fit it.
-bool append_indices(int component_type, const draco::Mesh& mesh, std::vector<unsigned char>& bytes) {
+// The faces' corners (of a point cloud, the points in order) in the index accessor's component
+// type; false when an index does not fit it.
+bool append_indices(int component_type, const draco::PointCloud& cloud, const draco::Mesh* mesh,
+                    std::vector<unsigned char>& bytes) {
   const std::size_t size = component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE    ? 1
                            : component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? 2
                            : component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT   ? 4
                                                                                       : 0;
   if (size == 0) return false;
   const std::uint64_t limit = size == 4 ? UINT32_MAX : (std::uint64_t(1) << (8 * size)) - 1;
-  for (draco::FaceIndex f(0); f < mesh.num_faces(); ++f)
-    for (int k = 0; k < 3; ++k) {
-      const std::uint32_t index = mesh.face(f)[k].value();
-      if (index >= mesh.num_points() || index > limit) return false;
-      unsigned char b[4];
-      std::memcpy(b, &index, 4);  // little endian, as glTF is
-      bytes.insert(bytes.end(), b, b + size);
-    }
+  const std::size_t count = mesh ? 3 * std::size_t(mesh->num_faces()) : cloud.num_points();
+  for (std::size_t c = 0; c < count; ++c) {
+    const std::uint32_t index =
+        mesh ? mesh->face(draco::FaceIndex(std::uint32_t(c / 3)))[c % 3].value() : std::uint32_t(c);
+    if (index >= cloud.num_points() || index > limit) return false;
+    unsigned char b[4];
+    std::memcpy(b, &index, 4);  // little endian, as glTF is
+    bytes.insert(bytes.end(), b, b + size);
+  }
   return true;
 }
 
@@ -107,14 +110,26 @@ void decode_primitive(tinygltf::Model& model, tinygltf::Primitive& p, const std:
 
   draco::DecoderBuffer stream;
   stream.Init(reinterpret_cast<const char*>(data.data() + view.byteOffset), view.byteLength);
+  // A POINTS primitive is a point cloud; any other is decoded as faces, a triangle list (so a strip
+  // becomes TRIANGLES).
+  const bool points = p.mode == TINYGLTF_MODE_POINTS;
   draco::Decoder decoder;
-  auto decoded = decoder.DecodeMeshFromBuffer(&stream);
-  if (!decoded.ok())
-    throw Error(where + ": the Draco data in buffer view " + std::to_string(v) +
-                " cannot be decoded: " + decoded.status().error_msg_string());
-  const draco::Mesh& mesh = *decoded.value();
-  if (mesh.num_faces() == 0 || mesh.num_points() == 0)
-    throw Error(where + ": the Draco data in buffer view " + std::to_string(v) + " holds no triangles");
+  std::unique_ptr<draco::PointCloud> cloud;
+  const auto take = [&](auto&& decoded) {
+    if (!decoded.ok())
+      throw Error(where + ": the Draco data in buffer view " + std::to_string(v) +
+                  " cannot be decoded: " + decoded.status().error_msg_string());
+    cloud = std::move(decoded).value();
+  };
+  if (points)
+    take(decoder.DecodePointCloudFromBuffer(&stream));
+  else
+    take(decoder.DecodeMeshFromBuffer(&stream));
+  const draco::PointCloud& mesh = *cloud;
+  const draco::Mesh* faces = points ? nullptr : static_cast<const draco::Mesh*>(&mesh);
+  if ((faces && faces->num_faces() == 0) || mesh.num_points() == 0)
+    throw Error(where + ": the Draco data in buffer view " + std::to_string(v) + " holds no " +
+                (points ? "points" : "triangles"));
   compressed_views.insert(static_cast<std::size_t>(v));
 
   auto accessor_of = [&](int index, const std::string& what) -> tinygltf::Accessor& {
@@ -149,21 +164,24 @@ void decode_primitive(tinygltf::Model& model, tinygltf::Primitive& p, const std:
   }
   if (ext.Has(kIndicesAside) && ext.Get(kIndicesAside).IsInt())
     p.indices = ext.Get(kIndicesAside).GetNumberAsInt();
-  // Draco always stores faces: a primitive without indices gets an index accessor of its own.
-  if (p.indices < 0) {
+  // Draco stores faces: a primitive of faces without indices gets an index accessor of its own.
+  if (p.indices < 0 && faces) {
     tinygltf::Accessor indices;
     indices.type = TINYGLTF_TYPE_SCALAR;
     indices.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
     model.accessors.push_back(std::move(indices));
     p.indices = static_cast<int>(model.accessors.size() - 1);
   }
-  tinygltf::Accessor& ia = accessor_of(p.indices, "indices");
-  std::vector<unsigned char> bytes;
-  if (!append_indices(ia.componentType, mesh, bytes))
-    throw Error(where + " (indices), accessor " + std::to_string(p.indices) + ": component type " +
-                std::to_string(ia.componentType) + " cannot hold the decoded indices");
-  attach(model, ia, std::move(bytes), 3 * std::size_t(mesh.num_faces()),
-         TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+  if (p.indices >= 0) {
+    tinygltf::Accessor& ia = accessor_of(p.indices, "indices");
+    std::vector<unsigned char> bytes;
+    if (!append_indices(ia.componentType, mesh, faces, bytes))
+      throw Error(where + " (indices), accessor " + std::to_string(p.indices) + ": component type " +
+                  std::to_string(ia.componentType) + " cannot hold the decoded indices");
+    attach(model, ia, std::move(bytes), faces ? 3 * std::size_t(faces->num_faces()) : mesh.num_points(),
+           TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+  }
+  if (faces) p.mode = TINYGLTF_MODE_TRIANGLES;
   p.extensions.erase(kDraco);
 }
 

@@ -22,7 +22,8 @@ bool set_draco_indices_aside(nlohmann::json& doc);
 
 /// Decodes every primitive that carries KHR_draco_mesh_compression: each accessor the extension
 /// names (and the indices) gets the decoded values in a new buffer and buffer view, in its own
-/// component type; the extension leaves the primitives and the document's extension lists. The
+/// component type; the extension leaves the primitives and the document's extension lists. A
+/// POINTS primitive is decoded as a point cloud; any other as faces, so a strip becomes TRIANGLES. The
 /// buffer views that held the bitstreams are added to `compressed_views` (the writer drops them).
 /// Throws qem::Error naming `name`, the mesh and the primitive when the bitstream or the extension
 /// is malformed or does not match the accessors (an attribute's component count, a value that
