@@ -51,60 +51,6 @@ std::vector<Face> faces_of(const qem::Mesh& m) {
   return faces;
 }
 
-/// `m` (positions, TEXCOORD_0, NORMAL) as one Draco-compressed primitive: the bitstream is the only
-/// buffer view, the accessors have none (as the extension writes them), the indices unsigned shorts.
-/// Draco ids: POSITION 0, TEXCOORD_0 1, NORMAL 2 (the builder's attribute order).
-json draco_document(const qem::Mesh& m, std::string& bin) {
-  const qem::VertexAttribute& uv = qem::test::attribute(m, qem::AttributeKind::TexCoord);
-  const qem::VertexAttribute& normal = qem::test::attribute(m, qem::AttributeKind::Normal);
-  draco::TriangleSoupMeshBuilder builder;
-  builder.Start(static_cast<int>(m.face_count()));
-  const int pos = builder.AddAttribute(draco::GeometryAttribute::POSITION, 3, draco::DT_FLOAT32);
-  const int tex = builder.AddAttribute(draco::GeometryAttribute::TEX_COORD, 2, draco::DT_FLOAT32);
-  const int nor = builder.AddAttribute(draco::GeometryAttribute::NORMAL, 3, draco::DT_FLOAT32);
-  std::vector<float> p(m.positions.begin(), m.positions.end()), t(uv.values.begin(), uv.values.end()),
-      n(normal.values.begin(), normal.values.end());
-  for (std::size_t f = 0; f < m.face_count(); ++f) {
-    const std::uint32_t* c = &m.indices[3 * f];
-    const draco::FaceIndex face(static_cast<std::uint32_t>(f));
-    builder.SetAttributeValuesForFace(pos, face, &p[3 * c[0]], &p[3 * c[1]], &p[3 * c[2]]);
-    builder.SetAttributeValuesForFace(tex, face, &t[2 * c[0]], &t[2 * c[1]], &t[2 * c[2]]);
-    builder.SetAttributeValuesForFace(nor, face, &n[3 * c[0]], &n[3 * c[1]], &n[3 * c[2]]);
-  }
-  std::unique_ptr<draco::Mesh> mesh = builder.Finalize();
-  EXPECT_TRUE(mesh);
-  draco::Encoder encoder;  // no quantization: the values come back exactly
-  draco::EncoderBuffer stream;
-  EXPECT_TRUE(encoder.EncodeMeshToBuffer(*mesh, &stream).ok());
-  bin.assign(stream.data(), stream.size());
-  std::array<float, 3> lo{1e30f, 1e30f, 1e30f}, hi{-1e30f, -1e30f, -1e30f};
-  for (std::size_t v = 0; v < m.vertex_count(); ++v)
-    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[3 * v + k]), hi[k] = std::max(hi[k], p[3 * v + k]);
-  json doc = {
-      {"asset", {{"version", "2.0"}}},
-      {"extensionsUsed", {"KHR_draco_mesh_compression"}},
-      {"extensionsRequired", {"KHR_draco_mesh_compression"}},
-      {"scene", 0},
-      {"scenes", {{{"nodes", {0}}}}},
-      {"nodes", {{{"mesh", 0}}}},
-      {"meshes",
-       {{{"primitives",
-          {{{"attributes", {{"POSITION", 0}, {"TEXCOORD_0", 1}, {"NORMAL", 2}}},
-            {"indices", 3},
-            {"extensions",
-             {{"KHR_draco_mesh_compression",
-               {{"bufferView", 0},
-                {"attributes", {{"POSITION", 0}, {"TEXCOORD_0", 1}, {"NORMAL", 2}}}}}}}}}}}}},
-      {"accessors",
-       {{{"componentType", 5126}, {"count", m.vertex_count()}, {"type", "VEC3"}, {"min", lo}, {"max", hi}},
-        {{"componentType", 5126}, {"count", m.vertex_count()}, {"type", "VEC2"}},
-        {{"componentType", 5126}, {"count", m.vertex_count()}, {"type", "VEC3"}},
-        {{"componentType", 5123}, {"count", m.indices.size()}, {"type", "SCALAR"}}}},
-      {"bufferViews", {{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", bin.size()}}}},
-      {"buffers", {{{"byteLength", 0}}}}};
-  return doc;
-}
-
 /// `doc` and `bin` as a .glb: the JSON chunk, then `bin` as the BIN chunk (buffer 0).
 std::string glb_of(json doc, std::string bin) {
   doc["buffers"] = {{{"byteLength", bin.size()}}};
@@ -136,7 +82,7 @@ std::string error_of(json doc, const std::string& bin) {
 TEST(GltfDraco, DecodesTheSameTrianglesAndAttributes) {
   const qem::Mesh sphere = qem::test::uv_sphere(12, 24);
   std::string bin;
-  const json doc = draco_document(sphere, bin);
+  const json doc = qem::test::draco_document(sphere, bin);
   const qem::GltfDocument d = qem::GltfDocument::parse(qem::test::gltf_text(doc, bin), "d.gltf");
   ASSERT_EQ(d.primitives().size(), 1u);
   EXPECT_TRUE(d.primitives()[0].simplifiable);
@@ -151,7 +97,7 @@ TEST(GltfDraco, DecodesTheSameTrianglesAndAttributes) {
 TEST(GltfDraco, IsWrittenUncompressedAndReadsBackTheSame) {
   const qem::Mesh sphere = qem::test::uv_sphere(8, 16);
   std::string bin;
-  const json doc = draco_document(sphere, bin);
+  const json doc = qem::test::draco_document(sphere, bin);
   const qem::GltfDocument d = qem::GltfDocument::parse(qem::test::gltf_text(doc, bin), "d.gltf");
   const std::string written = d.serialize(false);
   const json out = json::parse(written);
@@ -168,7 +114,7 @@ TEST(GltfDraco, IsWrittenUncompressedAndReadsBackTheSame) {
 TEST(GltfDraco, CommandLineSimplifiesACompressedFile) {
   const qem::Mesh sphere = qem::test::uv_sphere(24, 48);
   std::string bin;
-  const json doc = draco_document(sphere, bin);
+  const json doc = qem::test::draco_document(sphere, bin);
   const std::string dir = qem::test::temp_dir();
   const std::string in = dir + "/draco_sphere.gltf", out = dir + "/draco_sphere_simplified.glb";
   std::ofstream(in, std::ios::binary) << qem::test::gltf_text(doc, bin);
@@ -183,7 +129,7 @@ TEST(GltfDraco, CommandLineSimplifiesACompressedFile) {
 TEST(GltfDraco, AStripIsReadAsATriangleList) {
   const qem::Mesh sphere = qem::test::uv_sphere(6, 12);
   std::string bin;
-  json doc = draco_document(sphere, bin);
+  json doc = qem::test::draco_document(sphere, bin);
   doc["meshes"][0]["primitives"][0]["mode"] = 5;  // Draco decodes faces whatever the mode says
   const qem::GltfDocument d = qem::GltfDocument::parse(qem::test::gltf_text(doc, bin), "d.gltf");
   EXPECT_EQ(d.primitives()[0].mode, 4);
@@ -237,7 +183,7 @@ TEST(GltfDraco, APointCloudIsDecodedAndPassedThrough) {
 TEST(GltfDraco, MalformedDataIsRefusedByWhatIsWrong) {
   const qem::Mesh sphere = qem::test::uv_sphere(4, 8);
   std::string bin;
-  const json good = draco_document(sphere, bin);
+  const json good = qem::test::draco_document(sphere, bin);
   ASSERT_EQ(error_of(good, bin), "");
 
   const std::string broken = bin.substr(0, bin.size() / 2);  // cut off

@@ -1,5 +1,7 @@
 #include "test_meshes.h"
 
+#include <draco/compression/encode.h>
+#include <draco/mesh/triangle_soup_mesh_builder.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -12,6 +14,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <stdexcept>
 
 namespace qem::test {
 
@@ -292,6 +295,58 @@ std::string base64(const std::string& in) {
     out += {k[(v >> 18) & 63], k[(v >> 12) & 63], k[(v >> 6) & 63], '='};
   }
   return out;
+}
+
+nlohmann::json draco_document(const Mesh& m, std::string& bin) {
+  const qem::VertexAttribute& uv = attribute(m, AttributeKind::TexCoord);
+  const qem::VertexAttribute& normal = attribute(m, AttributeKind::Normal);
+  draco::TriangleSoupMeshBuilder builder;
+  builder.Start(static_cast<int>(m.face_count()));
+  const int pos = builder.AddAttribute(draco::GeometryAttribute::POSITION, 3, draco::DT_FLOAT32);
+  const int tex = builder.AddAttribute(draco::GeometryAttribute::TEX_COORD, 2, draco::DT_FLOAT32);
+  const int nor = builder.AddAttribute(draco::GeometryAttribute::NORMAL, 3, draco::DT_FLOAT32);
+  std::vector<float> p(m.positions.begin(), m.positions.end()), t(uv.values.begin(), uv.values.end()),
+      n(normal.values.begin(), normal.values.end());
+  for (std::size_t f = 0; f < m.face_count(); ++f) {
+    const std::uint32_t* c = &m.indices[3 * f];
+    const draco::FaceIndex face(static_cast<std::uint32_t>(f));
+    builder.SetAttributeValuesForFace(pos, face, &p[3 * c[0]], &p[3 * c[1]], &p[3 * c[2]]);
+    builder.SetAttributeValuesForFace(tex, face, &t[2 * c[0]], &t[2 * c[1]], &t[2 * c[2]]);
+    builder.SetAttributeValuesForFace(nor, face, &n[3 * c[0]], &n[3 * c[1]], &n[3 * c[2]]);
+  }
+  std::unique_ptr<draco::Mesh> mesh = builder.Finalize();
+  if (!mesh) throw std::runtime_error("draco_document: the builder failed");
+  draco::Encoder encoder;  // no quantization: the values come back exactly
+  draco::EncoderBuffer stream;
+  if (!encoder.EncodeMeshToBuffer(*mesh, &stream).ok())
+    throw std::runtime_error("draco_document: encoding failed");
+  bin.assign(stream.data(), stream.size());
+  std::array<float, 3> lo{1e30f, 1e30f, 1e30f}, hi{-1e30f, -1e30f, -1e30f};
+  for (std::size_t v = 0; v < m.vertex_count(); ++v)
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[3 * v + k]), hi[k] = std::max(hi[k], p[3 * v + k]);
+  nlohmann::json doc = {
+      {"asset", {{"version", "2.0"}}},
+      {"extensionsUsed", {"KHR_draco_mesh_compression"}},
+      {"extensionsRequired", {"KHR_draco_mesh_compression"}},
+      {"scene", 0},
+      {"scenes", {{{"nodes", {0}}}}},
+      {"nodes", {{{"mesh", 0}}}},
+      {"meshes",
+       {{{"primitives",
+          {{{"attributes", {{"POSITION", 0}, {"TEXCOORD_0", 1}, {"NORMAL", 2}}},
+            {"indices", 3},
+            {"extensions",
+             {{"KHR_draco_mesh_compression",
+               {{"bufferView", 0},
+                {"attributes", {{"POSITION", 0}, {"TEXCOORD_0", 1}, {"NORMAL", 2}}}}}}}}}}}}},
+      {"accessors",
+       {{{"componentType", 5126}, {"count", m.vertex_count()}, {"type", "VEC3"}, {"min", lo}, {"max", hi}},
+        {{"componentType", 5126}, {"count", m.vertex_count()}, {"type", "VEC2"}},
+        {{"componentType", 5126}, {"count", m.vertex_count()}, {"type", "VEC3"}},
+        {{"componentType", 5123}, {"count", m.indices.size()}, {"type", "SCALAR"}}}},
+      {"bufferViews", {{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", bin.size()}}}},
+      {"buffers", {{{"byteLength", 0}}}}};
+  return doc;
 }
 
 std::string gltf_text(nlohmann::json doc, const std::string& bin) {

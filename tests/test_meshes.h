@@ -55,6 +55,11 @@ const VertexAttribute& attribute(const Mesh& m, AttributeKind kind);
 std::string base64(const std::string& bytes);
 /// The text of glTF document `doc` with `bin` as its only buffer, embedded as a data: URI.
 std::string gltf_text(nlohmann::json doc, const std::string& bin);
+/// `m` (positions, TEXCOORD_0, NORMAL) as one Draco-compressed primitive (libdraco's encoder, no
+/// quantization: the values come back exactly): the bitstream (`bin`, to embed with gltf_text) is
+/// the only buffer view, the accessors have none, as the extension writes them, the indices
+/// unsigned shorts. Draco ids: POSITION 0, TEXCOORD_0 1, NORMAL 2.
+nlohmann::json draco_document(const Mesh& m, std::string& bin);
 /// Removes from a glTF document's JSON what tinygltf writes or leaves out for its default value
 /// (the same meaning either way): `mode: 4`, `normalized: false`, the materials' default factors,
 /// alpha mode, texture coordinate sets and scales, and an empty material list.

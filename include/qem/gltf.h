@@ -58,9 +58,10 @@ class GltfDocument {
   /// Reads a .gltf (buffers embedded as data: URIs or in files beside it) or a .glb (by content,
   /// whatever the extension). Images are kept as bytes, never decoded; external image files are
   /// referenced by their URI, not read. Throws qem::Error naming the file (and the mesh, primitive
-  /// and accessor when one is at fault) on malformed input, on KHR_draco_mesh_compression and
-  /// EXT_meshopt_compression (compressed geometry is refused, not decoded), and on accessors that
-  /// lie outside their buffer, indices beyond the vertex count, or non-finite values.
+  /// and accessor when one is at fault) on malformed input, on accessors that lie outside their
+  /// buffer, indices beyond the vertex count, or non-finite values. Geometry compressed with
+  /// KHR_draco_mesh_compression or EXT_meshopt_compression is decoded here (a malformed stream
+  /// throws); KHR_meshopt_compression is refused by name.
   static GltfDocument load(const std::string& path);
   /// Same, from bytes in memory; `name` is used in messages. Buffers must be embedded (.glb or
   /// data: URIs): no file is read.

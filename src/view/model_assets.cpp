@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "qem/error.h"
+#include "qem/gltf.h"
 #include "view/mtl.h"
 #include "view/safe_path.h"
 
@@ -116,17 +117,19 @@ void add_face_colours(ViewLevel& level) {
   level.materials = std::move(out);
 }
 
+// A glTF document's JSON: the whole text, or a .glb's JSON chunk.
+std::string_view json_text_of(const std::string& bytes, const std::string& name) {
+  if (!is_glb(bytes)) return bytes;
+  // GLB: 12-byte header, then the JSON chunk (length, type "JSON", data) (glTF 2.0 §4.4).
+  if (bytes.size() < 20 || get_u32(bytes, 16) != 0x4E4F534Au || get_u32(bytes, 12) > bytes.size() - 20)
+    throw Error(name + ": not a valid GLB (no JSON chunk)");
+  return std::string_view(bytes).substr(20, get_u32(bytes, 12));
+}
+
 }  // namespace
 
 std::vector<std::string> gltf_external_uris(const std::string& bytes, const std::string& name) {
-  std::string_view json_text = bytes;
-  if (is_glb(bytes)) {
-    // GLB: 12-byte header, then the JSON chunk (length, type "JSON", data) (glTF 2.0 §4.4).
-    if (bytes.size() < 20 || get_u32(bytes, 16) != 0x4E4F534Au || get_u32(bytes, 12) > bytes.size() - 20)
-      throw Error(name + ": not a valid GLB (no JSON chunk)");
-    json_text = std::string_view(bytes).substr(20, get_u32(bytes, 12));
-  }
-  nlohmann::json doc = nlohmann::json::parse(json_text, nullptr, false);
+  nlohmann::json doc = nlohmann::json::parse(json_text_of(bytes, name), nullptr, false);
   if (doc.is_discarded() || !doc.is_object()) throw Error(name + ": the glTF JSON cannot be parsed");
   std::vector<std::string> out;
   for (const char* list : {"buffers", "images"}) {
@@ -154,6 +157,13 @@ ViewLevel load_view_level(const std::string& path, const LoadOptions& options,
     // The document itself goes to the page; the mesh still gives counts, frame and error.
     level.gltf = level.name;
     level.files[level.gltf] = read_file(file);
+    // three.js's GLTFLoader reads compressed geometry only with decoders that the page does not
+    // carry: such a document goes to the page decoded (GltfDocument writes it uncompressed, its
+    // external buffers embedded).
+    const std::string_view json = json_text_of(level.files[level.gltf], path);
+    if (json.find("KHR_draco_mesh_compression") != std::string_view::npos ||
+        json.find("EXT_meshopt_compression") != std::string_view::npos)
+      level.files[level.gltf] = GltfDocument::load(path).serialize(is_glb(level.files[level.gltf]));
     for (const std::string& uri : gltf_external_uris(level.files[level.gltf], path))
       add_reference(level, folder, fs::path(), percent_decode(uri), path, "glTF resource", warnings);
   } else if (report.format == FileFormat::Obj && options.read_attributes) {

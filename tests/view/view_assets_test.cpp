@@ -168,6 +168,19 @@ TEST(ViewModelAssets, GltfKeepsTheDocumentAndItsRelativeResources) {
   EXPECT_EQ(level.mesh.face_count(), tri.face_count());
 }
 
+TEST(ViewModelAssets, CompressedGltfGoesToThePageDecoded) {
+  Folders f;
+  std::string bin;
+  const qem::Mesh sphere = test::uv_sphere(4, 8);
+  const std::string doc = test::gltf_text(test::draco_document(sphere, bin), bin);
+  write(f.model / "d.gltf", doc);
+  ViewLevel level = load_view_level((f.model / "d.gltf").string(), {}, nullptr);
+  const std::string& served = level.files.at("d.gltf");
+  EXPECT_EQ(served.find("KHR_draco_mesh_compression"), std::string::npos);  // three.js reads it as is
+  EXPECT_EQ(GltfDocument::parse(served, "served.gltf").mesh(0).face_count(), sphere.face_count());
+  EXPECT_EQ(level.mesh.face_count(), sphere.face_count());
+}
+
 TEST(ViewModelAssets, GlbJsonChunkIsRead) {
   const std::string glb = serialize_gltf(test::tetrahedron(), true);
   EXPECT_TRUE(gltf_external_uris(glb, "t.glb").empty());  // one embedded buffer, no URI
