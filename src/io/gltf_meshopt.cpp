@@ -45,14 +45,8 @@ void decode_view(tinygltf::Model& model, std::size_t v, const std::string& name)
   const std::uint64_t stride = unsigned_field(ext, "byteStride", where, true);
   const std::uint64_t count = unsigned_field(ext, "count", where, true);
   const std::string mode = string_field(ext, "mode", ""), filter = string_field(ext, "filter", "NONE");
-  if (source >= model.buffers.size())
-    throw Error(where + ": " + kMeshopt + " names buffer " + std::to_string(source) +
-                ", which does not exist");
+  // The data's place in its buffer was checked by decode_meshopt.
   const std::vector<unsigned char>& in = model.buffers[source].data;
-  if (offset > in.size() || length > in.size() - offset)
-    throw Error(where + ": " + kMeshopt + "'s data (bytes " + std::to_string(offset) + ", " +
-                std::to_string(length) + " long) lies outside buffer " + std::to_string(source) + " of " +
-                std::to_string(in.size()) + " bytes");
   if (view.buffer < 0 || static_cast<std::size_t>(view.buffer) >= model.buffers.size())
     throw Error(where + " names buffer " + std::to_string(view.buffer) + ", which does not exist");
   std::vector<unsigned char>& out = model.buffers[static_cast<std::size_t>(view.buffer)].data;
@@ -107,16 +101,43 @@ bool set_fallback_buffers_aside(nlohmann::json& doc) {
 }
 
 void decode_meshopt(tinygltf::Model& model, const std::string& name) {
+  // A fallback buffer holds no data: qem lays its compressed views out one after the other in a
+  // buffer of their own length (their offsets change; the writer re-packs every view anyway). A
+  // view may not claim more than its data can expand to: the vertex codec's most is 64 bytes per
+  // compressed byte (a 2-bit header per 16 bytes of one channel; the index codecs' is 12), and that
+  // data must lie in its buffer, so a file cannot make qem allocate far beyond its own size.
+  std::vector<char> fallback(model.buffers.size(), 0);
+  for (std::size_t b = 0; b < model.buffers.size(); ++b)
+    fallback[b] = model.buffers[b].extensions.count(kMeshopt) &&
+                  model.buffers[b].extensions.at(kMeshopt).Has(kLengthAside);
+  std::vector<std::uint64_t> laid(model.buffers.size(), 0);
+  for (std::size_t v = 0; v < model.bufferViews.size(); ++v) {
+    tinygltf::BufferView& view = model.bufferViews[v];
+    if (!view.extensions.count(kMeshopt)) continue;
+    const std::string where = name + ": buffer view " + std::to_string(v);
+    const tinygltf::Value& ext = view.extensions.at(kMeshopt);
+    const std::uint64_t source = unsigned_field(ext, "buffer", where, true);
+    const std::uint64_t offset = unsigned_field(ext, "byteOffset", where, false);
+    const std::uint64_t length = unsigned_field(ext, "byteLength", where, true);
+    if (source >= model.buffers.size() || fallback[source] || offset > model.buffers[source].data.size() ||
+        length > model.buffers[source].data.size() - offset)
+      throw Error(where + ": " + kMeshopt + "'s data (buffer " + std::to_string(source) + ", bytes " +
+                  std::to_string(offset) + ", " + std::to_string(length) + " long) is not in the file");
+    if (view.byteLength > 64 * length + 256)
+      throw Error(where + ": " + std::to_string(length) + " bytes of " + kMeshopt +
+                  " data cannot decode to " + std::to_string(view.byteLength));
+    if (view.buffer >= 0 && static_cast<std::size_t>(view.buffer) < fallback.size() &&
+        fallback[static_cast<std::size_t>(view.buffer)]) {
+      std::uint64_t& end = laid[static_cast<std::size_t>(view.buffer)];
+      view.byteOffset = end;
+      end = (end + view.byteLength + 3) & ~std::uint64_t(3);  // 4-byte aligned, as glTF asks
+    }
+  }
   for (std::size_t b = 0; b < model.buffers.size(); ++b) {
     tinygltf::Buffer& buffer = model.buffers[b];
     if (!buffer.extensions.count(kMeshopt)) continue;
-    const tinygltf::Value& ext = buffer.extensions.at(kMeshopt);
-    if (ext.Has(kLengthAside)) {
-      const std::uint64_t length =
-          unsigned_field(ext, kLengthAside, name + ": buffer " + std::to_string(b), true);
-      if (length > kLargestBuffer)
-        throw Error(name + ": buffer " + std::to_string(b) + " is longer than 4 GiB");
-      buffer.data.assign(length, 0);
+    if (fallback[b]) {
+      buffer.data.assign(laid[b], 0);
       buffer.uri.clear();
     }
     buffer.extensions.erase(kMeshopt);
