@@ -16,6 +16,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "qem/error.h"
+#include "qem/gltf.h"
+
 namespace qem::test {
 
 Mesh grid(int n) { return height_field(n, [](double, double) { return 0.0; }); }
@@ -295,6 +298,15 @@ std::string base64(const std::string& in) {
     out += {k[(v >> 18) & 63], k[(v >> 12) & 63], k[(v >> 6) & 63], '='};
   }
   return out;
+}
+
+std::string gltf_error(const std::string& bytes, const std::string& name) {
+  try {
+    GltfDocument::parse(bytes, name);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
 }
 
 nlohmann::json draco_document(const Mesh& m, std::string& bin) {

@@ -55,6 +55,8 @@ const VertexAttribute& attribute(const Mesh& m, AttributeKind kind);
 std::string base64(const std::string& bytes);
 /// The text of glTF document `doc` with `bin` as its only buffer, embedded as a data: URI.
 std::string gltf_text(nlohmann::json doc, const std::string& bin);
+/// The qem::Error message of reading glTF `bytes` named `name`, "" when they read.
+std::string gltf_error(const std::string& bytes, const std::string& name);
 /// `m` (positions, TEXCOORD_0, NORMAL) as one Draco-compressed primitive (libdraco's encoder, no
 /// quantization: the values come back exactly): the bitstream (`bin`, to embed with gltf_text) is
 /// the only buffer view, the accessors have none, as the extension writes them, the indices

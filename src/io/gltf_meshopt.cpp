@@ -15,7 +15,7 @@ namespace {
 
 constexpr const char* kMeshopt = "EXT_meshopt_compression";
 constexpr const char* kLengthAside = "qem_byteLength";  // set_fallback_buffers_aside's key
-// glTF buffers are at most 2^32 bytes long in a .glb, and this bounds what a file can make qem allocate.
+// The largest number a length or count of the extension may hold (a .glb is below 4 GiB).
 constexpr std::uint64_t kLargestBuffer = std::uint64_t(1) << 32;
 
 std::uint64_t unsigned_field(const tinygltf::Value& ext, const char* key, const std::string& where,

@@ -17,6 +17,8 @@ std::uint32_t read_u32(std::string_view bytes, std::size_t at) {
   return v;
 }
 
+bool is_glb(std::string_view bytes) { return bytes.size() >= 4 && bytes.substr(0, 4) == "glTF"; }
+
 void append_u32(std::string& out, std::uint32_t v) {
   char b[4];
   std::memcpy(b, &v, 4);
@@ -25,16 +27,19 @@ void append_u32(std::string& out, std::uint32_t v) {
 
 }  // namespace
 
+std::optional<std::string_view> json_of(std::string_view bytes) {
+  if (!is_glb(bytes)) return bytes;
+  // The header (magic, version, length), then the first chunk: length, type "JSON", data.
+  if (bytes.size() < 20 || bytes.substr(16, 4) != "JSON" || read_u32(bytes, 12) > bytes.size() - 20)
+    return std::nullopt;
+  return bytes.substr(20, read_u32(bytes, 12));
+}
+
 std::string prepare_for_tinygltf(std::string_view bytes) {
-  // The JSON: the whole text, or a .glb's first chunk (header: magic, version, length; chunk:
-  // length, type "JSON", data).
-  const bool glb = bytes.size() >= 4 && bytes.substr(0, 4) == "glTF";
-  std::string_view text = bytes;
-  if (glb) {
-    if (bytes.size() < 20 || bytes.substr(16, 4) != "JSON" || read_u32(bytes, 12) > bytes.size() - 20)
-      return "";
-    text = bytes.substr(20, read_u32(bytes, 12));
-  }
+  const bool glb = is_glb(bytes);
+  const std::optional<std::string_view> json_text = json_of(bytes);
+  if (!json_text) return "";  // for tinygltf to refuse with its own message
+  const std::string_view text = *json_text;
   if (text.find("KHR_draco_mesh_compression") == std::string_view::npos &&
       text.find("EXT_meshopt_compression") == std::string_view::npos)
     return "";

@@ -4,10 +4,15 @@
 // Each change is undone by the decoder that follows the load.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <string_view>
 
 namespace qem::io::gltf {
+
+/// The JSON of a glTF document's bytes: the whole text of a .gltf, or a .glb's JSON chunk (glTF 2.0
+/// §4.4); nullopt when a .glb has none within its bytes.
+std::optional<std::string_view> json_of(std::string_view bytes);
 
 /// A document's bytes (.gltf JSON or .glb) with those changes made, or "" when none is needed (the
 /// document uses neither extension, or its bytes are for tinygltf to refuse with its own message).

@@ -1,15 +1,16 @@
 // Models with their materials, textures and glTF documents for the viewer (model_assets.h).
 #include "view/model_assets.h"
 
-#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
+#include "io/gltf_prepass.h"
 #include "qem/error.h"
 #include "qem/gltf.h"
 #include "view/mtl.h"
@@ -27,12 +28,6 @@ std::string read_file(const fs::path& file) {
   ss << in.rdbuf();
   if (!in) throw Error(file.string() + ": cannot read");
   return ss.str();
-}
-
-std::uint32_t get_u32(const std::string& b, std::size_t at) {
-  std::uint32_t v = 0;
-  for (int k = 3; k >= 0; --k) v = (v << 8) | static_cast<unsigned char>(b[at + k]);
-  return v;
 }
 
 bool is_glb(const std::string& bytes) {
@@ -119,11 +114,9 @@ void add_face_colours(ViewLevel& level) {
 
 // A glTF document's JSON: the whole text, or a .glb's JSON chunk.
 std::string_view json_text_of(const std::string& bytes, const std::string& name) {
-  if (!is_glb(bytes)) return bytes;
-  // GLB: 12-byte header, then the JSON chunk (length, type "JSON", data) (glTF 2.0 §4.4).
-  if (bytes.size() < 20 || get_u32(bytes, 16) != 0x4E4F534Au || get_u32(bytes, 12) > bytes.size() - 20)
-    throw Error(name + ": not a valid GLB (no JSON chunk)");
-  return std::string_view(bytes).substr(20, get_u32(bytes, 12));
+  const std::optional<std::string_view> json = io::gltf::json_of(bytes);
+  if (!json) throw Error(name + ": not a valid GLB (no JSON chunk)");
+  return *json;
 }
 
 }  // namespace
