@@ -147,6 +147,7 @@ class Repairer {
   }
 
  private:
+  using Corners = std::array<std::uint32_t, 3>;
   std::uint32_t face_count() const { return std::uint32_t(tri_.size() / 3); }
   Vec3 point(std::uint32_t p) const { return {points_[3 * p], points_[3 * p + 1], points_[3 * p + 2]}; }
   std::array<std::uint32_t, 3> face(std::uint32_t f) const { return {tri_[3 * f], tri_[3 * f + 1], tri_[3 * f + 2]}; }
@@ -187,9 +188,12 @@ class Repairer {
     std::vector<Vec3> at;
     std::vector<double> weight, values;  // values: the channels' components per sample
     std::vector<std::uint32_t> context;  // the faces round the change that it leaves as they are
+    // Per sample, its nearest context face's squared distance (HUGE_VAL without one) and the
+    // sample's error on that face: the same before and after the change, so found once.
+    std::vector<double> context_d2, context_error;
   };
   // The samples round a change of faces `changed` (their slots, as they are before it).
-  void sample_values(std::span<const std::uint32_t> changed, const Vec3* also, ValueSamples& s) const {
+  void sample_values(std::span<const std::uint32_t> changed, const Vec3* also, ValueSamples& s) {
     s.at.clear(), s.weight.clear(), s.values.clear(), s.context.clear();
     if (channels_.empty() || opt_.input_faces.empty()) return;
     std::vector<std::uint32_t> corners;
@@ -222,28 +226,95 @@ class Repairer {
           }
       }
     }
+    // Each sample's nearest context face, the first of the nearest in s.context's order. Faces
+    // whose box is farther than the nearest found so far are passed over, the box nearest first.
+    ContextBoxes& boxes = scratch_boxes_;
+    const std::size_t n = s.context.size();
+    for (auto* bound : {&boxes.lo[0], &boxes.lo[1], &boxes.lo[2], &boxes.hi[0], &boxes.hi[1], &boxes.hi[2]})
+      bound->resize(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      const Corners t = face(s.context[k]);
+      for (int a = 0; a < 3; ++a) {
+        const double c0 = x_[t[0]][a], c1 = x_[t[1]][a], c2 = x_[t[2]][a];
+        boxes.lo[a][k] = std::min({c0, c1, c2}) - kWiden, boxes.hi[a][k] = std::max({c0, c1, c2}) + kWiden;
+      }
+    }
+    std::vector<double>& gaps = scratch_gaps_;
+    gaps.resize(n);
+    s.context_d2.assign(s.at.size(), HUGE_VAL), s.context_error.assign(s.at.size(), 0);
+    for (std::size_t i = 0; i < s.at.size() && n > 0; ++i) {
+      const Vec3 p = s.at[i];
+      for (std::size_t k = 0; k < n; ++k) {
+        const double dx = std::max(std::max(boxes.lo[0][k] - p.x, p.x - boxes.hi[0][k]), 0.0);
+        const double dy = std::max(std::max(boxes.lo[1][k] - p.y, p.y - boxes.hi[1][k]), 0.0);
+        const double dz = std::max(std::max(boxes.lo[2][k] - p.z, p.z - boxes.hi[2][k]), 0.0);
+        gaps[k] = dx * dx + dy * dy + dz * dz;
+      }
+      const std::size_t first = std::size_t(std::min_element(gaps.begin(), gaps.end()) - gaps.begin());
+      double& best_d2 = s.context_d2[i];
+      std::size_t best = n;
+      const auto consider = [&](std::size_t k) {
+        const double d2 = triangle_d2(p, face(s.context[k]));
+        if (d2 < best_d2 || (d2 == best_d2 && k < best)) best_d2 = d2, best = k;
+      };
+      consider(first);
+      for (std::size_t k = 0; k < n; ++k)
+        if (k != first && !beyond(gaps[k], best_d2)) consider(k);
+      if (best < n) s.context_error[i] = sample_error(s, i, face(s.context[best]));
+    }
+  }
+  // Boxes are widened by far more than the rounding of a closest point on a triangle inside them
+  // (frame units: the points lie within the unit box), so that a box `beyond` a squared distance
+  // holds no point as near.
+  static constexpr double kWiden = 1e-9;
+  struct ContextBoxes {
+    std::vector<double> lo[3], hi[3];  // per axis, so that a sample's gaps to them run in vectors
+  };
+  static bool beyond(double gap2, double d2) { return gap2 > d2 * (1 + 1e-9); }
+  double triangle_d2(const Vec3& p, const Corners& t) const {
+    return measure_detail::squared_distance(
+        p, measure_detail::closest_point_on_triangle(p, x_[t[0]], x_[t[1]], x_[t[2]]));
+  }
+  // Sample i's error on face t: its values against t's interpolated at its closest point on t.
+  double sample_error(const ValueSamples& s, std::size_t i, const Corners& t) const {
+    const std::array<double, 3> w =
+        measure_detail::closest_point_weights(s.at[i], x_[t[0]], x_[t[1]], x_[t[2]]);
+    const double* values = &s.values[i * value_width_];
+    return s.weight[i] *
+           values_gap(t, w, [&](const Channel& ch, std::uint32_t k) { return values[ch.first + k]; });
   }
   // The samples' error of appearance against the nearest of `count` faces (`corners(k)`: its three
   // vertices) and the faces round them (s.context: a sample nearer one of those is theirs, as in
   // the measure, which asks the whole output), their values interpolated at its closest point.
+  // (A sample farther from the box of the `count` faces than from its nearest context face keeps
+  // that face: the choice a test of every face would make, ties going to the `count` faces.)
   template <class CornersOf>
   double samples_value_error(const ValueSamples& s, std::size_t count, CornersOf corners) const {
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    for (std::size_t k = 0; k < count; ++k)
+      for (std::uint32_t c : corners(k))
+        for (int a = 0; a < 3; ++a)
+          lo[a] = std::min(lo[a], x_[c][a] - kWiden), hi[a] = std::max(hi[a], x_[c][a] + kWiden);
     double total = 0;
     for (std::size_t i = 0; i < s.at.size(); ++i) {
-      std::array<std::uint32_t, 3> best{};
+      const Vec3& p = s.at[i];
+      double gap2 = 0;
+      for (int a = 0; a < 3; ++a) {
+        const double gap = std::max({lo[a] - p[a], p[a] - hi[a], 0.0});
+        gap2 += gap * gap;
+      }
+      if (beyond(gap2, s.context_d2[i])) {
+        total += s.context_error[i];
+        continue;
+      }
+      Corners best{};
       double best_d2 = HUGE_VAL;
-      for (std::size_t k = 0; k < count + s.context.size(); ++k) {
-        const std::array<std::uint32_t, 3> t =
-            k < count ? corners(k)
-                      : std::array<std::uint32_t, 3>{tri_[3 * s.context[k - count]], tri_[3 * s.context[k - count] + 1],
-                                                     tri_[3 * s.context[k - count] + 2]};
-        const double d2 = measure_detail::squared_distance(
-            s.at[i], measure_detail::closest_point_on_triangle(s.at[i], x_[t[0]], x_[t[1]], x_[t[2]]));
+      for (std::size_t k = 0; k < count; ++k) {
+        const Corners t = corners(k);
+        const double d2 = triangle_d2(p, t);
         if (d2 < best_d2) best_d2 = d2, best = t;
       }
-      const std::array<double, 3> w = measure_detail::closest_point_weights(s.at[i], x_[best[0]], x_[best[1]], x_[best[2]]);
-      const double* values = &s.values[i * value_width_];
-      total += s.weight[i] * values_gap(best, w, [&](const Channel& ch, std::uint32_t k) { return values[ch.first + k]; });
+      total += best_d2 <= s.context_d2[i] ? sample_error(s, i, best) : s.context_error[i];
     }
     return total;
   }
@@ -650,21 +721,21 @@ class Repairer {
       if (scores[i].most >= old_most) return false;
     }
     if (!early && !points_near()) return false;
-    // The values at the points and between them, round the fan where it is and where it goes.
-    const auto fan_face = [&](std::size_t k) { return face(fan[k]); };
-    double values_before = 0;
-    if (!channels_.empty()) {
-      sample_values(fan, &y, scratch_samples_);
-      values_before = appearance_error(pts, on, scratch_samples_, fan.size(), fan_face);
-    }
-    x_[v] = y;
     double energy = 0;
     for (std::size_t i = 0; i < fan.size(); ++i) energy += scores[i].energy;
     add_points_energy(pts, scratch_d2_, energy);
-    if (energy > old_energy * (1 + opt_.error_margin)) return x_[v] = x, false;
-    if (!channels_.empty() &&
-        appearance_error(pts, scratch_nearest_, scratch_samples_, fan.size(), fan_face) > values_before)
-      return x_[v] = x, false;
+    if (energy > old_energy * (1 + opt_.error_margin)) return false;
+    if (!channels_.empty()) {
+      // The values at the points and between them, round the fan where it is and where it goes.
+      const auto fan_face = [&](std::size_t k) { return face(fan[k]); };
+      sample_values(fan, &y, scratch_samples_);
+      const double before = appearance_error(pts, on, scratch_samples_, fan.size(), fan_face);
+      x_[v] = y;
+      const double after = appearance_error(pts, scratch_nearest_, scratch_samples_, fan.size(), fan_face);
+      x_[v] = x;
+      if (after > before) return false;
+    }
+    x_[v] = y;
     for (std::size_t i = 0; i < fan.size(); ++i) score_[fan[i]] = scores[i], scored_[fan[i]] = 1, points_of_[fan[i]].clear();
     for (std::size_t i = 0; i < pts.size(); ++i)
       d2_[pts[i]] = scratch_d2_[i], points_of_[fan[scratch_nearest_[i]]].push_back(pts[i]);
@@ -810,7 +881,6 @@ class Repairer {
   static constexpr std::size_t kStuck = 8;
   static constexpr double kScoreFrom = 0.4;
   static constexpr double kBorderReach = 4;
-  using Corners = std::array<std::uint32_t, 3>;
 
   // A planned set of new faces replacing `old` faces: their scores, and the old faces' input points
   // each with its nearest new face.
@@ -1549,6 +1619,8 @@ class Repairer {
   };
   std::vector<Channel> channels_;                    // the attributes that judge flips and moves
   std::uint32_t value_width_ = 0;                    // their components, all together
+  ContextBoxes scratch_boxes_;                       // sample_values' context faces' boxes
+  std::vector<double> scratch_gaps_;                 // and a sample's distances to them
   ValueSamples scratch_samples_;                     // the input's surface round a change (sample_values)
   std::vector<std::uint32_t> scratch_on_;            // per point of a change, its face before it
   std::vector<Vec3> x_;                              // output positions in the frame
