@@ -183,6 +183,40 @@ TEST(Gltf, SkinnedMeshIsMergedInItsBindPose) {
   EXPECT_DOUBLE_EQ(qem::GltfDocument::parse(t.text(), "skin.gltf").primitives()[0].world_scale, 2.0);
 }
 
+TEST(Gltf, SkinnedPartMirroredByItsJointsKeepsEachFacesOutwardSide) {
+  // Joint 0 is the identity, joint 1 mirrors x. Vertex 0 follows joint 0, the others joint 1: both
+  // faces are mostly mirrored (the mean of their corners' matrices has a negative determinant),
+  // so both turn round, whatever the first vertex's matrix says.
+  Tiny t;
+  for (int v = 0; v < 4; ++v) t.bin += v == 0 ? std::string("\0\0\0\0", 4) : std::string("\1\0\0\0", 4);
+  for (int v = 0; v < 4; ++v)
+    for (float w : {1.0f, 0.0f, 0.0f, 0.0f}) put(t.bin, w);
+  json& p = t.doc["meshes"][0]["primitives"][0];
+  p["attributes"]["JOINTS_0"] = 5;
+  p["attributes"]["WEIGHTS_0"] = 6;
+  t.doc["accessors"].push_back({{"bufferView", 5}, {"componentType", 5121}, {"count", 4}, {"type", "VEC4"}});
+  t.doc["accessors"].push_back({{"bufferView", 6}, {"componentType", 5126}, {"count", 4}, {"type", "VEC4"}});
+  t.doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", 156}, {"byteLength", 16}});
+  t.doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", 172}, {"byteLength", 64}});
+  t.doc["nodes"][0]["skin"] = 0;
+  t.doc["nodes"].push_back(json::object());
+  t.doc["nodes"].push_back({{"scale", {-1, 1, 1}}});
+  t.doc["scenes"][0]["nodes"] = {0, 1, 2};
+  t.doc["skins"] = {{{"joints", {1, 2}}}};
+  // (The skin has no inverseBindMatrices, which glTF makes optional: identities, and none written.)
+  const json written = json::parse(qem::GltfDocument::parse(t.text(), "skin.gltf").serialize(false));
+  EXPECT_FALSE(written["skins"][0].contains("inverseBindMatrices"));
+  const qem::Mesh m = qem::parse_mesh(t.text(), qem::FileFormat::Auto, "skin.gltf");
+  EXPECT_EQ(m.indices, (std::vector<std::uint32_t>{0, 2, 1, 0, 3, 2}));
+  // Vertex 0 in place, the others mirrored.
+  EXPECT_EQ(m.positions[0], 0.0);
+  EXPECT_EQ(m.positions[3], -1.0);
+  // Every vertex on joint 0: nothing turns.
+  t.bin.replace(156, 16, std::string(16, '\0'));
+  EXPECT_EQ(qem::parse_mesh(t.text(), qem::FileFormat::Auto, "skin.gltf").indices,
+            (std::vector<std::uint32_t>{0, 1, 2, 0, 2, 3}));
+}
+
 TEST(Gltf, MirroringNodeKeepsTheOutwardWinding) {
   Tiny t;
   t.doc["nodes"][0]["scale"] = {-1, 1, 1};

@@ -19,6 +19,7 @@
 #include <limits>
 #include <map>
 #include <set>
+#include <span>
 #include <sstream>
 
 #include "io/gltf_accessors.h"
@@ -540,6 +541,13 @@ GltfDocument GltfDocument::from_bytes(std::string_view bytes, const std::string&
     else
       ok = loader.LoadASCIIFromString(&d.model, &err, &warn, bytes.data(),
                                       static_cast<unsigned>(bytes.size()), base_dir);
+    // tinygltf 2.7 requires a skin's inverseBindMatrices, which glTF 2.0 §5.28 makes optional (the
+    // identity); skin_matrices reads a missing one so.
+    for (const std::string missing = "'inverseBindMatrices' property is missing in Skin.\n";;) {
+      const std::size_t at = err.find(missing);
+      if (at == std::string::npos) break;
+      err.erase(at, missing.size());
+    }
     if (!ok || !err.empty())
       io::fail(name, err.empty() ? std::string("not a valid glTF file")
                                  : "not a valid glTF file: " + one_line(err));
@@ -846,17 +854,31 @@ void GltfDocument::save(const std::string& path) const {
 
 namespace {
 
+/// The determinant of the upper 3x3 of `m`.
+double determinant3(const Mat4& m) {
+  return m[0] * (m[5] * m[10] - m[6] * m[9]) - m[4] * (m[1] * m[10] - m[2] * m[9]) +
+         m[8] * (m[1] * m[6] - m[2] * m[5]);
+}
+
 /// Appends a part's faces on its vertices at `base`, with their material (no material: the one
-/// after the document's).
-void add_faces(Mesh& out, const Mesh& part, std::uint32_t base, const Mat4& world, int material,
-               std::size_t materials, bool& uses_default) {
-  // A mirroring transform (negative determinant) reverses the winding (glTF 2.0 §3.7.4).
-  const double det = world[0] * (world[5] * world[10] - world[6] * world[9]) -
-                     world[4] * (world[1] * world[10] - world[2] * world[9]) +
-                     world[8] * (world[1] * world[6] - world[2] * world[5]);
+/// after the document's). A mirroring transform (negative determinant) reverses the winding
+/// (glTF 2.0 §3.7.4): the node's `world`, or for a skinned part (`blended`: per vertex, from
+/// blended_matrices) the skinning's at the face, the mean of its corners' matrices (linear blend
+/// skinning's own transform there, but for the weights' change across the face), so that a part
+/// whose joints mirror some of it keeps each face's outward side.
+void add_faces(Mesh& out, const Mesh& part, std::uint32_t base, const Mat4& world,
+               std::span<const Mat4> blended, int material, std::size_t materials, bool& uses_default) {
+  const bool mirrored = determinant3(world) < 0;
   for (std::size_t f = 0; f < part.face_count(); ++f) {
     std::uint32_t a = part.indices[3 * f], b = part.indices[3 * f + 1], c = part.indices[3 * f + 2];
-    if (det < 0) std::swap(b, c);
+    bool flip = mirrored;
+    if (!blended.empty()) {
+      Mat4 sum{};
+      for (std::uint32_t v : {a, b, c})
+        for (int e = 0; e < 16; ++e) sum[e] += blended[v][e];
+      flip = determinant3(sum) < 0;
+    }
+    if (flip) std::swap(b, c);
     out.indices.insert(out.indices.end(), {base + a, base + b, base + c});
   }
   if (material < 0 || static_cast<std::size_t>(material) >= materials) {
@@ -942,14 +964,6 @@ Mesh GltfDocument::scene_mesh() const {
     if (out.positions.size() / 3 + part.vertex_count() > 0xffffffffu)
       throw Error(d.name + ": the scene has more than 2^32 vertices");
     const auto base = static_cast<std::uint32_t>(out.vertex_count());
-    const auto key = std::make_pair(part_ref.instance, d.primitive(i).attributes);
-    if (!d.replaced.count(i)) {
-      if (auto it = shared_base.find(key); it != shared_base.end()) {
-        add_faces(out, part, it->second, world, d.primitives[i].material, m.materials.size(), uses_default);
-        continue;
-      }
-      shared_base[key] = base;
-    }
     // A skinned part is placed in its bind pose, each vertex by its joints' blended matrix (the
     // node's matrix when it has no joints and weights).
     std::vector<Mat4> blended;
@@ -958,6 +972,15 @@ Mesh GltfDocument::scene_mesh() const {
       auto [it, fresh] = skin_joints.try_emplace(part_ref.skin);
       if (fresh) it->second = skin_matrices(m, part_ref.skin, skin_world, d.name);
       blended = blended_matrices(part, it->second, world, d.where(i));
+    }
+    const auto key = std::make_pair(part_ref.instance, d.primitive(i).attributes);
+    if (!d.replaced.count(i)) {
+      if (auto it = shared_base.find(key); it != shared_base.end()) {
+        add_faces(out, part, it->second, world, blended, d.primitives[i].material, m.materials.size(),
+                  uses_default);
+        continue;
+      }
+      shared_base[key] = base;
     }
     const auto matrix_of = [&](std::size_t v) -> const Mat4& { return blended.empty() ? world : blended[v]; };
     for (std::size_t v = 0; v < part.vertex_count(); ++v) {
@@ -986,9 +1009,7 @@ Mesh GltfDocument::scene_mesh() const {
           for (std::size_t r = 0; r < 3; ++r) a.values[v + r] = t[r] / len;
       }
     }
-    // The winding follows the sign of the part's matrix (of its first vertex, when skinned).
-    add_faces(out, part, base, part.vertex_count() > 0 ? matrix_of(0) : world, d.primitives[i].material,
-              m.materials.size(), uses_default);
+    add_faces(out, part, base, world, blended, d.primitives[i].material, m.materials.size(), uses_default);
   }
   if (uses_default) out.material_names.push_back("(default)");
   // Node matrices are unchecked numbers: a huge scale can push a coordinate to infinity.
