@@ -10,7 +10,10 @@
 // is chosen, the smallest at which the primitives' faces together meet the target; then each
 // primitive is simplified again with the face count its curve gives at that threshold. The final
 // runs are ordinary simplify() calls with a face target, so each output is what `qem simplify
-// --faces N` gives on that primitive alone. Deterministic: threads only share out primitives.
+// --faces N` gives on that primitive alone. The primitives of one mesh that meet (share a position:
+// one surface split by material) are one such unit, simplified as one mesh whose material
+// boundaries are seams and split back, so that the line where they meet is simplified without a
+// crack (docs/attributes.md, "glTF"). Deterministic: threads only share out the units.
 //
 //   qem::GltfDocument doc = qem::GltfDocument::load("in.glb");
 //   qem::SimplifyOptions opt;
