@@ -297,6 +297,37 @@ void compressed_gltf_seeds(const fs::path& out) {
           vertices + indices));
 }
 
+// A tetrahedron drawn twice by EXT_mesh_gpu_instancing (translations and quantized rotations).
+void instanced_gltf_seed(const fs::path& out) {
+  const qem::Mesh t = tetrahedron();
+  std::string bin;
+  for (double v : t.positions) {
+    const float f = float(v);
+    bin.append(reinterpret_cast<const char*>(&f), 4);
+  }
+  for (std::uint32_t v : t.indices) {
+    const auto i = std::uint16_t(v);
+    bin.append(reinterpret_cast<const char*>(&i), 2);
+  }
+  for (float f : {0.0f, 0.0f, 0.0f, 3.0f, 0.0f, 0.0f}) bin.append(reinterpret_cast<const char*>(&f), 4);
+  for (std::int16_t q : {0, 0, 0, 32767, 0, 23170, 0, 23170})
+    bin.append(reinterpret_cast<const char*>(&q), 2);
+  write_file(
+      out / "gltf" / "hand_instanced.glb",
+      glb(R"({"asset":{"version":"2.0"},"extensionsUsed":["EXT_mesh_gpu_instancing"],)"
+          R"("scenes":[{"nodes":[0]}],"nodes":[{"mesh":0,"extensions":{"EXT_mesh_gpu_instancing":)"
+          R"({"attributes":{"TRANSLATION":2,"ROTATION":3}}}}],)"
+          R"("meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],)"
+          R"("accessors":[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[-1,-1,-1],"max":[1,1,1]},)"
+          R"({"bufferView":1,"componentType":5123,"count":12,"type":"SCALAR"},)"
+          R"({"bufferView":2,"componentType":5126,"count":2,"type":"VEC3"},)"
+          R"({"bufferView":3,"componentType":5122,"normalized":true,"count":2,"type":"VEC4"}],)"
+          R"("bufferViews":[{"buffer":0,"byteLength":48},{"buffer":0,"byteOffset":48,"byteLength":24},)"
+          R"({"buffer":0,"byteOffset":72,"byteLength":24},{"buffer":0,"byteOffset":96,"byteLength":16}],)"
+          R"("buffers":[{"byteLength":112}]})",
+          bin));
+}
+
 void simplify_seeds(const fs::path& out) {
   // The simplify fuzzer decodes any bytes into a case, so varied random bytes are valid seeds.
   std::mt19937 rng(20240601);
@@ -347,7 +378,10 @@ void dictionaries(const fs::path& out) {
                      "ATTRIBUTES",
                      "TRIANGLES",
                      "OCTAHEDRAL",
-                     "EXPONENTIAL"});
+                     "EXPONENTIAL",
+                     "EXT_mesh_gpu_instancing",
+                     "TRANSLATION",
+                     "ROTATION"});
   dict("obj.dict", {"v ", "vt ", "vn ", "f ", "/", "//", "-1", "#", "\\\\\\x0a", "g ", "o ", "usemtl ",
                     "mtllib ", "1e308", "nan", "inf", "\\x0d\\x0a", "/1/", "/-1"});
   dict("ply.dict", {"ply\\x0a",
@@ -406,6 +440,7 @@ int main(int argc, char** argv) {
   serialised_seeds(out);
   handwritten_seeds(out);
   compressed_gltf_seeds(out);
+  instanced_gltf_seed(out);
   simplify_seeds(out);
   dictionaries(out);
   return 0;

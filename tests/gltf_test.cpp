@@ -217,6 +217,42 @@ TEST(Gltf, SkinnedPartMirroredByItsJointsKeepsEachFacesOutwardSide) {
             (std::vector<std::uint32_t>{0, 1, 2, 0, 2, 3}));
 }
 
+TEST(Gltf, GpuInstancedNodeIsMergedOncePerInstance) {
+  // EXT_mesh_gpu_instancing on the node (translation 10 in x): instance 0 at its place, instance 1
+  // moved 5 in y and scaled by 2 (after the node's matrix). The scene has the quad twice, and the
+  // primitive's world scale is the larger instance's.
+  Tiny t;
+  for (float v : {0.0f, 0.0f, 0.0f, 0.0f, 5.0f, 0.0f}) put(t.bin, v);  // 156: TRANSLATION
+  for (float v : {1.0f, 1.0f, 1.0f, 2.0f, 2.0f, 2.0f}) put(t.bin, v);  // 180: SCALE
+  t.doc["accessors"].push_back({{"bufferView", 5}, {"componentType", 5126}, {"count", 2}, {"type", "VEC3"}});
+  t.doc["accessors"].push_back({{"bufferView", 6}, {"componentType", 5126}, {"count", 2}, {"type", "VEC3"}});
+  t.doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", 156}, {"byteLength", 24}});
+  t.doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", 180}, {"byteLength", 24}});
+  t.doc["extensionsUsed"].push_back("EXT_mesh_gpu_instancing");
+  t.doc["nodes"][0]["extensions"]["EXT_mesh_gpu_instancing"]["attributes"] = {{"TRANSLATION", 5},
+                                                                              {"SCALE", 6}};
+  const qem::Mesh m = qem::parse_mesh(t.text(), qem::FileFormat::Auto, "instanced.gltf");
+  ASSERT_EQ(m.vertex_count(), 8u);
+  ASSERT_EQ(m.face_count(), 4u);
+  const std::vector<double> second = {10, 5, 0, 12, 5, 0, 12, 7, 0, 10, 7, 0};
+  for (std::size_t i = 0; i < second.size(); ++i) EXPECT_NEAR(m.positions[12 + i], second[i], 1e-12) << i;
+  EXPECT_EQ(m.positions[3], 11.0);
+  const qem::GltfDocument doc = qem::GltfDocument::parse(t.text(), "instanced.gltf");
+  EXPECT_DOUBLE_EQ(doc.primitives()[0].world_scale, 2.0);
+  // Written back as it was.
+  const json written = json::parse(doc.serialize(false));
+  EXPECT_EQ(written["nodes"][0]["extensions"]["EXT_mesh_gpu_instancing"]["attributes"]["SCALE"], 6);
+  // Counts that differ, or a SCALE that is not a VEC3: a clear error.
+  t.doc["accessors"][6]["count"] = 1;
+  EXPECT_NE(qem::test::gltf_error(t.text(), "instanced.gltf")
+                .find("EXT_mesh_gpu_instancing SCALE): 1 instances, not 2"),
+            std::string::npos)
+      << qem::test::gltf_error(t.text(), "instanced.gltf");
+  t.doc["accessors"][6]["count"] = 2, t.doc["accessors"][6]["type"] = "VEC2";
+  EXPECT_NE(qem::test::gltf_error(t.text(), "instanced.gltf").find("not a VEC3"), std::string::npos)
+      << qem::test::gltf_error(t.text(), "instanced.gltf");
+}
+
 TEST(Gltf, MirroringNodeKeepsTheOutwardWinding) {
   Tiny t;
   t.doc["nodes"][0]["scale"] = {-1, 1, 1};

@@ -43,7 +43,8 @@ struct GltfPrimitiveInfo {
   /// a length (the largest singular value of their world matrix; with a skin, of each joint's
   /// world matrix times its inverse bind matrix, the bind pose that glTF 2.0 §3.7.3 draws
   /// instead of the node's transform). 1 when no node places the mesh. A mesh that several nodes
-  /// instance takes the largest: its errors are measured where they are seen the biggest.
+  /// instance (or one node by EXT_mesh_gpu_instancing) takes the largest: its errors are measured
+  /// where they are seen the biggest.
   double world_scale = 1;
 };
 
@@ -100,8 +101,10 @@ class GltfDocument {
   /// face_materials = the glTF material of each face and material_names the glTF material names
   /// (a face with no material gets the extra name "(default)" after them), and the attributes
   /// that every merged primitive carries. What load_mesh returns for glTF. A skinned mesh is
-  /// placed in its bind pose (its joints' matrices blended by its weights); morph targets are not
-  /// applied (the rest shape) and their offsets are not merged.
+  /// placed in its bind pose (its joints' matrices blended by its weights; each face wound by the
+  /// sign of their mean's determinant); a node with EXT_mesh_gpu_instancing draws its mesh once
+  /// per instance (the node's matrix times the instance's); morph targets are not applied (the
+  /// rest shape) and their offsets are not merged.
   Mesh scene_mesh() const;
 
   /// What was read leniently or will be written differently (TANGENT dropped on a replaced

@@ -107,6 +107,19 @@ Mat4 multiply(const Mat4& a, const Mat4& b) {
   return r;
 }
 
+/// T * R * S of a translation, a unit quaternion (x, y, z, w) and a scale (glTF 2.0 §3.5.3).
+Mat4 trs_matrix(const double t[3], const double q[4], const double s[3]) {
+  Mat4 m = identity();
+  const double x = q[0], y = q[1], z = q[2], w = q[3];
+  const double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w),     2 * (x * z - y * w),
+                       2 * (x * y - z * w),     1 - 2 * (x * x + z * z), 2 * (y * z + x * w),
+                       2 * (x * z + y * w),     2 * (y * z - x * w),     1 - 2 * (x * x + y * y)};
+  for (int c = 0; c < 3; ++c)
+    for (int row = 0; row < 3; ++row) m[c * 4 + row] = r[c * 3 + row] * s[c];
+  std::copy(t, t + 3, m.begin() + 12);
+  return m;
+}
+
 /// A node's local matrix: `matrix`, or T * R * S (glTF 2.0 §3.5.3).
 Mat4 local_matrix(const tinygltf::Node& n) {
   if (n.matrix.size() == 16) {
@@ -114,18 +127,11 @@ Mat4 local_matrix(const tinygltf::Node& n) {
     std::copy(n.matrix.begin(), n.matrix.end(), m.begin());
     return m;
   }
-  Mat4 m = identity();
-  double s[3] = {1, 1, 1};
+  double t[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1}, s[3] = {1, 1, 1};
+  if (n.translation.size() == 3) std::copy(n.translation.begin(), n.translation.end(), t);
+  if (n.rotation.size() == 4) std::copy(n.rotation.begin(), n.rotation.end(), q);
   if (n.scale.size() == 3) std::copy(n.scale.begin(), n.scale.end(), s);
-  double x = 0, y = 0, z = 0, w = 1;
-  if (n.rotation.size() == 4) x = n.rotation[0], y = n.rotation[1], z = n.rotation[2], w = n.rotation[3];
-  const double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w),     2 * (x * z - y * w),
-                       2 * (x * y - z * w),     1 - 2 * (x * x + z * z), 2 * (y * z + x * w),
-                       2 * (x * z + y * w),     2 * (y * z - x * w),     1 - 2 * (x * x + y * y)};
-  for (int c = 0; c < 3; ++c)
-    for (int row = 0; row < 3; ++row) m[c * 4 + row] = r[c * 3 + row] * s[c];
-  if (n.translation.size() == 3) std::copy(n.translation.begin(), n.translation.end(), m.begin() + 12);
-  return m;
+  return trs_matrix(t, q, s);
 }
 
 /// The inverse transpose of the upper 3x3 (for normals), as a column-major 3x3.
@@ -186,6 +192,50 @@ std::vector<int> scene_roots(const tinygltf::Model& m) {
   for (std::size_t n = 0; n < m.nodes.size(); ++n)
     if (!child[n]) roots.push_back(static_cast<int>(n));
   return roots;
+}
+
+/// EXT_mesh_gpu_instancing: the matrices of node `n`'s instances, each T * R * S of its TRANSLATION,
+/// ROTATION (renormalised: it may be quantized) and SCALE (a missing one: the identity's), applied
+/// after the node's world matrix; empty when the node has none. Throws qem::Error naming `where`
+/// when the accessors are not VEC3 / VEC4 / VEC3 of one count.
+std::vector<Mat4> instance_matrices(const tinygltf::Model& m, const tinygltf::Node& n,
+                                    const std::string& where) {
+  const auto ext = n.extensions.find("EXT_mesh_gpu_instancing");
+  if (ext == n.extensions.end() || !ext->second.Has("attributes")) return {};
+  const tinygltf::Value& attributes = ext->second.Get("attributes");
+  constexpr const char* kNames[3] = {"TRANSLATION", "ROTATION", "SCALE"};
+  constexpr std::uint32_t kWidth[3] = {3, 4, 3};
+  std::vector<double> values[3];
+  std::size_t count = 0;
+  bool any = false;
+  for (int k = 0; k < 3; ++k) {
+    if (!attributes.Has(kNames[k])) continue;
+    const tinygltf::Value& index = attributes.Get(kNames[k]);
+    const std::string at = where + " (EXT_mesh_gpu_instancing " + kNames[k] + ")";
+    if (!index.IsNumber()) throw Error(at + ": not an accessor index");
+    std::uint32_t components = 0;
+    values[k] = read_accessor(m, index.GetNumberAsInt(), at, &components);
+    if (components != kWidth[k]) throw Error(at + ": not a VEC" + std::to_string(kWidth[k]));
+    const std::size_t n_k = values[k].size() / components;
+    if (any && n_k != count)
+      throw Error(at + ": " + std::to_string(n_k) + " instances, not " + std::to_string(count));
+    count = n_k, any = true;
+  }
+  std::vector<Mat4> out;
+  out.reserve(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    double t[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1}, s[3] = {1, 1, 1};
+    if (!values[0].empty()) std::copy_n(&values[0][3 * i], 3, t);
+    if (!values[1].empty()) {
+      std::copy_n(&values[1][4 * i], 4, q);
+      const double len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+      if (len > 0)
+        for (double& c : q) c /= len;
+    }
+    if (!values[2].empty()) std::copy_n(&values[2][3 * i], 3, s);
+    out.push_back(trs_matrix(t, q, s));
+  }
+  return out;
 }
 
 /// World matrices of the nodes the scene draws (depth first from scene_roots, the current path
@@ -404,7 +454,10 @@ void GltfDocument::Impl::measure_world_scales() {
     if (node.skin >= 0 && static_cast<std::size_t>(node.skin) < m.skins.size()) {
       for (const Mat4& joint : skin_matrices(m, node.skin, world, name)) scale = std::max(scale, largest_scale(joint));
     } else {
-      scale = largest_scale(world[n]);
+      const std::vector<Mat4> instances = instance_matrices(m, node, name + ": node " + std::to_string(n));
+      scale = instances.empty() ? largest_scale(world[n]) : 0;
+      for (const Mat4& instance : instances)
+        scale = std::max(scale, largest_scale(multiply(world[n], instance)));
     }
     double& s = mesh_scale[static_cast<std::size_t>(node.mesh)];
     if (std::isfinite(scale)) s = std::max(s, scale);
@@ -927,13 +980,24 @@ Mesh GltfDocument::scene_mesh() const {
     on_path[static_cast<std::size_t>(node)] = 1;
     const tinygltf::Node& n = m.nodes[static_cast<std::size_t>(node)];
     const Mat4 world = multiply(parent, local_matrix(n));
-    add_mesh(n.mesh, world, n.skin);
+    // EXT_mesh_gpu_instancing: the mesh once per instance (a skinned mesh follows its joints).
+    const std::vector<Mat4> instances =
+        n.mesh >= 0 && n.skin < 0 ? instance_matrices(m, n, d.name + ": node " + std::to_string(node))
+                                  : std::vector<Mat4>{};
+    if (instances.empty()) add_mesh(n.mesh, world, n.skin);
+    for (const Mat4& instance : instances) add_mesh(n.mesh, multiply(world, instance), n.skin);
     for (int c : n.children) self(self, c, world);
     on_path[static_cast<std::size_t>(node)] = 0;
   };
   for (int r : roots) visit(visit, r, identity());
   if (parts.empty() && m.nodes.empty())  // meshes that no node places: take them as they are
     for (std::size_t mesh = 0; mesh < m.meshes.size(); ++mesh) add_mesh(static_cast<int>(mesh), identity(), -1);
+  // Refused before anything is allocated: instancing (nodes, or EXT_mesh_gpu_instancing's counts)
+  // can multiply a small file into more vertices than a Mesh indexes.
+  std::size_t vertices = 0;
+  for (const Part& part : parts)
+    if ((vertices += d.primitives[part.primitive].vertex_count) > 0xffffffffu)
+      throw Error(d.name + ": the scene has more than 2^32 vertices");
 
   Mesh out;
   for (std::size_t mi = 0; mi < m.materials.size(); ++mi)
