@@ -64,13 +64,16 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
                       ", scalar=" + json_number(AttributeWeights{}.scalar) + "); seam=W weighs constraint planes along "
                       "the seams, as --boundary-weight for borders (default " + json_number(AttributeWeights{}.seam) + ")")
       ->delimiter(',');
-  sub->add_option("--seams", a.seams,
-                  "With attributes, seams (UV seams, normal creases, colour and material boundaries): strict "
-                  "(a collapse runs only along a seam, both sides together) or permissive (a collapse may "
-                  "cross a seam, not a material boundary, when its error, the attribute error included, "
-                  "allows: reaches targets that many small UV charts block, at some UV quality; "
-                  "docs/attributes.md)")
-      ->check(CLI::IsMember({"strict", "permissive"}))
+  sub->add_option(
+         "--seams", a.seams,
+         "With attributes, seams (UV seams, normal creases, colour and material boundaries): strict "
+         "(a collapse runs only along a seam, both sides together), creases (as strict along UV seams "
+         "and material boundaries, but a collapse may cross a normal crease or a colour boundary when "
+         "its error, the attribute error included, allows; gltfpack's -sp), or "
+         "permissive (UV seams may be crossed too: reaches targets that many small UV charts block, at "
+         "some UV quality, and can smear a texture or lose a feature drawn in a small chart); "
+         "docs/attributes.md")
+      ->check(CLI::IsMember({"strict", "permissive", "creases"}))
       ->capture_default_str();
   sub->add_option("--lock", a.lock,
                   "Vertices that never move and are never removed: seams (every position with more than "
@@ -199,7 +202,8 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
                   item + "'");
     *weight = w;
   }
-  opt.permissive_seams = a.seams == "permissive";
+  opt.permissive_seams = a.seams == "permissive" || a.seams == "creases";
+  opt.permissive_keeps_uv_seams = a.seams == "creases";
   opt.fit_attributes = a.attribute_fit;
   for (const std::string& what : a.lock) {
     if (what == "seams") opt.lock_seams = true;

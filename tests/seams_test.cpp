@@ -258,6 +258,37 @@ TEST(Seams, ProtectedVerticesKeepTheirSeamsInPermissiveMode) {
   EXPECT_THROW(simplify(in, o), Error);
 }
 
+TEST(Seams, CreasesModeCrossesCreasesButNoUvSeam) {
+  // permissive_keeps_uv_seams (`--seams creases`). A grid of UV charts has UV seams only: the mode
+  // makes exactly what strict makes. A flat-shaded cube without its UVs has normal creases only:
+  // exactly what permissive makes, which crosses them to go further than strict.
+  SimplifyOptions o;
+  o.target_faces = 40;
+  const Mesh charts = chart_grid(24, 3);
+  const SimplifyResult strict = simplify(charts, o);
+  EXPECT_GT(strict.mesh.face_count(), o.target_faces) << "the mesh does not test what it should";
+  o.permissive_seams = o.permissive_keeps_uv_seams = true;
+  const SimplifyResult kept = simplify(charts, o);
+  EXPECT_EQ(kept.mesh.indices, strict.mesh.indices);
+  EXPECT_EQ(kept.mesh.positions, strict.mesh.positions);
+  EXPECT_EQ(kept.mesh.attributes[0].values, strict.mesh.attributes[0].values);
+
+  Mesh cube = uv_cube(8, 0.1, true);
+  std::erase_if(cube.attributes, [](const VertexAttribute& a) { return a.kind == AttributeKind::TexCoord; });
+  ASSERT_EQ(cube.attributes.size(), 1u);
+  o.target_faces = 4;
+  o.permissive_seams = o.permissive_keeps_uv_seams = false;
+  const SimplifyResult cube_strict = simplify(cube, o);
+  o.permissive_seams = true;
+  const SimplifyResult cube_permissive = simplify(cube, o);
+  o.permissive_keeps_uv_seams = true;
+  const SimplifyResult creases = simplify(cube, o);
+  EXPECT_LT(cube_permissive.mesh.face_count(), cube_strict.mesh.face_count()) << "permissive crossed nothing";
+  EXPECT_EQ(creases.mesh.indices, cube_permissive.mesh.indices);
+  EXPECT_EQ(creases.mesh.positions, cube_permissive.mesh.positions);
+  EXPECT_EQ(open_edges_welded(creases.mesh), 0u) << "a crack opened";
+}
+
 TEST(Seams, AChartWhoseFacesAllDiedIsNoSeam) {
   // One-cell UV islands in a grid: once an island's two faces are gone, its corners hold one wedge
   // each and must be ordinary vertices again (removable, placed freely). A dead wedge left in its

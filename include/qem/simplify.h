@@ -183,6 +183,12 @@ struct SimplifyOptions {
   /// targets that strict seams block (many small UV charts), at the price of attribute quality
   /// along the seams it crosses (docs/attributes.md). Welded by position, no crack opens either way.
   bool permissive_seams = false;
+  /// With permissive_seams: UV seams are still never crossed (every vertex where texture
+  /// coordinates jump is protected, as by vertex_protect); only normal creases and colour
+  /// boundaries are, when the error allows (gltfpack's `-sp`). Crossing a UV seam joins two charts'
+  /// coordinates on the faces round it, which can smear the texture or lose a small feature drawn
+  /// in its own chart (docs/attributes.md, "Permissive"); crossing a crease smooths its shading.
+  bool permissive_keeps_uv_seams = false;
   InversionPolicy inversion = InversionPolicy::Forbid;
   /// A face that turns by more than this (degrees) counts as an inversion; must be < 90.
   double max_normal_turn_degrees = 75;

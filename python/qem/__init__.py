@@ -229,7 +229,8 @@ def _options(*, target_faces, target_ratio, target_vertices, max_error, max_erro
              max_distance=None, max_distance_relative=None,
              threshold_relative, weighting, placement, boundary_weight, lock_border, inversion, max_turn,
              allow_non_manifold, scheme, refit, threads, record, keep_components=True, prune=None,
-             prune_relative=None, exact_border=True, forget=_FORGET, forget_attributes=False, two_sided="rims"):
+             prune_relative=None, exact_border=True, forget=_FORGET, forget_attributes=False, two_sided="rims",
+             seams="strict"):
     o = _qem.SimplifyOptions()
 
     def count(name, value):
@@ -313,6 +314,10 @@ def _options(*, target_faces, target_ratio, target_vertices, max_error, max_erro
         raise ValueError(f"forget: expected a factor in [0, 1) (0 = never), got {forget!r}")
     o.forget = float(forget)
     o.forget_attributes = bool(forget_attributes)
+    if seams not in ("strict", "creases", "permissive"):
+        raise ValueError(f"seams: expected one of strict, creases, permissive, got {seams!r}")
+    o.permissive_seams = seams != "strict"
+    o.permissive_keeps_uv_seams = seams == "creases"
 
     if refit in (None, False):
         refit = "none"
@@ -355,7 +360,7 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
              prune_relative: Optional[float] = None, exact_border: bool = True, attributes: Optional[dict] = None,
              attribute_weights: Optional[dict] = None, fit_attributes: bool = False, vertex_lock=None,
              return_mapping: bool = False, far_repair: Optional[bool] = None, two_sided: str = "rims",
-             record: bool = False, progress: Optional[Callable[[float], Optional[bool]]] = None) -> SimplifyResult:
+             seams: str = "strict", record: bool = False, progress: Optional[Callable[[float], Optional[bool]]] = None) -> SimplifyResult:
     """Simplifies a triangle mesh by quadric-error pair contraction (Garland & Heckbert 1997).
 
     vertices: (n, 3) array, any float dtype; faces: (m, 3) array of vertex indices, any integer dtype.
@@ -419,6 +424,11 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
         (NORMAL, TEXCOORD_0, COLOR_0, ...) when not given. Returned in result.attributes by the
         simplified mesh: one vertex per wedge (a position may carry several attribute sets, split at
         seams), seams kept closed and in place, normals unit, colours in [0, 1].
+      seams: "strict" (the default): a collapse runs along a seam only, both sides together;
+        "creases": so along UV seams and material boundaries, but a normal crease or a colour
+        boundary may be crossed where the error allows (lower E on hard-surface assets);
+        "permissive": UV seams too, at the risk of smearing a texture (docs/attributes.md,
+        "Permissive seams").
       attribute_weights: {"normal": w, "uv": w, "color": w, "scalar": w}: what a unit of each
         attribute costs against a unit of distance (1/w costs one bounding-box diagonal); the
         library's defaults otherwise.
@@ -451,7 +461,8 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
                        boundary_weight=boundary_weight, lock_border=lock_border, inversion=inversion,
                        max_turn=max_turn, allow_non_manifold=allow_non_manifold, scheme=scheme, refit=refit,
                        forget=forget, forget_attributes=forget_attributes, threads=threads, record=record, keep_components=keep_components, prune=prune,
-                       prune_relative=prune_relative, exact_border=exact_border, two_sided=two_sided)
+                       prune_relative=prune_relative, exact_border=exact_border, two_sided=two_sided,
+                       seams=seams)
     # The light default follows the command line here too: not on a mesh with texture coordinates
     # or normals, where it lowers E but raises their errors a little (docs/attributes.md, "Seams,
     # locks and the refit"); colours alone keep it; "full" or (rounds, points) still refits them,

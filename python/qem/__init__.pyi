@@ -163,6 +163,8 @@ def simplify(
     vertex_lock: Optional[npt.ArrayLike] = ...,
     return_mapping: bool = ...,
     far_repair: Optional[bool] = ...,
+    two_sided: Literal["rims", "all", "none"] = ...,
+    seams: Literal["strict", "creases", "permissive"] = ...,
     record: bool = ...,
     progress: Optional[Callable[[float], Optional[bool]]] = ...,
 ) -> SimplifyResult: ...

@@ -283,3 +283,21 @@ def test_two_sided():
     assert qem.option_names("two_sided") == ["rims", "all", "none"]
     with pytest.raises(ValueError, match="two_sided"):
         qem.simplify(v, f, target_faces=100, two_sided=True)
+
+
+def test_seams_mode_creases_crosses_them(small_torus):
+    # Every edge a normal crease (each face its own vertices and its normal): strict seams (the
+    # default) keep every crease and stop far above the target; "creases" crosses them where the
+    # error allows, and no crack opens either way.
+    v, f = small_torus
+    corners = np.asarray(v)[np.asarray(f)].reshape(-1, 3)
+    faces = np.arange(len(corners), dtype=np.int32).reshape(-1, 3)
+    n = np.cross(corners[1::3] - corners[0::3], corners[2::3] - corners[0::3])
+    normals = {"NORMAL": np.repeat(n / np.linalg.norm(n, axis=1)[:, None], 3, axis=0)}
+    strict = qem.simplify(corners, faces, target_faces=300, attributes=normals)
+    creases = qem.simplify(corners, faces, target_faces=300, attributes=normals, seams="creases")
+    assert len(creases.faces) < len(strict.faces)
+    assert _open_edges(creases.vertices, creases.faces) == 0
+    assert _open_edges(strict.vertices, strict.faces) == 0
+    with pytest.raises(ValueError, match="seams"):
+        qem.simplify(corners, faces, target_faces=300, seams="loose")

@@ -253,6 +253,27 @@ std::uint32_t Wedges::final_wedge_of_input(std::uint32_t v) const {
   return w;
 }
 
+namespace {
+
+// SimplifyOptions::permissive_keeps_uv_seams: every vertex whose wedges' texture coordinates
+// differ is protected, so that only creases and colour boundaries are crossed.
+void protect_uv_seams(Wedges& wg, std::uint32_t vertices) {
+  if (wg.protect.empty()) wg.protect.assign(vertices, 0);
+  for (std::uint32_t v = 0; v < vertices; ++v) {
+    const std::uint32_t a = wg.first[v];
+    if (a == kNoVertex || wg.protect[v]) continue;
+    for (std::uint32_t b = wg.next[a]; b != a && !wg.protect[v]; b = wg.next[b])
+      for (const Channel& ch : wg.channels)
+        if (ch.kind == AttributeKind::TexCoord)
+          for (std::uint32_t c = 0; c < ch.components; ++c)
+            if (wg.value[std::size_t(a) * wg.width + ch.first + c] !=
+                wg.value[std::size_t(b) * wg.width + ch.first + c])
+              wg.protect[v] = 1;
+  }
+}
+
+}  // namespace
+
 Wedges build_wedges(MeshView in, const std::vector<std::uint32_t>& internal, WorkingMesh& m,
                     const SimplifyOptions& options) {
   Wedges wg;
@@ -332,6 +353,7 @@ Wedges build_wedges(MeshView in, const std::vector<std::uint32_t>& internal, Wor
     for (std::uint32_t w = 0; w < wg.count(); ++w)
       if (options.vertex_protect[wg.source[w]]) wg.protect[wg.vertex[w]] = 1;
   }
+  if (wg.permissive && options.permissive_keeps_uv_seams) protect_uv_seams(wg, m.vertex_count());
   wg.corners.assign(wg.count(), 0);
   for (std::uint32_t w : m.corner_wedge) ++wg.corners[w];
   wg.renew_quadrics(m);
