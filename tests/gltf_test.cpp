@@ -251,6 +251,13 @@ TEST(Gltf, GpuInstancedNodeIsMergedOncePerInstance) {
   t.doc["accessors"][6]["count"] = 2, t.doc["accessors"][6]["type"] = "VEC2";
   EXPECT_NE(qem::test::gltf_error(t.text(), "instanced.gltf").find("not a VEC3"), std::string::npos)
       << qem::test::gltf_error(t.text(), "instanced.gltf");
+  // An index that names no accessor (one far beyond int's range included).
+  for (double bad : {7.0, 1e20, -1.0, 0.5}) {
+    t.doc["nodes"][0]["extensions"]["EXT_mesh_gpu_instancing"]["attributes"]["SCALE"] = bad;
+    EXPECT_NE(qem::test::gltf_error(t.text(), "instanced.gltf").find("not the index of an accessor"),
+              std::string::npos)
+        << bad << ": " << qem::test::gltf_error(t.text(), "instanced.gltf");
+  }
 }
 
 TEST(Gltf, MirroringNodeKeepsTheOutwardWinding) {

@@ -120,8 +120,7 @@ py::dict mesh_to_python(Mesh&& mesh) {
 }
 
 void bind_simplify(py::module_& m) {
-  py::class_<SimplifyOptions>(m, "SimplifyOptions",
-                              "qem::SimplifyOptions, field for field (see qem/simplify.h)")
+  py::class_<SimplifyOptions>(m, "SimplifyOptions", "qem::SimplifyOptions, field for field (see qem/simplify.h)")
       .def(py::init<>())
       .def_readwrite("target_faces", &SimplifyOptions::target_faces)
       .def_readwrite("target_ratio", &SimplifyOptions::target_ratio)
@@ -132,24 +131,16 @@ void bind_simplify(py::module_& m) {
       .def_readwrite("prune_size_is_relative", &SimplifyOptions::prune_size_is_relative)
       .def_readwrite("max_error", &SimplifyOptions::max_error)
       .def_readwrite("max_error_is_relative", &SimplifyOptions::max_error_is_relative)
-      .def_property(
-          "weighting", [](const SimplifyOptions& o) { return to_string(o.weighting); },
-          [](SimplifyOptions& o, const std::string& s) {
-            o.weighting = enum_named<Weighting>("weighting", s);
-          })
-      .def_property(
-          "placement", [](const SimplifyOptions& o) { return to_string(o.placement); },
-          [](SimplifyOptions& o, const std::string& s) {
-            o.placement = enum_named<Placement>("placement", s);
-          })
-      .def_property(
-          "scheme", [](const SimplifyOptions& o) { return to_string(o.scheme); },
-          [](SimplifyOptions& o, const std::string& s) { o.scheme = enum_named<Scheme>("scheme", s); })
-      .def_property(
-          "inversion", [](const SimplifyOptions& o) { return to_string(o.inversion); },
-          [](SimplifyOptions& o, const std::string& s) {
-            o.inversion = enum_named<InversionPolicy>("inversion", s);
-          })
+      .def_property("weighting", [](const SimplifyOptions& o) { return to_string(o.weighting); },
+                    [](SimplifyOptions& o, const std::string& s) { o.weighting = enum_named<Weighting>("weighting", s); })
+      .def_property("placement", [](const SimplifyOptions& o) { return to_string(o.placement); },
+                    [](SimplifyOptions& o, const std::string& s) { o.placement = enum_named<Placement>("placement", s); })
+      .def_property("scheme", [](const SimplifyOptions& o) { return to_string(o.scheme); },
+                    [](SimplifyOptions& o, const std::string& s) { o.scheme = enum_named<Scheme>("scheme", s); })
+      .def_property("inversion", [](const SimplifyOptions& o) { return to_string(o.inversion); },
+                    [](SimplifyOptions& o, const std::string& s) {
+                      o.inversion = enum_named<InversionPolicy>("inversion", s);
+                    })
       .def_readwrite("threshold", &SimplifyOptions::threshold)
       .def_readwrite("threshold_is_relative", &SimplifyOptions::threshold_is_relative)
       .def_readwrite("boundary_weight", &SimplifyOptions::boundary_weight)
@@ -167,11 +158,8 @@ void bind_simplify(py::module_& m) {
       .def_readwrite("refit_points_per_vertex", &SimplifyOptions::refit_points_per_vertex)
       .def_readwrite("refit_by_reduction", &SimplifyOptions::refit_by_reduction)
       .def_readwrite("far_repair", &SimplifyOptions::far_repair)
-      .def_property(
-          "two_sided", [](const SimplifyOptions& o) { return to_string(o.two_sided); },
-          [](SimplifyOptions& o, const std::string& s) {
-            o.two_sided = enum_named<TwoSided>("two_sided", s);
-          })
+      .def_property("two_sided", [](const SimplifyOptions& o) { return to_string(o.two_sided); },
+                    [](SimplifyOptions& o, const std::string& s) { o.two_sided = enum_named<TwoSided>("two_sided", s); })
       .def_readwrite("fit_attributes", &SimplifyOptions::fit_attributes)
       .def_readwrite("permissive_seams", &SimplifyOptions::permissive_seams)
       .def_readwrite("permissive_keeps_uv_seams", &SimplifyOptions::permissive_keeps_uv_seams)
@@ -191,18 +179,14 @@ void bind_simplify(py::module_& m) {
                           : kind == "color" ? &o.attribute_weights.color
                           : kind == "scalar" ? &o.attribute_weights.scalar
                                              : nullptr;
-              if (!w)
-                throw py::value_error("attribute_weights: unknown kind '" + kind +
-                                      "' (normal, uv, color, scalar)");
+              if (!w) throw py::value_error("attribute_weights: unknown kind '" + kind + "' (normal, uv, color, scalar)");
               const double x = value.cast<double>();
               if (!(x >= 0) || !std::isfinite(x))
                 throw py::value_error("attribute_weights['" + kind + "']: expected a finite weight >= 0");
               *w = x;
             }
           })
-      .def(
-          "check", [](const SimplifyOptions& o) { check_options(o); },
-          "Raises qem.Error for an option out of range");
+      .def("check", [](const SimplifyOptions& o) { check_options(o); }, "Raises qem.Error for an option out of range");
 
   m.def("option_names", [](const std::string& option) -> std::vector<std::string> {
     if (option == "weighting") return option_names<Weighting>();

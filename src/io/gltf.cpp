@@ -212,9 +212,12 @@ std::vector<Mat4> instance_matrices(const tinygltf::Model& m, const tinygltf::No
     if (!attributes.Has(kNames[k])) continue;
     const tinygltf::Value& index = attributes.Get(kNames[k]);
     const std::string at = where + " (EXT_mesh_gpu_instancing " + kNames[k] + ")";
-    if (!index.IsNumber()) throw Error(at + ": not an accessor index");
+    // (Range-checked as a double first: converting one beyond int's range is undefined.)
+    const double accessor = index.IsNumber() ? index.GetNumberAsDouble() : -1;
+    if (!(accessor >= 0 && accessor < double(m.accessors.size()) && accessor == std::floor(accessor)))
+      throw Error(at + ": not the index of an accessor of the file");
     std::uint32_t components = 0;
-    values[k] = read_accessor(m, index.GetNumberAsInt(), at, &components);
+    values[k] = read_accessor(m, int(accessor), at, &components);
     if (components != kWidth[k]) throw Error(at + ": not a VEC" + std::to_string(kWidth[k]));
     const std::size_t n_k = values[k].size() / components;
     if (any && n_k != count)
