@@ -159,7 +159,8 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
   for (std::size_t j = 0; j < jobs.size(); ++j) members[root(j)].push_back(j);
   for (std::size_t j = 0; j < jobs.size(); ++j) {
     if (members[j].empty()) continue;
-    if (members[j].size() > 1 && !gltf_options.per_primitive) {
+    // (A caller's vertex_protect is per primitive as read: it keeps them apart.)
+    if (members[j].size() > 1 && !gltf_options.per_primitive && options.vertex_protect.empty()) {
       std::vector<Mesh> parts;
       for (std::size_t k : members[j]) parts.push_back(meshes[k]);
       if (std::optional<Mesh> merged = merge_parts(parts)) {
