@@ -31,6 +31,7 @@ __all__ = [
     "Measure",
     "Level",
     "simplify",
+    "simplify_gltf",
     "load",
     "save",
     "measure",
@@ -488,6 +489,55 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
         result.vertex_source = result.face_source = result.output_vertex_of_input = None
     result.record = Record(d["record"]) if d["record"] is not None else None
     return result
+
+
+def simplify_gltf(input, output, *, target_faces: Optional[int] = None, target_ratio: Optional[float] = None,
+                  target_vertices: Optional[int] = None, max_error: Optional[float] = None,
+                  max_error_relative: Optional[float] = None, max_distance: Optional[float] = None,
+                  max_distance_relative: Optional[float] = None, per_mesh: bool = False, seams: str = "strict",
+                  attribute_weights: Optional[dict] = None, refit="none", far_repair: Optional[bool] = None,
+                  threads: int = 0, **options) -> dict:
+    """Simplifies a glTF document (.glb, or .gltf with its buffers) into another, as `qem simplify
+    in.glb out.glb` does: every triangle primitive with its attributes (normals, texture coordinates,
+    colours, skin weights, morph targets), materials, textures, nodes, skins, animations and
+    extensions passed through. The target is the scene's, every primitive stopping at about the same
+    error in world units (max_error and max_distance in world units too; *_relative of the scene's
+    diagonal); per_mesh=True applies it to each primitive. Primitives of one mesh that meet are
+    simplified together, so no crack opens between them. No refit by default (a document's
+    primitives carry normals or texture coordinates, which the light refit would raise), as on the
+    command line; refit="full" or (rounds, points) asks for one. The other keywords are
+    qem.simplify's (weighting, placement, forget, max_turn...). The output is written to a temporary
+    file and renamed: a failed run leaves none.
+
+    Returns a dict: faces_in, faces_out, target_faces, world_threshold, max_world_error,
+    simplified / unchanged / kept (counts of primitives), primitives (per primitive: mesh,
+    primitive, status, faces_in, faces_out, world_scale, world_error, stop_reason, note) and notes
+    (what was dropped or kept, about the input).
+    Raises ValueError naming a bad argument, qem.Error for a file or options the library refuses.
+    """
+    unknown = set(options) - set(_GLTF_PASSED)
+    if unknown:
+        raise ValueError(f"simplify_gltf: unknown option(s) {', '.join(sorted(unknown))}")
+    defaults = dict(threshold=0.0, threshold_relative=None, weighting="area", placement="optimal",
+                    boundary_weight=1.0, lock_border=False, inversion="forbid", max_turn=75.0,
+                    allow_non_manifold=False, scheme="passes", forget=_FORGET, forget_attributes=False,
+                    keep_components=True, prune=None, prune_relative=None, exact_border=True, two_sided="rims")
+    defaults.update(options)
+    if attribute_weights is not None and not isinstance(attribute_weights, dict):
+        raise ValueError("attribute_weights: expected a dict {kind: weight} with kinds normal, uv, color, scalar")
+    o = _options(target_faces=target_faces, target_ratio=target_ratio, target_vertices=target_vertices,
+                 max_error=max_error, max_error_relative=max_error_relative, max_distance=max_distance,
+                 max_distance_relative=max_distance_relative, refit=refit, threads=threads, record=False,
+                 seams=seams, **defaults)
+    o.far_repair = o.refit_rounds > 0 if far_repair is None else bool(far_repair)
+    if attribute_weights is not None:
+        o.attribute_weights = attribute_weights
+    return _qem.simplify_gltf(str(input), str(output), o, bool(per_mesh), threads)
+
+
+_GLTF_PASSED = ("threshold", "threshold_relative", "weighting", "placement", "boundary_weight", "lock_border",
+                "inversion", "max_turn", "allow_non_manifold", "scheme", "forget", "forget_attributes",
+                "keep_components", "prune", "prune_relative", "exact_border", "two_sided")
 
 
 def load(path, *, weld: str = "auto") -> Mesh:

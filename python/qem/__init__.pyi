@@ -168,6 +168,25 @@ def simplify(
     record: bool = ...,
     progress: Optional[Callable[[float], Optional[bool]]] = ...,
 ) -> SimplifyResult: ...
+def simplify_gltf(
+    input: _Path,
+    output: _Path,
+    *,
+    target_faces: Optional[int] = ...,
+    target_ratio: Optional[float] = ...,
+    target_vertices: Optional[int] = ...,
+    max_error: Optional[float] = ...,
+    max_error_relative: Optional[float] = ...,
+    max_distance: Optional[float] = ...,
+    max_distance_relative: Optional[float] = ...,
+    per_mesh: bool = ...,
+    seams: Literal["strict", "creases", "permissive"] = ...,
+    attribute_weights: Optional[Mapping[str, float]] = ...,
+    refit: _Refit = ...,
+    far_repair: Optional[bool] = ...,
+    threads: int = ...,
+    **options: Any,
+) -> dict: ...
 def load(path: _Path, *, weld: Literal["auto", "on", "off"] = ...) -> _LoadedMesh: ...
 def save(path: _Path, mesh: _MeshLike, *, binary: bool = ..., double: Optional[bool] = ...) -> None: ...
 def measure(original: _MeshLike, approx: _MeshLike, *, samples: int = ..., seed: int = ..., threads: int = ...) -> Measure: ...

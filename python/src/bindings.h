@@ -16,6 +16,7 @@ namespace py = pybind11;
 
 void bind_simplify(py::module_& m);  // SimplifyOptions, simplify, Record
 void bind_tools(py::module_& m);     // load, save, measure, cluster, info, lod
+void bind_gltf(py::module_& m);      // simplify_gltf
 
 /// The value of an option enum called `name`, or ValueError listing the choices.
 template <class Enum>

@@ -14,4 +14,5 @@ PYBIND11_MODULE(_qem, m) {
   m.attr("RECOMMENDED_FORGET") = qem::kRecommendedForget;  // the defaults of qem/__init__.py
   qem::python::bind_simplify(m);
   qem::python::bind_tools(m);
+  qem::python::bind_gltf(m);
 }

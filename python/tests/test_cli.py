@@ -111,3 +111,26 @@ def test_record_file_replays_with_cli(cli, shared_data, tmp_path):
     run(cli, "replay", tmp_path / "r.qemr", "--faces", "3000", tmp_path / "cli.ply")
     qem.save(tmp_path / "py.ply", qem.Record.load(tmp_path / "r.qemr").replay(3000))
     assert (tmp_path / "py.ply").read_bytes() == (tmp_path / "cli.ply").read_bytes()
+
+
+@pytest.mark.parametrize("kwargs, args", [
+    (dict(target_ratio=0.1), ["--ratio", "0.1"]),
+    (dict(target_ratio=0.25, per_mesh=True, seams="creases"), ["--ratio", "0.25", "--per-mesh", "--seams", "creases"]),
+])
+def test_simplify_gltf_same_bytes_as_cli(cli, shared_data, tmp_path, kwargs, args):
+    # The document path: the same output bytes and the same per-primitive report as `qem simplify
+    # in.glb out.glb`; a bad option or file is refused and writes nothing.
+    src = shared_data / "CesiumMilkTruck.glb"
+    out_cli, out_py = tmp_path / "cli.glb", tmp_path / "py.glb"
+    report_cli = json.loads(run(cli, "simplify", src, out_cli, "--quiet", "--json", *args))
+    r = qem.simplify_gltf(src, out_py, **kwargs)
+    assert out_py.read_bytes() == out_cli.read_bytes()
+    assert r["faces_out"] == report_cli["out_faces"] and r["faces_in"] == report_cli["in_faces"]
+    assert [p["faces_out"] for p in r["primitives"]] == [e["out_faces"] for e in report_cli["each"]]
+    assert [p["status"] for p in r["primitives"]] == [e["status"] for e in report_cli["each"]]
+    assert r["simplified"] >= 3
+    with pytest.raises(ValueError, match="unknown option"):
+        qem.simplify_gltf(src, tmp_path / "x.glb", target_ratio=0.5, ratio=0.5)
+    with pytest.raises(qem.Error):
+        qem.simplify_gltf(tmp_path / "missing.glb", tmp_path / "y.glb", target_ratio=0.5)
+    assert not (tmp_path / "x.glb").exists() and not (tmp_path / "y.glb").exists()
