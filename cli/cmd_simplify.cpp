@@ -93,9 +93,7 @@ int run_simplify_gltf(const SimplifyArgs& a, const SimplifyOptions& opt) {
     std::string each;
     for (const GltfPrimitiveOutcome& o : r.primitives) {
       const GltfPrimitiveInfo& p = doc.primitives()[o.primitive];
-      const char* status = o.status == GltfPrimitiveOutcome::Status::Simplified  ? "simplified"
-                           : o.status == GltfPrimitiveOutcome::Status::Unchanged ? "unchanged"
-                                                                                 : "kept";
+      const char* status = to_string(o.status);
       each += std::string(each.empty() ? "" : ",") + "{\"mesh\":" + std::to_string(p.mesh) +
               ",\"primitive\":" + std::to_string(p.primitive) + ",\"status\":\"" + status +
               "\",\"in_faces\":" + std::to_string(o.faces_in) +

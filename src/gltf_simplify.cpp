@@ -94,6 +94,18 @@ double local_error(double world_error, double world_scale) {
 
 }  // namespace
 
+const char* to_string(GltfPrimitiveOutcome::Status status) {
+  switch (status) {
+    case GltfPrimitiveOutcome::Status::Simplified:
+      return "simplified";
+    case GltfPrimitiveOutcome::Status::Unchanged:
+      return "unchanged";
+    case GltfPrimitiveOutcome::Status::Kept:
+      break;
+  }
+  return "kept";
+}
+
 GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& options,
                                      const GltfSimplifyOptions& gltf_options) {
   check_options(options);

@@ -64,6 +64,9 @@ struct GltfPrimitiveOutcome {
   std::string note;  ///< why it was kept, or "" (the document's notes() say it too)
 };
 
+/// "simplified", "unchanged" or "kept": the status as the command line's --json and Python report it.
+const char* to_string(GltfPrimitiveOutcome::Status status);
+
 struct GltfSimplifyReport {
   std::vector<GltfPrimitiveOutcome> primitives;  ///< one per document primitive, in order
   std::size_t simplified = 0, unchanged = 0, kept = 0;

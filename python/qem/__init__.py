@@ -17,6 +17,7 @@ library refuses raises qem.Error, a subclass of ValueError.
 
 from __future__ import annotations
 
+import inspect as _inspect
 import math as _math
 import re as _re
 from typing import Callable, Optional
@@ -518,11 +519,7 @@ def simplify_gltf(input, output, *, target_faces: Optional[int] = None, target_r
     unknown = set(options) - set(_GLTF_PASSED)
     if unknown:
         raise ValueError(f"simplify_gltf: unknown option(s) {', '.join(sorted(unknown))}")
-    defaults = dict(threshold=0.0, threshold_relative=None, weighting="area", placement="optimal",
-                    boundary_weight=1.0, lock_border=False, inversion="forbid", max_turn=75.0,
-                    allow_non_manifold=False, scheme="passes", forget=_FORGET, forget_attributes=False,
-                    keep_components=True, prune=None, prune_relative=None, exact_border=True, two_sided="rims")
-    defaults.update(options)
+    defaults = {**_GLTF_PASSED, **options}
     if attribute_weights is not None and not isinstance(attribute_weights, dict):
         raise ValueError("attribute_weights: expected a dict {kind: weight} with kinds normal, uv, color, scalar")
     o = _options(target_faces=target_faces, target_ratio=target_ratio, target_vertices=target_vertices,
@@ -535,9 +532,12 @@ def simplify_gltf(input, output, *, target_faces: Optional[int] = None, target_r
     return _qem.simplify_gltf(str(input), str(output), o, bool(per_mesh), threads)
 
 
-_GLTF_PASSED = ("threshold", "threshold_relative", "weighting", "placement", "boundary_weight", "lock_border",
-                "inversion", "max_turn", "allow_non_manifold", "scheme", "forget", "forget_attributes",
-                "keep_components", "prune", "prune_relative", "exact_border", "two_sided")
+# simplify's keywords that simplify_gltf passes on, with simplify's defaults (one place for them).
+_GLTF_PASSED = {name: p.default for name, p in _inspect.signature(simplify).parameters.items()
+                if name in ("threshold", "threshold_relative", "weighting", "placement", "boundary_weight",
+                            "lock_border", "inversion", "max_turn", "allow_non_manifold", "scheme", "forget",
+                            "forget_attributes", "keep_components", "prune", "prune_relative", "exact_border",
+                            "two_sided")}
 
 
 def load(path, *, weld: str = "auto") -> Mesh:

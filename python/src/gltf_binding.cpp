@@ -33,9 +33,7 @@ py::dict simplify_gltf(const std::string& input, const std::string& output, cons
     py::dict d;
     d["mesh"] = p.mesh;
     d["primitive"] = p.primitive;
-    d["status"] = o.status == GltfPrimitiveOutcome::Status::Simplified  ? "simplified"
-                  : o.status == GltfPrimitiveOutcome::Status::Unchanged ? "unchanged"
-                                                                        : "kept";
+    d["status"] = to_string(o.status);
     d["faces_in"] = o.faces_in;
     d["faces_out"] = o.faces_out;
     d["world_scale"] = o.world_scale;

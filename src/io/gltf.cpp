@@ -34,6 +34,7 @@ namespace qem {
 namespace {
 
 using io::gltf::append_accessor;
+using io::gltf::is_glb;
 using io::gltf::read_accessor;
 
 // Extensions that change how geometry is stored and that qem does not decode (Draco and
@@ -364,6 +365,9 @@ struct GltfDocument::Impl {
   std::map<std::size_t, Mesh> replaced;
   std::vector<std::string> notes;
   std::set<std::size_t> compressed_views;  // the Draco bitstreams decoded at load: not written
+  // Per node, its EXT_mesh_gpu_instancing instances' matrices (instance_matrices; empty without
+  // them, and for a skinned node, which its joints place), read once at load.
+  std::vector<std::vector<Mat4>> node_instances;
 
   std::string where(std::size_t i) const {
     const GltfPrimitiveInfo& p = primitives[i];
@@ -373,7 +377,7 @@ struct GltfDocument::Impl {
     return model.meshes[primitives[i].mesh].primitives[primitives[i].primitive];
   }
   void check_and_list();
-  void measure_world_scales();
+  void measure_world_scales();  // and node_instances
   Mesh read(std::size_t i) const;
   tinygltf::Model rebuilt() const;
 };
@@ -449,6 +453,7 @@ void GltfDocument::Impl::measure_world_scales() {
   const tinygltf::Model& m = model;
   std::vector<char> reached;
   const std::vector<Mat4> world = node_world_matrices(m, reached);
+  node_instances.assign(m.nodes.size(), {});
   std::vector<double> mesh_scale(m.meshes.size(), 0);
   for (std::size_t n = 0; n < m.nodes.size(); ++n) {
     const tinygltf::Node& node = m.nodes[n];
@@ -457,9 +462,9 @@ void GltfDocument::Impl::measure_world_scales() {
     if (node.skin >= 0 && static_cast<std::size_t>(node.skin) < m.skins.size()) {
       for (const Mat4& joint : skin_matrices(m, node.skin, world, name)) scale = std::max(scale, largest_scale(joint));
     } else {
-      const std::vector<Mat4> instances = instance_matrices(m, node, name + ": node " + std::to_string(n));
-      scale = instances.empty() ? largest_scale(world[n]) : 0;
-      for (const Mat4& instance : instances)
+      node_instances[n] = instance_matrices(m, node, name + ": node " + std::to_string(n));
+      scale = node_instances[n].empty() ? largest_scale(world[n]) : 0;
+      for (const Mat4& instance : node_instances[n])
         scale = std::max(scale, largest_scale(multiply(world[n], instance)));
     }
     double& s = mesh_scale[static_cast<std::size_t>(node.mesh)];
@@ -545,8 +550,6 @@ tinygltf::TinyGLTF make_loader(bool files) {
     loader.SetFsCallbacks(tinygltf::FsCallbacks{no_file_exists, same_path, no_file, no_write, nullptr});
   return loader;
 }
-
-bool is_glb(std::string_view bytes) { return bytes.size() >= 4 && bytes.substr(0, 4) == "glTF"; }
 
 /// tinygltf's messages, one line each, as one line.
 std::string one_line(std::string e) {
@@ -984,9 +987,7 @@ Mesh GltfDocument::scene_mesh() const {
     const tinygltf::Node& n = m.nodes[static_cast<std::size_t>(node)];
     const Mat4 world = multiply(parent, local_matrix(n));
     // EXT_mesh_gpu_instancing: the mesh once per instance (a skinned mesh follows its joints).
-    const std::vector<Mat4> instances =
-        n.mesh >= 0 && n.skin < 0 ? instance_matrices(m, n, d.name + ": node " + std::to_string(node))
-                                  : std::vector<Mat4>{};
+    const std::vector<Mat4>& instances = d.node_instances[static_cast<std::size_t>(node)];
     if (instances.empty()) add_mesh(n.mesh, world, n.skin);
     for (const Mat4& instance : instances) add_mesh(n.mesh, multiply(world, instance), n.skin);
     for (int c : n.children) self(self, c, world);
@@ -1028,9 +1029,7 @@ Mesh GltfDocument::scene_mesh() const {
         return b.name == a.name && b.components == a.components;
       });
     });
-    if (out.positions.size() / 3 + part.vertex_count() > 0xffffffffu)
-      throw Error(d.name + ": the scene has more than 2^32 vertices");
-    const auto base = static_cast<std::uint32_t>(out.vertex_count());
+    const auto base = static_cast<std::uint32_t>(out.vertex_count());  // below 2^32: counted above
     // A skinned part is placed in its bind pose, each vertex by its joints' blended matrix (the
     // node's matrix when it has no joints and weights).
     std::vector<Mat4> blended;

@@ -17,8 +17,6 @@ std::uint32_t read_u32(std::string_view bytes, std::size_t at) {
   return v;
 }
 
-bool is_glb(std::string_view bytes) { return bytes.size() >= 4 && bytes.substr(0, 4) == "glTF"; }
-
 void append_u32(std::string& out, std::uint32_t v) {
   char b[4];
   std::memcpy(b, &v, 4);
@@ -26,6 +24,13 @@ void append_u32(std::string& out, std::uint32_t v) {
 }
 
 }  // namespace
+
+bool is_glb(std::string_view bytes) { return bytes.size() >= 4 && bytes.substr(0, 4) == "glTF"; }
+
+bool names_compression(std::string_view json) {
+  return json.find("KHR_draco_mesh_compression") != std::string_view::npos ||
+         json.find("EXT_meshopt_compression") != std::string_view::npos;
+}
 
 std::optional<std::string_view> json_of(std::string_view bytes) {
   if (!is_glb(bytes)) return bytes;
@@ -40,9 +45,7 @@ std::string prepare_for_tinygltf(std::string_view bytes) {
   const std::optional<std::string_view> json_text = json_of(bytes);
   if (!json_text) return "";  // for tinygltf to refuse with its own message
   const std::string_view text = *json_text;
-  if (text.find("KHR_draco_mesh_compression") == std::string_view::npos &&
-      text.find("EXT_meshopt_compression") == std::string_view::npos)
-    return "";
+  if (!names_compression(text)) return "";
   nlohmann::json doc = nlohmann::json::parse(text, nullptr, false);
   if (doc.is_discarded() || !doc.is_object()) return "";
   const bool draco = set_draco_indices_aside(doc);

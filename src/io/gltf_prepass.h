@@ -10,6 +10,13 @@
 
 namespace qem::io::gltf {
 
+/// Whether a document's bytes are a .glb (the binary container's magic), not a .gltf's JSON.
+bool is_glb(std::string_view bytes);
+
+/// Whether a document's JSON (json_of) names either compression extension: the test that decides
+/// whether the load must decode (and the viewer serve the document decoded).
+bool names_compression(std::string_view json);
+
 /// The JSON of a glTF document's bytes: the whole text of a .gltf, or a .glb's JSON chunk (glTF 2.0
 /// §4.4); nullopt when a .glb has none within its bytes.
 std::optional<std::string_view> json_of(std::string_view bytes);

@@ -2,7 +2,6 @@
 #include "view/model_assets.h"
 
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -28,10 +27,6 @@ std::string read_file(const fs::path& file) {
   ss << in.rdbuf();
   if (!in) throw Error(file.string() + ": cannot read");
   return ss.str();
-}
-
-bool is_glb(const std::string& bytes) {
-  return bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
 }
 
 // Adds the file `ref` (relative to `from`, which must lie in `folder`) to the level's files;
@@ -154,9 +149,8 @@ ViewLevel load_view_level(const std::string& path, const LoadOptions& options,
     // carry: such a document goes to the page decoded (GltfDocument writes it uncompressed, its
     // external buffers embedded).
     const std::string_view json = json_text_of(level.files[level.gltf], path);
-    if (json.find("KHR_draco_mesh_compression") != std::string_view::npos ||
-        json.find("EXT_meshopt_compression") != std::string_view::npos)
-      level.files[level.gltf] = GltfDocument::load(path).serialize(is_glb(level.files[level.gltf]));
+    if (io::gltf::names_compression(json))
+      level.files[level.gltf] = GltfDocument::load(path).serialize(io::gltf::is_glb(level.files[level.gltf]));
     for (const std::string& uri : gltf_external_uris(level.files[level.gltf], path))
       add_reference(level, folder, fs::path(), percent_decode(uri), path, "glTF resource", warnings);
   } else if (report.format == FileFormat::Obj && options.read_attributes) {
