@@ -16,6 +16,7 @@
 
 #include "merged_primitives.h"
 #include "qem/error.h"
+#include "quantized_borders.h"
 
 namespace qem {
 namespace {
@@ -147,6 +148,14 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
     return j;
   };
   if (options.vertex_lock.empty()) {
+    // A Draco-compressed mesh's primitives meet at positions a quantization step apart: snapped
+    // together first (quantized_borders.h). The jobs of one mesh follow one another.
+    for (std::size_t first = 0, last; first < jobs.size(); first = last) {
+      std::vector<double> steps;
+      for (last = first; last < jobs.size() && info[jobs[last]].mesh == info[jobs[first]].mesh; ++last)
+        steps.push_back(info[jobs[last]].position_step);
+      snap_quantized_borders(std::span(meshes).subspan(first, last - first), steps);
+    }
     // (mesh, position) -> the first job that has it, and whether another has it too
     std::map<std::pair<std::size_t, std::array<double, 3>>, std::pair<std::size_t, bool>> owner;
     const auto at = [&](std::size_t j, std::size_t v) {
@@ -384,8 +393,9 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
       for (std::size_t k = 0, first = 0; k < u.parts.size(); first += u.parts[k++].vertex_count()) {
         if (faces[k] > 0) continue;
         locked.resize(u.vertices, 0);
+        // (A part that vanishes with its vertices locked is left so: not made again.)
+        again |= locked[first] == 0;
         std::fill_n(locked.begin() + std::ptrdiff_t(first), u.parts[k].vertex_count(), std::uint8_t(1));
-        again = true;
       }
       if (!again) break;
       o.vertex_lock = locked;

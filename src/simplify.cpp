@@ -16,6 +16,7 @@
 #include "core/settings.h"
 #include "geometry/box.h"
 #include "geometry/frame.h"
+#include "material_carrier.h"
 #include "qem/error.h"
 #include "refit/attribute_fit.h"
 #include "refit/refit_after_simplify.h"
@@ -381,11 +382,20 @@ SimplifyResult simplify_two_sided(MeshView input, const SimplifyOptions& options
 }  // namespace
 
 SimplifyResult simplify(MeshView input, const SimplifyOptions& options, SimplifyObserver* observer) {
+  if (needs_material_carrier(input)) {
+    SimplifyResult out = with_material_carrier(
+        input, [&](MeshView with) { return simplify_two_sided(with, options, observer, nullptr, nullptr); });
+    drop_material_carrier(out.mesh.attributes);
+    return out;
+  }
   return simplify_two_sided(input, options, observer, nullptr, nullptr);
 }
 
 SimplifyResult simplify(Mesh&& input, const SimplifyOptions& options, SimplifyObserver* observer) {
+  const bool carried = needs_material_carrier(input);
+  if (carried) input.attributes.push_back(material_carrier(input.vertex_count()));
   SimplifyResult out = simplify_two_sided(input, options, observer, &input.indices, &input.attributes);
+  if (carried) drop_material_carrier(out.mesh.attributes);
   out.mesh.material_names = std::move(input.material_names);
   out.mesh.material_library = std::move(input.material_library);
   return out;

@@ -131,32 +131,70 @@ TEST(Attributes, ColourStepDoesNotBleed) {
 }
 
 TEST(Attributes, MaterialsNeverMergeAndTheirBoundaryStays) {
-  Mesh in = test::height_field(30, [](double x, double y) { return 0.05 * std::sin(6 * x) * std::cos(5 * y); });
-  in.attributes.push_back({"NORMAL", AttributeKind::Normal, 3, std::vector<double>(3 * in.vertex_count(), 0)});
-  for (std::size_t v = 0; v < in.vertex_count(); ++v) in.attributes[0].values[3 * v + 2] = 1;
-  // Material by the face's centre: left or right of x = 0.5 (a grid line), vertices shared.
-  for (std::size_t f = 0; f < in.face_count(); ++f) {
-    double cx = 0;
-    for (int k = 0; k < 3; ++k) cx += in.positions[3 * in.indices[3 * f + k]] / 3;
-    in.face_materials.push_back(cx < 0.5 ? 0 : 1);
-  }
-  SimplifyOptions o;
-  o.target_faces = 60;
-  const SimplifyResult r = simplify(in, o);
-  ASSERT_EQ(r.mesh.face_materials.size(), r.mesh.face_count());
-  std::map<std::array<double, 3>, std::set<std::uint32_t>> materials_at;
-  for (std::size_t f = 0; f < r.mesh.face_count(); ++f) {
-    EXPECT_EQ(r.mesh.face_materials[f], in.face_materials[r.face_source[f]]);
-    for (int k = 0; k < 3; ++k) {
-      const std::uint32_t v = r.mesh.indices[3 * f + k];
-      materials_at[{r.mesh.positions[3 * v], r.mesh.positions[3 * v + 1], r.mesh.positions[3 * v + 2]}].insert(
-          r.mesh.face_materials[f]);
+  // With normals, and with materials alone (an OBJ with `usemtl` and no `vt`/`vn`), from a view
+  // and from a mesh given away.
+  for (int variant = 0; variant < 3; ++variant) {
+    SCOPED_TRACE(variant == 0   ? "normals"
+                 : variant == 1 ? "materials alone, view"
+                                : "materials alone, moved");
+    Mesh in =
+        test::height_field(30, [](double x, double y) { return 0.05 * std::sin(6 * x) * std::cos(5 * y); });
+    if (variant == 0) {
+      in.attributes.push_back(
+          {"NORMAL", AttributeKind::Normal, 3, std::vector<double>(3 * in.vertex_count(), 0)});
+      for (std::size_t v = 0; v < in.vertex_count(); ++v) in.attributes[0].values[3 * v + 2] = 1;
+    }
+    // Material by the face's centre: left or right of x = 0.5 (a grid line), vertices shared.
+    for (std::size_t f = 0; f < in.face_count(); ++f) {
+      double cx = 0;
+      for (int k = 0; k < 3; ++k) cx += in.positions[3 * in.indices[3 * f + k]] / 3;
+      in.face_materials.push_back(cx < 0.5 ? 0 : 1);
+    }
+    SimplifyOptions o;
+    o.target_faces = 60;
+    const Mesh copy = in;
+    const SimplifyResult r = variant == 2 ? simplify(std::move(in), o) : simplify(in, o);
+    EXPECT_LE(r.mesh.face_count(), 60u);
+    EXPECT_EQ(r.mesh.attributes.size(), copy.attributes.size());
+    ASSERT_EQ(r.mesh.face_materials.size(), r.mesh.face_count());
+    std::map<std::array<double, 3>, std::set<std::uint32_t>> materials_at;
+    for (std::size_t f = 0; f < r.mesh.face_count(); ++f) {
+      EXPECT_EQ(r.mesh.face_materials[f], copy.face_materials[r.face_source[f]]);
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t v = r.mesh.indices[3 * f + k];
+        materials_at[{r.mesh.positions[3 * v], r.mesh.positions[3 * v + 1], r.mesh.positions[3 * v + 2]}]
+            .insert(r.mesh.face_materials[f]);
+      }
+    }
+    std::size_t on_both = 0;
+    for (const auto& [p, m] : materials_at)
+      if (m.size() > 1) {
+        ++on_both;
+        EXPECT_EQ(p[0], 0.5) << "a point of both materials left the boundary";
+      }
+    EXPECT_GE(on_both, 2u);
+    // Welded by position, no edge along the boundary inside the square is open: no crack.
+    std::map<std::array<double, 3>, std::uint32_t> weld;
+    std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
+    std::vector<std::array<double, 3>> at;
+    const auto id = [&](std::uint32_t v) {
+      const std::array<double, 3> p{r.mesh.positions[3 * v], r.mesh.positions[3 * v + 1],
+                                    r.mesh.positions[3 * v + 2]};
+      const auto [it, fresh] = weld.try_emplace(p, std::uint32_t(at.size()));
+      if (fresh) at.push_back(p);
+      return it->second;
+    };
+    for (std::size_t f = 0; f < r.mesh.face_count(); ++f)
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t a = id(r.mesh.indices[3 * f + k]), b = id(r.mesh.indices[3 * f + (k + 1) % 3]);
+        ++uses[{std::min(a, b), std::max(a, b)}];
+      }
+    for (const auto& [e, n] : uses) {
+      const bool inside = at[e.first][0] == 0.5 && at[e.second][0] == 0.5 && at[e.first][1] > 0 &&
+                          at[e.first][1] < 1 && at[e.second][1] > 0 && at[e.second][1] < 1;
+      EXPECT_FALSE(inside && n == 1) << "a crack along the boundary";
     }
   }
-  for (const auto& [p, m] : materials_at)
-    if (m.size() > 1) {
-      EXPECT_EQ(p[0], 0.5) << "a point of both materials left the boundary";
-    }
 }
 
 TEST(Attributes, ProvenanceFollowsTheWedges) {

@@ -328,6 +328,75 @@ TEST(GltfSimplify, PrimitivesOfOneMeshStayJoined) {
   }
 }
 
+/// The primitives of `doc` (one mesh) as one mesh of Draco-compressed primitives, each with its
+/// positions quantized to `bits` bits in its own box (as gltf-transform and Blender write them).
+std::string draco_halves(const qem::GltfDocument& doc, int bits) {
+  json out = {{"asset", {{"version", "2.0"}}},
+              {"extensionsUsed", {"KHR_draco_mesh_compression"}},
+              {"extensionsRequired", {"KHR_draco_mesh_compression"}},
+              {"scene", 0},
+              {"scenes", {{{"nodes", {0}}}}},
+              {"nodes", {{{"mesh", 0}}}},
+              {"meshes", {{{"primitives", json::array()}}}},
+              {"accessors", json::array()},
+              {"bufferViews", json::array()},
+              {"buffers", {{{"byteLength", 0}}}}};
+  std::string bin;
+  for (std::size_t k = 0; k < doc.primitives().size(); ++k) {
+    const qem::Mesh m = doc.mesh(k);
+    const std::string stream = qem::test::draco_bitstream(m, bits);
+    out["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", bin.size()}, {"byteLength", stream.size()}});
+    bin += stream;
+    bin.resize((bin.size() + 3) & ~std::size_t(3), '\0');
+    std::vector<double> lo(3, 1e30), hi(3, -1e30);
+    for (std::size_t i = 0; i < m.positions.size(); ++i)
+      lo[i % 3] = std::min(lo[i % 3], m.positions[i]), hi[i % 3] = std::max(hi[i % 3], m.positions[i]);
+    const std::size_t a = out["accessors"].size();
+    out["accessors"].push_back(
+        {{"componentType", 5126}, {"count", m.vertex_count()}, {"type", "VEC3"}, {"min", lo}, {"max", hi}});
+    out["accessors"].push_back({{"componentType", 5125}, {"count", m.indices.size()}, {"type", "SCALAR"}});
+    out["meshes"][0]["primitives"].push_back(
+        {{"attributes", {{"POSITION", a}}},
+         {"indices", a + 1},
+         {"extensions",
+          {{"KHR_draco_mesh_compression",
+            {{"bufferView", out["bufferViews"].size() - 1}, {"attributes", {{"POSITION", 0}}}}}}}});
+  }
+  return qem::test::gltf_text(out, bin);
+}
+
+TEST(GltfSimplify, DracoCompressedPrimitivesStayJoined) {
+  // Draco quantizes each primitive in its own box: decoded, the halves of a sphere no longer meet
+  // at equal positions (the file itself has cracks a step wide). They are joined within the grids'
+  // steps, so the output is closed, in both modes.
+  const Scene s = split_sphere([](double z) { return z > 0.3 ? 0 : 1; }, 2);
+  const std::string text = draco_halves(qem::GltfDocument::parse(s.text(), "halves.gltf"), 11);
+  const qem::GltfDocument input = qem::GltfDocument::parse(text, "draco.gltf");
+  ASSERT_EQ(input.primitives().size(), 2u);
+  for (const qem::GltfPrimitiveInfo& p : input.primitives()) {
+    const qem::Mesh m = input.mesh(p.primitive);
+    std::array<double, 3> lo{1e30, 1e30, 1e30}, hi{-1e30, -1e30, -1e30};
+    for (std::size_t i = 0; i < m.positions.size(); ++i)
+      lo[i % 3] = std::min(lo[i % 3], m.positions[i]), hi[i % 3] = std::max(hi[i % 3], m.positions[i]);
+    const double range = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+    EXPECT_NEAR(p.position_step, range / 2047, 1e-6 * range);
+  }
+  ASSERT_GT(qem::test::open_edges_welded(input.scene_mesh()), 20u) << "the halves should not meet exactly";
+  for (bool per_mesh : {false, true}) {
+    SCOPED_TRACE(per_mesh ? "per mesh" : "shared budget");
+    qem::GltfDocument doc = qem::GltfDocument::parse(text, "draco.gltf");
+    qem::SimplifyOptions opt;
+    opt.target_ratio = 0.1;
+    qem::GltfSimplifyOptions gltf_options;
+    gltf_options.per_primitive = per_mesh;
+    const qem::GltfSimplifyReport r = qem::simplify_document(doc, opt, gltf_options);
+    EXPECT_EQ(r.simplified, 2u);
+    EXPECT_LT(r.faces_out, r.faces_in / 5);
+    EXPECT_EQ(qem::test::open_edges_welded(doc.scene_mesh()), 0u) << "a crack between the primitives";
+    EXPECT_GT(shared_positions(doc), 4u);
+  }
+}
+
 TEST(GltfSimplify, MergedPrimitiveThatWouldVanishIsKept) {
   // CesiumMilkTruck's body, glass and window trim are one mesh of three primitives whose borders
   // meet. Merged and simplified with permissive seams to 1 %, the trim (six frames between the body

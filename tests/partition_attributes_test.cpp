@@ -72,6 +72,16 @@ const Mesh& material_cube() {
   return mesh;
 }
 
+// The cube's materials without its attributes (an OBJ with `usemtl` and no `vt`/`vn`).
+const Mesh& materials_alone() {
+  static const Mesh mesh = [] {
+    Mesh m = material_cube();
+    m.attributes.clear();
+    return m;
+  }();
+  return mesh;
+}
+
 SimplifyOptions ratio(double r, unsigned threads = 2) {
   SimplifyOptions o;
   o.target_ratio = r;
@@ -92,7 +102,10 @@ struct Case {
   const char* name;
   const Mesh& (*mesh)();
 };
-const Case kCases[] = {{"seamed sphere", seamed_sphere}, {"coloured sphere", coloured_sphere}, {"material cube", material_cube}};
+const Case kCases[] = {{"seamed sphere", seamed_sphere},
+                       {"coloured sphere", coloured_sphere},
+                       {"material cube", material_cube},
+                       {"materials alone", materials_alone}};
 
 }  // namespace
 
@@ -233,8 +246,9 @@ TEST(PartitionAttributes, TheCutLocksSeamsByPosition) {
     for (const MeshPart& p : parts)
       for (std::uint32_t g : p.input_vertex) ++uses[g];
     for (const MeshPart& p : parts) {
-      // The part carries its vertices' rows and its faces' materials.
-      ASSERT_EQ(p.mesh.attributes.size(), in.attributes.size());
+      // The part carries its vertices' rows and its faces' materials (materials alone, with the
+      // constant attribute that takes them through the part's run).
+      ASSERT_EQ(p.mesh.attributes.size(), in.attributes.size() + (in.attributes.empty() ? 1 : 0));
       for (std::size_t a = 0; a < in.attributes.size(); ++a) {
         const std::uint32_t w = in.attributes[a].components;
         ASSERT_EQ(p.mesh.attributes[a].values.size(), w * p.mesh.vertex_count());

@@ -309,30 +309,41 @@ std::string gltf_error(const std::string& bytes, const std::string& name) {
   return "";
 }
 
-nlohmann::json draco_document(const Mesh& m, std::string& bin) {
-  const qem::VertexAttribute& uv = attribute(m, AttributeKind::TexCoord);
-  const qem::VertexAttribute& normal = attribute(m, AttributeKind::Normal);
+std::string draco_bitstream(const Mesh& m, int position_bits) {
+  const qem::VertexAttribute* uv = nullptr;
+  const qem::VertexAttribute* normal = nullptr;
+  for (const VertexAttribute& a : m.attributes) {
+    if (a.kind == AttributeKind::TexCoord && !uv) uv = &a;
+    if (a.kind == AttributeKind::Normal && !normal) normal = &a;
+  }
   draco::TriangleSoupMeshBuilder builder;
   builder.Start(static_cast<int>(m.face_count()));
   const int pos = builder.AddAttribute(draco::GeometryAttribute::POSITION, 3, draco::DT_FLOAT32);
-  const int tex = builder.AddAttribute(draco::GeometryAttribute::TEX_COORD, 2, draco::DT_FLOAT32);
-  const int nor = builder.AddAttribute(draco::GeometryAttribute::NORMAL, 3, draco::DT_FLOAT32);
-  std::vector<float> p(m.positions.begin(), m.positions.end()), t(uv.values.begin(), uv.values.end()),
-      n(normal.values.begin(), normal.values.end());
+  const int tex = uv ? builder.AddAttribute(draco::GeometryAttribute::TEX_COORD, 2, draco::DT_FLOAT32) : -1;
+  const int nor = normal ? builder.AddAttribute(draco::GeometryAttribute::NORMAL, 3, draco::DT_FLOAT32) : -1;
+  std::vector<float> p(m.positions.begin(), m.positions.end()), t, n;
+  if (uv) t.assign(uv->values.begin(), uv->values.end());
+  if (normal) n.assign(normal->values.begin(), normal->values.end());
   for (std::size_t f = 0; f < m.face_count(); ++f) {
     const std::uint32_t* c = &m.indices[3 * f];
     const draco::FaceIndex face(static_cast<std::uint32_t>(f));
     builder.SetAttributeValuesForFace(pos, face, &p[3 * c[0]], &p[3 * c[1]], &p[3 * c[2]]);
-    builder.SetAttributeValuesForFace(tex, face, &t[2 * c[0]], &t[2 * c[1]], &t[2 * c[2]]);
-    builder.SetAttributeValuesForFace(nor, face, &n[3 * c[0]], &n[3 * c[1]], &n[3 * c[2]]);
+    if (uv) builder.SetAttributeValuesForFace(tex, face, &t[2 * c[0]], &t[2 * c[1]], &t[2 * c[2]]);
+    if (normal) builder.SetAttributeValuesForFace(nor, face, &n[3 * c[0]], &n[3 * c[1]], &n[3 * c[2]]);
   }
   std::unique_ptr<draco::Mesh> mesh = builder.Finalize();
-  if (!mesh) throw std::runtime_error("draco_document: the builder failed");
-  draco::Encoder encoder;  // no quantization: the values come back exactly
+  if (!mesh) throw std::runtime_error("draco_bitstream: the builder failed");
+  draco::Encoder encoder;  // without quantization, the values come back exactly
+  if (position_bits > 0) encoder.SetAttributeQuantization(draco::GeometryAttribute::POSITION, position_bits);
   draco::EncoderBuffer stream;
   if (!encoder.EncodeMeshToBuffer(*mesh, &stream).ok())
-    throw std::runtime_error("draco_document: encoding failed");
-  bin.assign(stream.data(), stream.size());
+    throw std::runtime_error("draco_bitstream: encoding failed");
+  return std::string(stream.data(), stream.size());
+}
+
+nlohmann::json draco_document(const Mesh& m, std::string& bin) {
+  bin = draco_bitstream(m);
+  std::vector<float> p(m.positions.begin(), m.positions.end());
   std::array<float, 3> lo{1e30f, 1e30f, 1e30f}, hi{-1e30f, -1e30f, -1e30f};
   for (std::size_t v = 0; v < m.vertex_count(); ++v)
     for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[3 * v + k]), hi[k] = std::max(hi[k], p[3 * v + k]);

@@ -57,6 +57,10 @@ std::string base64(const std::string& bytes);
 std::string gltf_text(nlohmann::json doc, const std::string& bin);
 /// The qem::Error message of reading glTF `bytes` named `name`, "" when they read.
 std::string gltf_error(const std::string& bytes, const std::string& name);
+/// `m`'s triangles (positions, and its texture coordinates and normals when it has them; Draco ids
+/// in that order) as a Draco bitstream (libdraco's encoder); positions quantized to `position_bits`
+/// bits in the mesh's own box, or stored as they are (0).
+std::string draco_bitstream(const Mesh& m, int position_bits = 0);
 /// `m` (positions, TEXCOORD_0, NORMAL) as one Draco-compressed primitive (libdraco's encoder, no
 /// quantization: the values come back exactly): the bitstream (`bin`, to embed with gltf_text) is
 /// the only buffer view, the accessors have none, as the extension writes them, the indices

@@ -46,6 +46,11 @@ struct GltfPrimitiveInfo {
   /// instance (or one node by EXT_mesh_gpu_instancing) takes the largest: its errors are measured
   /// where they are seen the biggest.
   double world_scale = 1;
+  /// The spacing of the grid on which a Draco-compressed primitive's positions were quantized, in
+  /// the mesh's units (range / (2^bits - 1)); 0 when they were stored as they are. Draco quantizes
+  /// each primitive in its own box, so where two primitives of one mesh meet, their positions
+  /// differ by up to half of each one's spacing: simplify_document joins them within that.
+  double position_step = 0;
 };
 
 /// A loaded glTF file. Movable, not copyable.

@@ -105,7 +105,10 @@ SimplifyResult simplify_partitioned(MeshView input, const SimplifyOptions& optio
                                     const PartitionOptions& partition = {}, PartitionReport* report = nullptr);
 
 /// The cut itself (also used by the MPI front end, which runs the parts elsewhere and finishes with
-/// finish_partitioned): the parts with their targets.
+/// finish_partitioned): the parts with their targets. An input with face materials and no
+/// attribute gives parts with one constant attribute, "qem:materials", which takes the materials
+/// through the parts' runs (simplify keeps materials apart on its attribute path) and which
+/// finish_partitioned takes off again.
 std::vector<MeshPart> split_mesh(MeshView input, const SimplifyOptions& options, unsigned parts,
                                  PartitionReport* report = nullptr);
 

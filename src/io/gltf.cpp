@@ -414,7 +414,8 @@ void GltfDocument::Impl::check_and_list() {
                   ", " + std::to_string(view.byteLength) + " long) lies outside its buffer of " +
                   std::to_string(size) + " bytes");
   }
-  io::gltf::decode_draco(model, name, compressed_views);
+  io::gltf::PositionSteps position_steps;
+  io::gltf::decode_draco(model, name, compressed_views, position_steps);
   refuse_compression(model, name);
   for (std::size_t m = 0; m < model.meshes.size(); ++m)
     for (std::size_t k = 0; k < model.meshes[m].primitives.size(); ++k) {
@@ -425,6 +426,8 @@ void GltfDocument::Impl::check_and_list() {
       info.material = p.material;
       info.mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
       info.morph_targets = p.targets.size();
+      if (const auto step = position_steps.find({m, k}); step != position_steps.end())
+        info.position_step = step->second;
       if (p.attributes.count("POSITION")) info.attributes.push_back("POSITION");
       for (const auto& [semantic, accessor] : p.attributes)
         if (semantic != "POSITION") info.attributes.push_back(semantic);

@@ -1,7 +1,9 @@
 #include "io/gltf_draco.h"
 
+#include <draco/attributes/attribute_quantization_transform.h>
 #include <draco/compression/decode.h>
 #include <draco/core/decoder_buffer.h>
+#include <draco/core/quantization_utils.h>
 
 #include <algorithm>
 #include <cstdint>
@@ -32,6 +34,33 @@ bool append_values(const draco::PointCloud& mesh, const draco::PointAttribute& a
       return false;
     const auto* p = reinterpret_cast<const unsigned char*>(values);
     bytes.insert(bytes.end(), p, p + sizeof(T) * static_cast<std::size_t>(n));
+  }
+  return true;
+}
+
+// A position attribute decoded without its quantization transform (the decoder's
+// skip_attribute_transform): its integers dequantized as libdraco's own inverse transform does
+// (AttributeQuantizationTransform: the integer times range / (2^bits - 1), plus the minimum, in
+// float), appended to `bytes` as floats; the grid's spacing in `step`. False when its quantization
+// cannot be read.
+bool append_dequantized(const draco::PointCloud& mesh, const draco::PointAttribute& attribute,
+                        std::vector<unsigned char>& bytes, double& step) {
+  draco::AttributeQuantizationTransform transform;
+  if (!attribute.GetAttributeTransformData() || !transform.InitFromAttribute(attribute)) return false;
+  const int n = attribute.num_components();
+  const int32_t max_quantized = (int32_t(1) << transform.quantization_bits()) - 1;
+  draco::Dequantizer dequantizer;
+  if (n > 4 || !dequantizer.Init(transform.range(), max_quantized)) return false;
+  step = double(transform.range()) / max_quantized;
+  std::int32_t q[4] = {};
+  for (draco::PointIndex i(0); i < mesh.num_points(); ++i) {
+    if (!attribute.ConvertValue<std::int32_t>(attribute.mapped_index(i), static_cast<std::int8_t>(n), q))
+      return false;
+    for (int c = 0; c < n; ++c) {
+      const float value = dequantizer.DequantizeFloat(q[c]) + transform.min_value(c);
+      const auto* b = reinterpret_cast<const unsigned char*>(&value);
+      bytes.insert(bytes.end(), b, b + sizeof(float));
+    }
   }
   return true;
 }
@@ -96,7 +125,7 @@ void attach(tinygltf::Model& model, tinygltf::Accessor& a, std::vector<unsigned 
 }
 
 void decode_primitive(tinygltf::Model& model, tinygltf::Primitive& p, const std::string& where,
-                      std::set<std::size_t>& compressed_views) {
+                      std::set<std::size_t>& compressed_views, double& position_step) {
   const tinygltf::Value& ext = p.extensions.at(kDraco);
   const tinygltf::Value& view_value = ext.Get("bufferView");
   const tinygltf::Value& names = ext.Get("attributes");
@@ -109,11 +138,9 @@ void decode_primitive(tinygltf::Model& model, tinygltf::Primitive& p, const std:
   const std::vector<unsigned char>& data = model.buffers[static_cast<std::size_t>(view.buffer)].data;
 
   draco::DecoderBuffer stream;
-  stream.Init(reinterpret_cast<const char*>(data.data() + view.byteOffset), view.byteLength);
   // A POINTS primitive is a point cloud; any other is decoded as faces, a triangle list (so a strip
   // becomes TRIANGLES).
   const bool points = p.mode == TINYGLTF_MODE_POINTS;
-  draco::Decoder decoder;
   std::unique_ptr<draco::PointCloud> cloud;
   const auto take = [&](auto&& decoded) {
     if (!decoded.ok())
@@ -121,10 +148,36 @@ void decode_primitive(tinygltf::Model& model, tinygltf::Primitive& p, const std:
                   " cannot be decoded: " + decoded.status().error_msg_string());
     cloud = std::move(decoded).value();
   };
-  if (points)
-    take(decoder.DecodePointCloudFromBuffer(&stream));
-  else
-    take(decoder.DecodeMeshFromBuffer(&stream));
+  // A mesh's positions are read as the encoder's integers with its quantization, and dequantized
+  // here as libdraco would: the grid's spacing tells the primitives of one mesh, each quantized in
+  // its own box, where they meet (GltfPrimitiveInfo::position_step). A point cloud is decoded as is.
+  const auto decode = [&](bool keep_positions_quantized) {
+    draco::Decoder decoder;
+    if (keep_positions_quantized) decoder.SetSkipAttributeTransform(draco::GeometryAttribute::POSITION);
+    stream.Init(reinterpret_cast<const char*>(data.data() + view.byteOffset), view.byteLength);
+    if (points)
+      take(decoder.DecodePointCloudFromBuffer(&stream));
+    else
+      take(decoder.DecodeMeshFromBuffer(&stream));
+  };
+  decode(!points);
+  // (An integer accessor for a position Draco quantized, unusual, takes libdraco's own conversion.)
+  const auto quantized = [](const draco::PointAttribute* a) {
+    return a && a->attribute_type() == draco::GeometryAttribute::POSITION && a->GetAttributeTransformData();
+  };
+  for (const std::string& semantic : names.Keys()) {
+    const tinygltf::Value& id = names.Get(semantic);
+    const auto named = p.attributes.find(semantic);
+    if (!id.IsInt() || id.GetNumberAsInt() < 0 || named == p.attributes.end() || named->second < 0 ||
+        static_cast<std::size_t>(named->second) >= model.accessors.size())
+      continue;  // (refused below)
+    if (quantized(cloud->GetAttributeByUniqueId(static_cast<std::uint32_t>(id.GetNumberAsInt()))) &&
+        model.accessors[static_cast<std::size_t>(named->second)].componentType !=
+            TINYGLTF_COMPONENT_TYPE_FLOAT) {
+      decode(false);
+      break;
+    }
+  }
   const draco::PointCloud& mesh = *cloud;
   const draco::Mesh* faces = points ? nullptr : static_cast<const draco::Mesh*>(&mesh);
   if ((faces && faces->num_faces() == 0) || mesh.num_points() == 0)
@@ -156,7 +209,12 @@ void decode_primitive(tinygltf::Model& model, tinygltf::Primitive& p, const std:
                   ": the Draco attribute has " + std::to_string(attribute->num_components()) +
                   " components, the accessor's type " + std::to_string(components_of(a.type)));
     std::vector<unsigned char> bytes;
-    if (!append_values(a.componentType, mesh, *attribute, bytes))
+    double step = 0;
+    if (quantized(attribute)) {
+      if (!append_dequantized(mesh, *attribute, bytes, step))
+        throw Error(where + " (" + semantic + "): the Draco attribute's quantization cannot be read");
+      if (semantic == "POSITION") position_step = step;
+    } else if (!append_values(a.componentType, mesh, *attribute, bytes))
       throw Error(where + " (" + semantic + "), accessor " + std::to_string(named->second) +
                   ": a decoded value does not fit the accessor's component type " +
                   std::to_string(a.componentType));
@@ -211,13 +269,16 @@ bool set_draco_indices_aside(nlohmann::json& doc) {
   return moved;
 }
 
-void decode_draco(tinygltf::Model& model, const std::string& name, std::set<std::size_t>& compressed_views) {
+void decode_draco(tinygltf::Model& model, const std::string& name, std::set<std::size_t>& compressed_views,
+                  PositionSteps& position_steps) {
   for (std::size_t m = 0; m < model.meshes.size(); ++m)
     for (std::size_t k = 0; k < model.meshes[m].primitives.size(); ++k) {
       tinygltf::Primitive& p = model.meshes[m].primitives[k];
       if (!p.extensions.count(kDraco)) continue;
+      double step = 0;
       decode_primitive(model, p, name + ": mesh " + std::to_string(m) + ", primitive " + std::to_string(k),
-                       compressed_views);
+                       compressed_views, step);
+      if (step > 0) position_steps[{m, k}] = step;
     }
   // No primitive is compressed now (a list naming an extension nothing uses is dropped too).
   for (std::vector<std::string>* list : {&model.extensionsUsed, &model.extensionsRequired})

@@ -8,9 +8,11 @@
 #include <tiny_gltf.h>
 
 #include <cstddef>
+#include <map>
 #include <nlohmann/json_fwd.hpp>
 #include <set>
 #include <string>
+#include <utility>
 
 namespace qem::io::gltf {
 
@@ -27,7 +29,10 @@ bool set_draco_indices_aside(nlohmann::json& doc);
 /// buffer views that held the bitstreams are added to `compressed_views` (the writer drops them).
 /// Throws qem::Error naming `name`, the mesh and the primitive when the bitstream or the extension
 /// is malformed or does not match the accessors (an attribute's component count, a value that
-/// does not fit the accessor's type).
-void decode_draco(tinygltf::Model& model, const std::string& name, std::set<std::size_t>& compressed_views);
+/// does not fit the accessor's type). The spacing of the grid each primitive's POSITION was
+/// quantized to (in the mesh's units) goes to `position_steps`, by (mesh, primitive).
+using PositionSteps = std::map<std::pair<std::size_t, std::size_t>, double>;
+void decode_draco(tinygltf::Model& model, const std::string& name, std::set<std::size_t>& compressed_views,
+                  PositionSteps& position_steps);
 
 }  // namespace qem::io::gltf

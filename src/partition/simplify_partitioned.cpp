@@ -16,8 +16,9 @@
 #include "core/parallel_chunks.h"
 #include "core/release_memory.h"
 #include "core/run.h"
-#include "partition/partition_targets.h"
 #include "core/same_position.h"
+#include "material_carrier.h"
+#include "partition/partition_targets.h"
 #include "qem/error.h"
 #include "qem/partition.h"
 #include "refit/attribute_fit.h"
@@ -118,6 +119,12 @@ namespace {
 SimplifyResult finish(MeshView input, const SimplifyOptions& options, std::span<const MeshPart> parts,
                       std::span<const MeshPartResult> results, PartitionReport* report,
                       const std::function<void()>& release) {
+  if (needs_material_carrier(input)) {  // as split_mesh gave the parts (material_carrier.h)
+    SimplifyResult r = with_material_carrier(
+        input, [&](MeshView with) { return finish(with, options, parts, results, report, release); });
+    drop_material_carrier(r.mesh.attributes);
+    return r;
+  }
   if (parts.size() != results.size()) throw Error("finish_partitioned: one result per part is needed");
   constexpr std::uint32_t kNone = SimplifyResult::kUnmapped;
   // Weld: a vertex of a part's output that started as a cut vertex never moved and was never

@@ -9,9 +9,10 @@
 #include "check_mesh.h"
 #include "core/default_init_allocator.h"
 #include "core/parallel_chunks.h"
-#include "core/spatial_order.h"
-#include "partition/partition_targets.h"
 #include "core/same_position.h"
+#include "core/spatial_order.h"
+#include "material_carrier.h"
+#include "partition/partition_targets.h"
 #include "qem/error.h"
 #include "qem/partition.h"
 
@@ -110,6 +111,10 @@ Array<std::uint64_t> centroid_codes(MeshView input, const std::vector<std::uint3
 
 std::vector<MeshPart> split_mesh(MeshView input, const SimplifyOptions& options, unsigned part_count,
                                  PartitionReport* report) {
+  if (needs_material_carrier(input)) {  // taken off by finish_partitioned (material_carrier.h)
+    return with_material_carrier(
+        input, [&](MeshView with) { return split_mesh(with, options, part_count, report); });
+  }
   check_mesh(input, "input");
   if (const std::string why = partition_refusal(input, options); !why.empty())
     throw Error("cannot simplify part by part: " + why);

@@ -1,0 +1,101 @@
+#include "quantized_borders.h"
+
+#include <algorithm>
+#include <array>
+#include <cfloat>
+#include <cmath>
+#include <cstdint>
+#include <map>
+#include <utility>
+#include <vector>
+
+namespace qem {
+namespace {
+
+using Point = std::array<double, 3>;
+
+Point position(const Mesh& m, std::size_t v) {
+  const double* p = &m.positions[3 * v];
+  return {p[0], p[1], p[2]};
+}
+
+/// Whether each vertex of `m` lies on a border: an edge of one face, the mesh welded by position
+/// (its seams, vertices split at one position, are not borders).
+std::vector<std::uint8_t> border_vertices(const Mesh& m) {
+  std::map<Point, std::uint32_t> weld;
+  std::vector<std::uint32_t> id(m.vertex_count());
+  for (std::size_t v = 0; v < id.size(); ++v)
+    id[v] = weld.try_emplace(position(m, v), std::uint32_t(weld.size())).first->second;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
+  edges.reserve(m.indices.size());
+  for (std::size_t f = 0; f < m.face_count(); ++f)
+    for (int c = 0; c < 3; ++c) {
+      const std::uint32_t a = id[m.indices[3 * f + c]], b = id[m.indices[3 * f + (c + 1) % 3]];
+      if (a != b) edges.emplace_back(std::min(a, b), std::max(a, b));
+    }
+  std::sort(edges.begin(), edges.end());
+  std::vector<std::uint8_t> welded_border(weld.size(), 0);
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i;
+    while (j < edges.size() && edges[j] == edges[i]) ++j;
+    if (j - i == 1) welded_border[edges[i].first] = welded_border[edges[i].second] = 1;
+    i = j;
+  }
+  std::vector<std::uint8_t> border(id.size());
+  for (std::size_t v = 0; v < id.size(); ++v) border[v] = welded_border[id[v]];
+  return border;
+}
+
+}  // namespace
+
+std::size_t snap_quantized_borders(std::span<Mesh> parts, std::span<const double> steps) {
+  double cell = 0;  // no two parts' tolerance exceeds the largest step
+  for (double s : steps)
+    if (std::isfinite(s)) cell = std::max(cell, s);
+  if (cell <= 0) return 0;
+  struct Entry {
+    Point p;
+    double step;
+  };
+  std::map<Point, std::vector<Entry>> grid;  // earlier parts' border vertices by cell
+  const auto cell_of = [&](const Point& p) {
+    return Point{std::floor(p[0] / cell), std::floor(p[1] / cell), std::floor(p[2] / cell)};
+  };
+  std::size_t moved = 0;
+  for (std::size_t k = 0; k < parts.size(); ++k) {
+    Mesh& m = parts[k];
+    const double own = std::isfinite(steps[k]) ? steps[k] : 0;
+    const std::vector<std::uint8_t> border = border_vertices(m);
+    std::vector<Point> snapped(m.vertex_count());
+    std::vector<std::uint8_t> moves(m.vertex_count(), 0);
+    for (std::size_t v = 0; v < m.vertex_count(); ++v) {
+      if (!border[v] || grid.empty()) continue;
+      const Point p = position(m, v), c = cell_of(p);
+      double best = INFINITY;
+      for (double dx : {-1.0, 0.0, 1.0})
+        for (double dy : {-1.0, 0.0, 1.0})
+          for (double dz : {-1.0, 0.0, 1.0}) {
+            const auto it = grid.find({c[0] + dx, c[1] + dy, c[2] + dz});
+            if (it == grid.end()) continue;
+            for (const Entry& e : it->second) {
+              if (e.step + own <= 0) continue;  // two unquantized parts: matched exactly, not here
+              double d = 0, size = 0;
+              for (int a = 0; a < 3; ++a)
+                d = std::max(d, std::abs(p[a] - e.p[a])),
+                size = std::max({size, std::abs(p[a]), std::abs(e.p[a])});
+              // half of each grid's step, and the rounding of the dequantized floats
+              const double within = 0.5 * (e.step + own) * 1.01 + 4 * FLT_EPSILON * size;
+              if (d <= within && d < best) best = d, snapped[v] = e.p;
+            }
+          }
+      moves[v] = best < INFINITY && best > 0;
+    }
+    for (std::size_t v = 0; v < m.vertex_count(); ++v)
+      if (moves[v]) std::copy(snapped[v].begin(), snapped[v].end(), &m.positions[3 * v]), ++moved;
+    for (std::size_t v = 0; v < m.vertex_count(); ++v)
+      if (border[v]) grid[cell_of(position(m, v))].push_back({position(m, v), own});
+  }
+  return moved;
+}
+
+}  // namespace qem
