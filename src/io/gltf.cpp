@@ -28,6 +28,7 @@
 #include "io/gltf_prepass.h"
 #include "io/io_common.h"
 #include "qem/gltf.h"
+#include "quantized_borders.h"
 
 namespace qem {
 
@@ -1014,13 +1015,32 @@ Mesh GltfDocument::scene_mesh() const {
   // Primitives of one node instance that share their vertex accessors (one primitive per
   // material over the same vertices, as save_mesh writes) share their vertices here too.
   std::map<std::pair<std::size_t, std::map<std::string, int>>, std::uint32_t> shared_base;
+  // Draco-compressed primitives of one mesh joined where they meet, as simplify_document joins them
+  // (quantized_borders.h): each was quantized in its own box.
+  std::map<std::size_t, Mesh> snapped;
+  for (std::size_t first = 0, last; first < d.primitives.size(); first = last) {
+    std::vector<std::size_t> members;
+    std::vector<double> steps;
+    bool quantized = false;
+    for (last = first; last < d.primitives.size() && d.primitives[last].mesh == d.primitives[first].mesh;
+         ++last)
+      if (d.primitives[last].simplifiable && !d.replaced.count(last)) {
+        members.push_back(last), steps.push_back(d.primitives[last].position_step);
+        quantized |= steps.back() > 0;
+      }
+    if (!quantized || members.size() < 2) continue;
+    std::vector<Mesh> meshes;
+    for (std::size_t i : members) meshes.push_back(d.read(i));
+    snap_quantized_borders(meshes, steps);
+    for (std::size_t k = 0; k < members.size(); ++k) snapped[members[k]] = std::move(meshes[k]);
+  }
   std::vector<Mat4> skin_world;  // the nodes' world matrices, when a part is skinned
   std::vector<char> reached;
   std::map<int, std::vector<Mat4>> skin_joints;  // per skin: skin_matrices
   for (const Part& part_ref : parts) {
     const std::size_t i = part_ref.primitive;
     const Mat4& world = part_ref.world;
-    const Mesh part = d.replaced.count(i) ? d.replaced.at(i) : d.read(i);
+    const Mesh part = d.replaced.count(i) ? d.replaced.at(i) : snapped.count(i) ? snapped.at(i) : d.read(i);
     if (first) {
       for (const VertexAttribute& a : part.attributes)  // the rest pose: no morph offsets
         if (!is_morph_name(a.name)) out.attributes.push_back({a.name, a.kind, a.components, {}});
