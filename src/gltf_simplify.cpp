@@ -149,13 +149,8 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
   };
   if (options.vertex_lock.empty()) {
     // A Draco-compressed mesh's primitives meet at positions a quantization step apart: snapped
-    // together first (quantized_borders.h). The jobs of one mesh follow one another.
-    for (std::size_t first = 0, last; first < jobs.size(); first = last) {
-      std::vector<double> steps;
-      for (last = first; last < jobs.size() && info[jobs[last]].mesh == info[jobs[first]].mesh; ++last)
-        steps.push_back(info[jobs[last]].position_step);
-      snap_quantized_borders(std::span(meshes).subspan(first, last - first), steps);
-    }
+    // together first (quantized_borders.h).
+    snap_quantized_primitives(meshes, jobs, info);
     // (mesh, position) -> the first job that has it, and whether another has it too
     std::map<std::pair<std::size_t, std::array<double, 3>>, std::pair<std::size_t, bool>> owner;
     const auto at = [&](std::size_t j, std::size_t v) {

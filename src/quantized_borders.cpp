@@ -98,4 +98,15 @@ std::size_t snap_quantized_borders(std::span<Mesh> parts, std::span<const double
   return moved;
 }
 
+void snap_quantized_primitives(std::span<Mesh> meshes, std::span<const std::size_t> primitives,
+                               const std::vector<GltfPrimitiveInfo>& info) {
+  for (std::size_t first = 0, last; first < primitives.size(); first = last) {
+    std::vector<double> steps;
+    for (last = first;
+         last < primitives.size() && info[primitives[last]].mesh == info[primitives[first]].mesh; ++last)
+      steps.push_back(info[primitives[last]].position_step);
+    snap_quantized_borders(meshes.subspan(first, last - first), steps);
+  }
+}
+
 }  // namespace qem

@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <span>
 
+#include "qem/gltf.h"
 #include "qem/mesh.h"
 
 namespace qem {
@@ -20,5 +21,11 @@ namespace qem {
 /// matched exactly by the caller and so only snapped to quantized parts). Vertices of one part at
 /// one position move together. Returns the number of vertices moved.
 std::size_t snap_quantized_borders(std::span<Mesh> parts, std::span<const double> steps);
+
+/// snap_quantized_borders over the primitives of each glTF mesh: meshes[k] is primitive
+/// primitives[k] of a document whose primitives() are `info`, in document order (so that the
+/// primitives of one mesh follow one another), with their position_step.
+void snap_quantized_primitives(std::span<Mesh> meshes, std::span<const std::size_t> primitives,
+                               const std::vector<GltfPrimitiveInfo>& info);
 
 }  // namespace qem

@@ -1018,22 +1018,16 @@ Mesh GltfDocument::scene_mesh() const {
   // Draco-compressed primitives of one mesh joined where they meet, as simplify_document joins them
   // (quantized_borders.h): each was quantized in its own box.
   std::map<std::size_t, Mesh> snapped;
-  for (std::size_t first = 0, last; first < d.primitives.size(); first = last) {
-    std::vector<std::size_t> members;
-    std::vector<double> steps;
-    bool quantized = false;
-    for (last = first; last < d.primitives.size() && d.primitives[last].mesh == d.primitives[first].mesh;
-         ++last)
-      if (d.primitives[last].simplifiable && !d.replaced.count(last)) {
-        members.push_back(last), steps.push_back(d.primitives[last].position_step);
-        quantized |= steps.back() > 0;
-      }
-    if (!quantized || members.size() < 2) continue;
-    std::vector<Mesh> meshes;
-    for (std::size_t i : members) meshes.push_back(d.read(i));
-    snap_quantized_borders(meshes, steps);
-    for (std::size_t k = 0; k < members.size(); ++k) snapped[members[k]] = std::move(meshes[k]);
-  }
+  std::set<std::size_t> compressed;  // the meshes with a Draco-quantized primitive
+  for (const GltfPrimitiveInfo& p : d.primitives)
+    if (p.position_step > 0) compressed.insert(p.mesh);
+  std::vector<std::size_t> members;
+  std::vector<Mesh> meshes;
+  for (std::size_t i = 0; i < d.primitives.size(); ++i)
+    if (compressed.count(d.primitives[i].mesh) && d.primitives[i].simplifiable && !d.replaced.count(i))
+      members.push_back(i), meshes.push_back(d.read(i));
+  snap_quantized_primitives(meshes, members, d.primitives);
+  for (std::size_t k = 0; k < members.size(); ++k) snapped[members[k]] = std::move(meshes[k]);
   std::vector<Mat4> skin_world;  // the nodes' world matrices, when a part is skinned
   std::vector<char> reached;
   std::map<int, std::vector<Mat4>> skin_joints;  // per skin: skin_matrices

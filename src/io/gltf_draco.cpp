@@ -48,7 +48,9 @@ bool append_dequantized(const draco::PointCloud& mesh, const draco::PointAttribu
   draco::AttributeQuantizationTransform transform;
   if (!attribute.GetAttributeTransformData() || !transform.InitFromAttribute(attribute)) return false;
   const int n = attribute.num_components();
-  const int32_t max_quantized = (int32_t(1) << transform.quantization_bits()) - 1;
+  const int bits = transform.quantization_bits();
+  if (bits < 1 || bits > 30) return false;  // (libdraco's own bound)
+  const int32_t max_quantized = (int32_t(1) << bits) - 1;
   draco::Dequantizer dequantizer;
   if (n > 4 || !dequantizer.Init(transform.range(), max_quantized)) return false;
   step = double(transform.range()) / max_quantized;
