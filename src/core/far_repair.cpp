@@ -8,6 +8,7 @@
 #include <iterator>
 #include <numbers>
 #include <queue>
+#include <unordered_map>
 #include <vector>
 
 #include "core/attribute_weight.h"
@@ -46,6 +47,32 @@ constexpr std::array<SampleAt, kSamples> sample_order() {
 }
 constexpr std::array<SampleAt, kSamples> kOrder = sample_order();
 static_assert(kGrid == 4, "the edge's points in sample_order are written out for 4 subdivisions");
+
+// A triangle with its box, for asking whether it lies within a distance of a point: a triangle
+// whose box is farther is not. The box is widened by a margin far beyond the rounding of the
+// closest point on the triangle (relative 1e-9 of its coordinates), so skipping by it never
+// changes an answer that closest_point_on_triangle would give.
+struct BoxedTriangle {
+  Vec3 a, b, c, lo, hi;
+  static BoxedTriangle of(const Vec3& a, const Vec3& b, const Vec3& c) {
+    const double size = std::max({std::abs(a.x), std::abs(a.y), std::abs(a.z), std::abs(b.x), std::abs(b.y),
+                                  std::abs(b.z), std::abs(c.x), std::abs(c.y), std::abs(c.z)});
+    const double margin = 1e-9 * size;
+    return {a,
+            b,
+            c,
+            {std::min({a.x, b.x, c.x}) - margin, std::min({a.y, b.y, c.y}) - margin,
+             std::min({a.z, b.z, c.z}) - margin},
+            {std::max({a.x, b.x, c.x}) + margin, std::max({a.y, b.y, c.y}) + margin,
+             std::max({a.z, b.z, c.z}) + margin}};
+  }
+  /// The squared distance from q to the box (0 inside it).
+  double box_distance2(const Vec3& q) const {
+    const double dx = std::max({lo.x - q.x, q.x - hi.x, 0.0}), dy = std::max({lo.y - q.y, q.y - hi.y, 0.0}),
+                 dz = std::max({lo.z - q.z, q.z - hi.z, 0.0});
+    return dx * dx + dy * dy + dz * dz;
+  }
+};
 
 // What a face contributes: its samples' largest and summed squared distances to the input (the
 // sum times the face's area over the sample count: its side of GH97 §6.1's E).
@@ -1037,22 +1064,32 @@ class Repairer {
         }
     std::sort(context.begin(), context.end());
     context.erase(std::unique(context.begin(), context.end()), context.end());
-    const auto nearest2 = [&](const Vec3& q, const auto& faces, const auto& corner) {
-      double best = HUGE_VAL;
-      for (const auto& f : faces) {
-        const auto [a, b, c] = corner(f);
-        best = std::min(best, measure_detail::squared_distance(q, measure_detail::closest_point_on_triangle(q, a, b, c)));
-      }
-      return best;
-    };
-    const auto planned = [&](const Corners& t) { return std::array<Vec3, 3>{at(t[0], y), at(t[1], y), at(t[2], y)}; };
+    // Each sample asks only whether a face of a set lies within the limit, so the first face
+    // within ends the search, and a face whose box (widened far beyond the rounding of the
+    // closest-point computation) is farther is skipped: the same answers as the nearest distance.
+    std::vector<BoxedTriangle>& planned = scratch_planned_;
+    std::vector<BoxedTriangle>& rest = scratch_rest_;
+    std::vector<BoxedTriangle>& old = scratch_old_;
+    planned.clear(), rest.clear(), old.clear();
+    for (const Corners& t : p.faces)
+      planned.push_back(BoxedTriangle::of(at(t[0], y), at(t[1], y), at(t[2], y)));
     const auto current = [&](std::uint32_t f) {
-      return std::array<Vec3, 3>{x_[tri_[3 * f]], x_[tri_[3 * f + 1]], x_[tri_[3 * f + 2]]};
+      return BoxedTriangle::of(x_[tri_[3 * f]], x_[tri_[3 * f + 1]], x_[tri_[3 * f + 2]]);
     };
+    for (std::uint32_t f : context) rest.push_back(current(f));
+    for (std::uint32_t f : p.old) old.push_back(current(f));
     std::vector<std::uint32_t>& near = scratch_near_;
     near.clear();
     surface_.triangles_near(centre, radius, near);
     const double limit2 = limit * limit, radius2 = radius * radius;
+    const auto any_within = [limit2](const Vec3& q, const std::vector<BoxedTriangle>& faces) {
+      for (const BoxedTriangle& t : faces)
+        if (t.box_distance2(q) < limit2 &&
+            measure_detail::squared_distance(q, measure_detail::closest_point_on_triangle(q, t.a, t.b, t.c)) <
+                limit2)
+          return true;
+      return false;
+    };
     for (std::uint32_t t : near) {
       const std::array<double, 9> c = surface_.triangle(t);
       const Vec3 a{c[0], c[1], c[2]}, b{c[3], c[4], c[5]}, d{c[6], c[7], c[8]};
@@ -1063,11 +1100,9 @@ class Repairer {
         for (int j = 0; i + j <= m; ++j) {
           const Vec3 q = a + (b - a) * (double(i) / m) + (d - a) * (double(j) / m);
           if (measure_detail::squared_distance(q, centre) > radius2) continue;
-          const double made = nearest2(q, p.faces, planned);
-          if (made < limit2) continue;
-          const double rest = nearest2(q, context, current);
-          if (std::min(made, rest) < limit2) continue;
-          if (nearest2(q, p.old, current) < limit2) return false;
+          // Near the new faces, or near the faces round them: the input stays near.
+          if (any_within(q, planned) || any_within(q, rest)) continue;
+          if (any_within(q, old)) return false;
         }
     }
     return true;
@@ -1275,16 +1310,30 @@ class Repairer {
   // The best collapse of u into a neighbour (lowest energy), its faces within `limit`; false: none.
   // `border`: u is a border vertex, and goes into one of its two border neighbours (the one face of
   // that edge dies); a corner (a turn above kCornerDegrees, as the contractions keep) stays.
+  // Refusals are remembered until the mesh changes (forget_refused_collapses): the relocations ask
+  // again for the same flattest vertices at each far place, mostly at lower limits.
   bool plan_collapse(std::uint32_t u, double limit, bool border, Collapse& best) {
+    const std::uint64_t key = 2 * std::uint64_t(u) + (border ? 1 : 0);
+    if (const auto it = refused_below_.find(key); it != refused_below_.end() && limit <= it->second)
+      return false;
+    // Whether every target was refused for a reason that holds at any lower limit too.
+    bool refused_at_lower = true;
+    const auto refuse = [&] {
+      if (refused_at_lower) {
+        double& at = refused_below_[key];
+        at = std::max(at, limit);
+      }
+      return false;
+    };
     const std::vector<std::uint32_t> around = ring(u);
     for (std::uint32_t x : around)
-      if (held(x)) return false;
+      if (held(x)) return refuse();
     std::vector<std::uint32_t> targets = around;
     if (border) {
       targets = border_neighbours(u);
-      if (targets.size() != 2) return false;
+      if (targets.size() != 2) return refuse();
       const Vec3 in = normalized(x_[u] - x_[targets[0]]), out = normalized(x_[targets[1]] - x_[u]);
-      if (dot(in, out) < std::cos(kCornerDegrees * std::numbers::pi / 180)) return false;
+      if (dot(in, out) < std::cos(kCornerDegrees * std::numbers::pi / 180)) return refuse();
     }
     const std::size_t dying = border ? 1 : 2;
     bool found = false, sampled = false;
@@ -1316,7 +1365,14 @@ class Repairer {
       // Nothing left of u's part (a lone triangle), or a face twice (a tetrahedron's): refused, so
       // that no part vanishes or folds onto itself.
       if (c.faces.empty() || any_face_exists(c.faces)) continue;
-      if (!keeps_facing(c, {}) || !score_plan(c, {}, limit) || !input_stays_near(c, {}, limit)) continue;
+      if (!keeps_facing(c, {}) || !score_plan(c, {}, limit)) continue;
+      // One that would not be chosen over the best so far is not tested further (the same choice).
+      if (found && !(c.energy - c.old_energy < best.energy - best.old_energy)) continue;
+      // (Not monotone in the limit: a lower one may pass where this one refuses.)
+      if (!input_stays_near(c, {}, limit)) {
+        refused_at_lower = false;
+        continue;
+      }
       // (u's faces, and so the samples round them, are the same whichever v it goes into.)
       if (!sampled) sample_values(c.old, nullptr, scratch_samples_), sampled = true;
       if (!keeps_appearance(c, scratch_samples_)) continue;
@@ -1325,8 +1381,10 @@ class Repairer {
         found = true;
       }
     }
-    return found;
+    return found || refuse();
   }
+  // After a change to the mesh: no refusal holds any more.
+  void forget_refused_collapses() { refused_below_.clear(); }
 
   // Whether collapse c (scored: its points and their new faces) leaves the error of appearance of
   // its points and of the samples s round it (sample_values of c.old) as it was, or lowers it (to
@@ -1555,6 +1613,7 @@ class Repairer {
         continue;
       }
       stuck = 0;
+      forget_refused_collapses();
       const std::uint32_t w = collapse.u;
       Relocation r;
       r.removed = w, r.kept = collapse.v, r.point = split.point, r.at_point = split.at_point;
@@ -1647,6 +1706,8 @@ class Repairer {
   std::vector<double> d2_;                           // per point, its squared distance to its face
   std::vector<std::uint32_t> moved_;                 // vertices moved (ascending, once each)
   std::vector<std::uint32_t> scratch_points_, scratch_context_, scratch_near_, scratch_split_;
+  std::vector<BoxedTriangle> scratch_planned_, scratch_rest_, scratch_old_;  // input_stays_near
+  std::unordered_map<std::uint64_t, double> refused_below_;  // plan_collapse: 2 u + border -> limit
   std::vector<std::uint32_t> scratch_nearest_;  // per point of a flip or move, its nearest new face
   std::vector<double> scratch_d2_;
 };
