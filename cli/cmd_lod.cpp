@@ -162,9 +162,9 @@ int run_lod_mesh(const LodArgs& a) {
     opt.target_ratio = *std::min_element(a.ratios.begin(), a.ratios.end());
   // A level of 0 faces (or ratio 0) is the mesh as far as the checks allow.
   opt.as_far_as_possible = opt.target_faces == 0 && opt.target_ratio == 0;
-  // A record replays positions and faces only: with attributes (UVs, normals, colours) each level
-  // is a run of its own, which carries them.
-  const bool attributes = !mesh.attributes.empty();
+  // A record replays positions and faces only: with attributes (UVs, normals, colours) or face
+  // materials each level is a run of its own, which carries them.
+  const bool attributes = !mesh.attributes.empty() || !mesh.face_materials.empty();
   const double cpu_simplify0 = process_cpu_seconds();
   const SimplifyResult result = simplify(mesh, opt, attributes ? nullptr : &recorder);
   const double simplify_cpu = process_cpu_seconds() - cpu_simplify0;

@@ -197,11 +197,12 @@ int run_simplify(const SimplifyArgs& a) {
     opt.far_repair = far_repair_wanted(a.algorithm, opt);
   }
   const double load_s = t_load.seconds();
-  if (!a.record.empty() && !mesh.attributes.empty())
-    throw Error(a.input + ": --record keeps positions and faces only, and this mesh has attributes (" +
-                mesh.attributes.front().name +
-                ", ...) that a replay would lose; simplify without --record, or " +
-                "use `qem lod`, which makes each level with its attributes");
+  if (!a.record.empty() && (!mesh.attributes.empty() || !mesh.face_materials.empty()))
+    throw Error(a.input + ": --record keeps positions and faces only, and this mesh has " +
+                (mesh.attributes.empty() ? std::string("face materials")
+                                         : "attributes (" + mesh.attributes.front().name + ", ...)") +
+                " that a replay would lose; simplify without --record, or " +
+                "use `qem lod`, which makes each level with its attributes and materials");
 
   Stopwatch t_simplify;
   const double cpu0 = process_cpu_seconds();

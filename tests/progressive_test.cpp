@@ -358,6 +358,39 @@ TEST(Progressive, CliDoublePlyStaysDoubleInSimplifyLodAndReplay) {
   EXPECT_TRUE(read_record(dir + "/run.qrec").double_input);
 }
 
+TEST(Progressive, CliFaceColoursSurviveSimplifyAndLodAndRefuseARecord) {
+  // A PLY with face colours and no vertex attributes (Hoppe's cessna is such a file): its colours
+  // are materials, which the output keeps, in simplify and in each lod level; a record, which holds
+  // positions and faces only, is refused rather than replayed without them.
+  const std::string dir = test::temp_dir() + "/prog_cli_face_colours";
+  std::filesystem::create_directories(dir);
+  Mesh m = test::icosphere(4);
+  m.material_names = {"rgb(255,0,0)", "rgb(0,0,255)"};
+  for (std::size_t f = 0; f < m.face_count(); ++f) {
+    double x = 0;
+    for (int k = 0; k < 3; ++k) x += m.positions[3 * m.indices[3 * f + k]];
+    m.face_materials.push_back(x < 0 ? 0 : 1);
+  }
+  const std::string in = dir + "/coloured.ply";
+  save_mesh(in, m);
+  const auto check = [](const Mesh& out) {
+    EXPECT_EQ(out.material_names, (std::vector<std::string>{"rgb(255,0,0)", "rgb(0,0,255)"}));
+    ASSERT_EQ(out.face_materials.size(), out.face_count());
+    std::size_t red = 0;
+    for (std::uint32_t k : out.face_materials) red += k == 0;
+    EXPECT_GT(red, 0u);
+    EXPECT_LT(red, out.face_count());
+  };
+  ASSERT_EQ(run("simplify " + in + " " + dir + "/out.ply --ratio 0.1"), 0);
+  check(load_mesh(dir + "/out.ply"));
+  ASSERT_EQ(run("lod " + in + " " + dir + "/lod --ratios 0.5,0.1"), 0);
+  for (const view::ManifestLevel& level : view::read_lod_manifest(dir + "/lod/manifest.json"))
+    check(load_mesh(level.path));
+  EXPECT_NE(
+      run("simplify " + in + " " + dir + "/rec.ply --ratio 0.1 --record " + dir + "/run.qrec 2>/dev/null"),
+      0);
+}
+
 TEST(Progressive, CliLodWritesLevelsAndManifest) {
   const std::string dir = test::temp_dir() + "/prog_cli_lod";
   std::filesystem::create_directories(dir);
