@@ -133,12 +133,13 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
   std::vector<Mesh> meshes(jobs.size());
   for (std::size_t j = 0; j < jobs.size(); ++j) meshes[j] = doc.mesh(jobs[j]);
 
-  // The primitives of one mesh are one surface split by material. Where they meet (the same
-  // position), the shared budget simplifies them as one mesh whose faces carry their primitive as
-  // their material (merged_primitives.h): the common border is a seam whose sides collapse
-  // together. Per primitive, or where their attributes cannot be merged, each keeps the vertices it
-  // shares with another, so that the border stays closed instead of opening a crack. (Unless the
-  // caller locks vertices itself: its vertex_lock then applies to every primitive as given.)
+  // The primitives of one mesh are one surface split by material (and so are those of meshes that
+  // the same nodes draw, GltfPrimitiveInfo::placement). Where they meet (the same position), the
+  // shared budget simplifies them as one mesh whose faces carry their primitive as their material
+  // (merged_primitives.h): the common border is a seam whose sides collapse together. Per
+  // primitive, or where their attributes cannot be merged, each keeps the vertices it shares with
+  // another, so that the border stays closed instead of opening a crack. (Unless the caller locks
+  // vertices itself: its vertex_lock then applies to every primitive as given.)
   std::vector<Unit> units;
   std::vector<std::vector<std::uint8_t>> shared(jobs.size());
   std::vector<std::size_t> group(jobs.size());  // union-find over jobs that share a position
@@ -151,11 +152,11 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
     // A Draco-compressed mesh's primitives meet at positions a quantization step apart: snapped
     // together first (quantized_borders.h).
     snap_quantized_primitives(meshes, jobs, info);
-    // (mesh, position) -> the first job that has it, and whether another has it too
+    // (placement, position) -> the first job that has it, and whether another has it too
     std::map<std::pair<std::size_t, std::array<double, 3>>, std::pair<std::size_t, bool>> owner;
     const auto at = [&](std::size_t j, std::size_t v) {
       const double* p = &meshes[j].positions[3 * v];
-      return std::pair{info[jobs[j]].mesh, std::array<double, 3>{p[0], p[1], p[2]}};
+      return std::pair{info[jobs[j]].placement, std::array<double, 3>{p[0], p[1], p[2]}};
     };
     for (std::size_t j = 0; j < jobs.size(); ++j)
       for (std::size_t v = 0; v < meshes[j].vertex_count(); ++v) {
@@ -200,7 +201,7 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
   std::sort(units.begin(), units.end(),
             [](const Unit& a, const Unit& b) { return a.primitives[0] < b.primitives[0]; });
   for (Unit& u : units) {
-    u.world_scale = info[u.primitives[0]].world_scale;  // one mesh: the same nodes
+    u.world_scale = info[u.primitives[0]].world_scale;  // one placement: the same nodes
     u.faces = u.mesh.face_count(), u.vertices = u.mesh.vertex_count();
   }
   // Several units at once, each on one thread; one at a time, each with the caller's threads.

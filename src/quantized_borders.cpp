@@ -100,12 +100,17 @@ std::size_t snap_quantized_borders(std::span<Mesh> parts, std::span<const double
 
 void snap_quantized_primitives(std::span<Mesh> meshes, std::span<const std::size_t> primitives,
                                const std::vector<GltfPrimitiveInfo>& info) {
-  for (std::size_t first = 0, last; first < primitives.size(); first = last) {
+  std::map<std::size_t, std::vector<std::size_t>> by_placement;  // (in document order)
+  for (std::size_t k = 0; k < primitives.size(); ++k)
+    by_placement[info[primitives[k]].placement].push_back(k);
+  for (const auto& [placement, members] : by_placement) {
     std::vector<double> steps;
-    for (last = first;
-         last < primitives.size() && info[primitives[last]].mesh == info[primitives[first]].mesh; ++last)
-      steps.push_back(info[primitives[last]].position_step);
-    snap_quantized_borders(meshes.subspan(first, last - first), steps);
+    for (std::size_t k : members) steps.push_back(info[primitives[k]].position_step);
+    if (members.size() < 2 || *std::max_element(steps.begin(), steps.end()) <= 0) continue;
+    std::vector<Mesh> parts;
+    for (std::size_t k : members) parts.push_back(std::move(meshes[k]));
+    snap_quantized_borders(parts, steps);
+    for (std::size_t i = 0; i < members.size(); ++i) meshes[members[i]] = std::move(parts[i]);
   }
 }
 

@@ -22,9 +22,9 @@ namespace qem {
 /// one position move together. Returns the number of vertices moved.
 std::size_t snap_quantized_borders(std::span<Mesh> parts, std::span<const double> steps);
 
-/// snap_quantized_borders over the primitives of each glTF mesh: meshes[k] is primitive
-/// primitives[k] of a document whose primitives() are `info`, in document order (so that the
-/// primitives of one mesh follow one another), with their position_step.
+/// snap_quantized_borders over the primitives of each placement (GltfPrimitiveInfo::placement: one
+/// mesh, or meshes the same nodes draw): meshes[k] is primitive primitives[k] of a document whose
+/// primitives() are `info`, in document order, with their position_step.
 void snap_quantized_primitives(std::span<Mesh> meshes, std::span<const std::size_t> primitives,
                                const std::vector<GltfPrimitiveInfo>& info);
 

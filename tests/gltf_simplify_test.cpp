@@ -399,6 +399,36 @@ TEST(GltfSimplify, DracoCompressedPrimitivesStayJoined) {
   }
 }
 
+TEST(GltfSimplify, MeshesThatTheSameNodesDrawStayJoined) {
+  // An exporter that splits one object into a mesh per material puts each under its own node
+  // (Sketchfab's downloads: Object_0, Object_1, ... under one parent). Drawn by the same world
+  // matrices, the halves of a sphere in two meshes are joined as two primitives of one mesh are;
+  // a mesh drawn by other matrices too is another object.
+  Scene s = split_sphere([](double z) { return z > 0.3 ? 0 : 1; }, 2);
+  const json second = s.doc["meshes"][0]["primitives"][1];
+  s.doc["meshes"][0]["primitives"].erase(1);
+  s.doc["meshes"].push_back({{"primitives", json::array({second})}});
+  s.node(1, 1);  // as split_sphere's node for mesh 0
+  const qem::GltfDocument input = qem::GltfDocument::parse(s.text(), "two_meshes.gltf");
+  ASSERT_EQ(input.primitives().size(), 2u);
+  EXPECT_EQ(input.primitives()[0].placement, 0u);
+  EXPECT_EQ(input.primitives()[1].placement, 0u);
+  const std::size_t line = shared_positions(input);
+  ASSERT_GT(line, 20u);
+  for (bool per_mesh : {false, true}) {
+    SCOPED_TRACE(per_mesh ? "per mesh" : "shared budget");
+    const qem::GltfDocument doc = halves_to_a_tenth(s.text(), per_mesh);
+    if (per_mesh)
+      EXPECT_EQ(shared_positions(doc), line);
+    else
+      EXPECT_LT(shared_positions(doc), line);
+  }
+  s.node(1, 3);  // mesh 1 drawn a second time, three times larger
+  const qem::GltfDocument apart = qem::GltfDocument::parse(s.text(), "two_meshes.gltf");
+  EXPECT_EQ(apart.primitives()[0].placement, 0u);
+  EXPECT_EQ(apart.primitives()[1].placement, 1u);
+}
+
 TEST(GltfSimplify, MergedPrimitiveThatWouldVanishIsKept) {
   // CesiumMilkTruck's body, glass and window trim are one mesh of three primitives whose borders
   // meet. Merged and simplified with permissive seams to 1 %, the trim (six frames between the body

@@ -51,6 +51,11 @@ struct GltfPrimitiveInfo {
   /// each primitive in its own box, so where two primitives of one mesh meet, their positions
   /// differ by up to half of each one's spacing: simplify_document joins them within that.
   double position_step = 0;
+  /// Primitives whose meshes the default scene draws by exactly the same world matrices (not
+  /// skinned) share this number, the lowest such mesh index: an exporter that splits one object
+  /// into a mesh per material puts each under its own node, and their primitives meet where their
+  /// positions are equal. Otherwise it is `mesh`.
+  std::size_t placement = 0;
 };
 
 /// A loaded glTF file. Movable, not copyable.

@@ -459,23 +459,43 @@ void GltfDocument::Impl::measure_world_scales() {
   const std::vector<Mat4> world = node_world_matrices(m, reached);
   node_instances.assign(m.nodes.size(), {});
   std::vector<double> mesh_scale(m.meshes.size(), 0);
+  // Per mesh, the world matrices that draw it (sorted); a skinned mesh has none of its own.
+  std::vector<std::vector<Mat4>> placed_by(m.meshes.size());
+  std::vector<char> skinned(m.meshes.size(), 0);
   for (std::size_t n = 0; n < m.nodes.size(); ++n) {
     const tinygltf::Node& node = m.nodes[n];
     if (!reached[n] || node.mesh < 0 || static_cast<std::size_t>(node.mesh) >= m.meshes.size()) continue;
+    const auto mesh = static_cast<std::size_t>(node.mesh);
     double scale = 0;
     if (node.skin >= 0 && static_cast<std::size_t>(node.skin) < m.skins.size()) {
       for (const Mat4& joint : skin_matrices(m, node.skin, world, name)) scale = std::max(scale, largest_scale(joint));
+      skinned[mesh] = 1;
     } else {
       node_instances[n] = instance_matrices(m, node, name + ": node " + std::to_string(n));
       scale = node_instances[n].empty() ? largest_scale(world[n]) : 0;
-      for (const Mat4& instance : node_instances[n])
-        scale = std::max(scale, largest_scale(multiply(world[n], instance)));
+      if (node_instances[n].empty()) placed_by[mesh].push_back(world[n]);
+      for (const Mat4& instance : node_instances[n]) {
+        placed_by[mesh].push_back(multiply(world[n], instance));
+        scale = std::max(scale, largest_scale(placed_by[mesh].back()));
+      }
     }
-    double& s = mesh_scale[static_cast<std::size_t>(node.mesh)];
+    double& s = mesh_scale[mesh];
     if (std::isfinite(scale)) s = std::max(s, scale);
   }
   for (GltfPrimitiveInfo& p : primitives)
     if (mesh_scale[p.mesh] > 0) p.world_scale = mesh_scale[p.mesh];
+  // Meshes drawn by exactly the same world matrices (an exporter's one object split into a mesh
+  // per material, each under its own node) share a placement: their primitives meet where their
+  // positions are equal.
+  std::map<std::vector<Mat4>, std::size_t> first_placed;
+  std::vector<std::size_t> placement(m.meshes.size());
+  for (std::size_t mesh = 0; mesh < m.meshes.size(); ++mesh) {
+    placement[mesh] = mesh;
+    if (skinned[mesh] || placed_by[mesh].empty()) continue;
+    std::sort(placed_by[mesh].begin(), placed_by[mesh].end());
+    placement[mesh] = first_placed.try_emplace(placed_by[mesh], mesh).first->second;
+  }
+  for (GltfPrimitiveInfo& p : primitives) p.placement = placement[p.mesh];
 }
 
 Mesh GltfDocument::Impl::read(std::size_t i) const {
@@ -1015,16 +1035,16 @@ Mesh GltfDocument::scene_mesh() const {
   // Primitives of one node instance that share their vertex accessors (one primitive per
   // material over the same vertices, as save_mesh writes) share their vertices here too.
   std::map<std::pair<std::size_t, std::map<std::string, int>>, std::uint32_t> shared_base;
-  // Draco-compressed primitives of one mesh joined where they meet, as simplify_document joins them
+  // Draco-compressed primitives of one placement joined where they meet, as simplify_document joins them
   // (quantized_borders.h): each was quantized in its own box.
   std::map<std::size_t, Mesh> snapped;
-  std::set<std::size_t> compressed;  // the meshes with a Draco-quantized primitive
+  std::set<std::size_t> compressed;  // the placements with a Draco-quantized primitive
   for (const GltfPrimitiveInfo& p : d.primitives)
-    if (p.position_step > 0) compressed.insert(p.mesh);
+    if (p.position_step > 0) compressed.insert(p.placement);
   std::vector<std::size_t> members;
   std::vector<Mesh> meshes;
   for (std::size_t i = 0; i < d.primitives.size(); ++i)
-    if (compressed.count(d.primitives[i].mesh) && d.primitives[i].simplifiable && !d.replaced.count(i))
+    if (compressed.count(d.primitives[i].placement) && d.primitives[i].simplifiable && !d.replaced.count(i))
       members.push_back(i), meshes.push_back(d.read(i));
   snap_quantized_primitives(meshes, members, d.primitives);
   for (std::size_t k = 0; k < members.size(); ++k) snapped[members[k]] = std::move(meshes[k]);
