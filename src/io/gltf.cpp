@@ -491,7 +491,13 @@ void GltfDocument::Impl::measure_world_scales() {
   std::vector<std::size_t> placement(m.meshes.size());
   for (std::size_t mesh = 0; mesh < m.meshes.size(); ++mesh) {
     placement[mesh] = mesh;
-    if (skinned[mesh] || placed_by[mesh].empty()) continue;
+    // (A matrix that is not finite, from a broken file, has no order to sort or compare it by.)
+    const auto finite = [](const Mat4& w) {
+      return std::all_of(w.begin(), w.end(), [](double x) { return std::isfinite(x); });
+    };
+    if (skinned[mesh] || placed_by[mesh].empty() ||
+        !std::all_of(placed_by[mesh].begin(), placed_by[mesh].end(), finite))
+      continue;
     std::sort(placed_by[mesh].begin(), placed_by[mesh].end());
     placement[mesh] = first_placed.try_emplace(placed_by[mesh], mesh).first->second;
   }
