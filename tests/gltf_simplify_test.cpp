@@ -311,6 +311,22 @@ qem::GltfDocument halves_to_a_tenth(const std::string& text, bool per_mesh) {
   return doc;
 }
 
+/// halves_to_a_tenth in the shared budget, then per mesh: the line where the halves meet (`line`
+/// shared positions) is simplified in the first and kept as it is in the second. Both documents.
+std::array<qem::GltfDocument, 2> halves_in_both_modes(const std::string& text, std::size_t line) {
+  std::array<qem::GltfDocument, 2> docs;
+  for (bool per_mesh : {false, true}) {
+    SCOPED_TRACE(per_mesh ? "per mesh" : "shared budget");
+    qem::GltfDocument& doc = docs[per_mesh ? 1 : 0];
+    doc = halves_to_a_tenth(text, per_mesh);
+    if (per_mesh)
+      EXPECT_EQ(shared_positions(doc), line);
+    else
+      EXPECT_LT(shared_positions(doc), line);
+  }
+  return docs;
+}
+
 TEST(GltfSimplify, PrimitivesOfOneMeshStayJoined) {
   // Two halves of a sphere. Simplified apart, each would move or remove its side of the line where
   // they meet: a crack. With the shared budget they are simplified as one surface (the line a seam
@@ -323,13 +339,7 @@ TEST(GltfSimplify, PrimitivesOfOneMeshStayJoined) {
   ASSERT_EQ(qem::test::open_edges_welded(input.scene_mesh()), 0u);
   const std::size_t line = shared_positions(input);
   ASSERT_GT(line, 20u);
-  for (bool per_mesh : {false, true}) {
-    SCOPED_TRACE(per_mesh ? "per mesh" : "shared budget");
-    const qem::GltfDocument doc = halves_to_a_tenth(s.text(), per_mesh);
-    if (per_mesh)
-      EXPECT_EQ(shared_positions(doc), line);
-    else
-      EXPECT_LT(shared_positions(doc), line);
+  for (const qem::GltfDocument& doc : halves_in_both_modes(s.text(), line)) {
     EXPECT_EQ(doc.mesh(0).attributes.size(), 2u);  // NORMAL, TEXCOORD_0
     EXPECT_EQ(doc.mesh(1).attributes.size(), 1u);  // NORMAL
   }
@@ -415,14 +425,7 @@ TEST(GltfSimplify, MeshesThatTheSameNodesDrawStayJoined) {
   EXPECT_EQ(input.primitives()[1].placement, 0u);
   const std::size_t line = shared_positions(input);
   ASSERT_GT(line, 20u);
-  for (bool per_mesh : {false, true}) {
-    SCOPED_TRACE(per_mesh ? "per mesh" : "shared budget");
-    const qem::GltfDocument doc = halves_to_a_tenth(s.text(), per_mesh);
-    if (per_mesh)
-      EXPECT_EQ(shared_positions(doc), line);
-    else
-      EXPECT_LT(shared_positions(doc), line);
-  }
+  halves_in_both_modes(s.text(), line);
   s.node(1, 3);  // mesh 1 drawn a second time, three times larger
   const qem::GltfDocument apart = qem::GltfDocument::parse(s.text(), "two_meshes.gltf");
   EXPECT_EQ(apart.primitives()[0].placement, 0u);
