@@ -49,10 +49,14 @@ std::vector<std::uint8_t> border_vertices(const Mesh& m) {
 }  // namespace
 
 std::size_t snap_quantized_borders(std::span<Mesh> parts, std::span<const double> steps) {
-  double cell = 0;  // no two parts' tolerance exceeds the largest step
+  double largest = 0, size = 0;
   for (double s : steps)
-    if (std::isfinite(s)) cell = std::max(cell, s);
-  if (cell <= 0) return 0;
+    if (std::isfinite(s)) largest = std::max(largest, s);
+  if (largest <= 0) return 0;
+  for (const Mesh& m : parts)
+    for (double x : m.positions) size = std::max(size, std::abs(x));
+  // No two parts' tolerance (below) exceeds a cell, so a match is in a neighbouring one.
+  const double cell = 1.01 * largest + 4 * FLT_EPSILON * size;
   struct Entry {
     Point p;
     double step;
@@ -79,10 +83,8 @@ std::size_t snap_quantized_borders(std::span<Mesh> parts, std::span<const double
             if (it == grid.end()) continue;
             for (const Entry& e : it->second) {
               if (e.step + own <= 0) continue;  // two unquantized parts: matched exactly, not here
-              double d = 0, size = 0;
-              for (int a = 0; a < 3; ++a)
-                d = std::max(d, std::abs(p[a] - e.p[a])),
-                size = std::max({size, std::abs(p[a]), std::abs(e.p[a])});
+              double d = 0;
+              for (int a = 0; a < 3; ++a) d = std::max(d, std::abs(p[a] - e.p[a]));
               // half of each grid's step, and the rounding of the dequantized floats
               const double within = 0.5 * (e.step + own) * 1.01 + 4 * FLT_EPSILON * size;
               if (d <= within && d < best) best = d, snapped[v] = e.p;
