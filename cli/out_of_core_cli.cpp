@@ -60,6 +60,12 @@ int run_out_of_core(const std::string& input, const std::string& output, const S
   Stopwatch total;
   OutOfCoreReport report;
   SimplifyResult r = simplify_out_of_core(input, options, ooc, &report);
+  if (!report.unread.empty() && !out.quiet) {  // nothing dropped without a word
+    std::string names;
+    for (const std::string& n : report.unread) names += (names.empty() ? "" : ", ") + n;
+    std::fprintf(stderr, "qem: note: %s: out of core keeps positions and faces only; not carried: %s\n",
+                 input.c_str(), names.c_str());
+  }
   if (show && tty) std::fprintf(stderr, "\n");
   SaveOptions save;
   save.binary = !out.ascii;
@@ -72,13 +78,17 @@ int run_out_of_core(const std::string& input, const std::string& output, const S
                 ",\"seconds\":" + json_number(p.seconds) + ",\"cpu_seconds\":" + json_number(p.cpu_seconds) +
                 "}";
     phases += "]";
+    std::string unread = "[";
+    for (const std::string& n : report.unread)
+      unread += std::string(unread.size() > 1 ? "," : "") + json_string(n);
+    unread += "]";
     std::printf(
         "{\"tool\":\"qem\",\"out_of_core\":true,\"in_faces\":%llu,\"target_faces\":%zu,\"out_faces\":%zu,"
         "\"out_vertices\":%zu,\"clustered_faces\":%llu,\"grid_resolution\":%llu,\"grid_coarsenings\":%u,"
         "\"memory_limit_bytes\":%llu,"
         "\"peak_memory_bytes\":%llu,\"temp_bytes_written\":%llu,\"parts\":%u,\"total_s\":%s,\"cpu_s\":%s,"
         "\"peak_rss_mb\":%s,"
-        "\"max_error\":%s,\"max_error_rel\":%s,\"stop\":\"%s\",\"phases\":%s}\n",
+        "\"max_error\":%s,\"max_error_rel\":%s,\"stop\":\"%s\",\"phases\":%s,\"not_carried\":%s}\n",
         static_cast<unsigned long long>(report.input_faces), out.target_faces, r.mesh.face_count(),
         r.mesh.vertex_count(), static_cast<unsigned long long>(report.clustered_faces),
         static_cast<unsigned long long>(report.grid_resolution), report.grid_coarsenings,
@@ -87,7 +97,7 @@ int run_out_of_core(const std::string& input, const std::string& output, const S
         static_cast<unsigned long long>(report.temp_bytes_written), report.parts,
         json_number(total.seconds()).c_str(), json_number(process_cpu_seconds()).c_str(),
         json_number(peak_rss_mb()).c_str(), json_number(r.max_error).c_str(),
-        json_number(r.max_error_relative).c_str(), to_string(r.stop_reason), phases.c_str());
+        json_number(r.max_error_relative).c_str(), to_string(r.stop_reason), phases.c_str(), unread.c_str());
   }
   if (!out.quiet)
     std::fprintf(

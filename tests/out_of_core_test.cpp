@@ -210,6 +210,33 @@ TEST(OutOfCore, OpenSurfaceKeepsItsBorder) {
   EXPECT_EQ(entries(dir), 0u);
 }
 
+// The two phases carry positions and faces only: what else the PLY holds is named in the report
+// (and by the command line, on stderr and in --json), not dropped without a word.
+TEST(OutOfCore, ReportsWhatItDoesNotCarry) {
+  const std::string dir = fresh_dir("unread");
+  const std::string path = dir + "/coloured.ply";
+  Mesh m = test::icosphere(4);
+  m.attributes.push_back(
+      {"COLOR_0", AttributeKind::Color, 3, std::vector<double>(3 * m.vertex_count(), 0.5)});
+  m.material_names = {"rgb(255,0,0)"};
+  m.face_materials.assign(m.face_count(), 0);
+  save_mesh(path, m);
+  SimplifyOptions opt;
+  opt.target_ratio = 0.1;
+  OutOfCoreOptions ooc;
+  ooc.memory_limit = std::uint64_t(32) << 20;
+  ooc.temp_dir = dir;
+  OutOfCoreReport report;
+  simplify_out_of_core(path, opt, ooc, &report);
+  EXPECT_EQ(report.unread, (std::vector<std::string>{"vertex red", "vertex green", "vertex blue", "face red",
+                                                     "face green", "face blue"}));
+  save_mesh(path, test::icosphere(4));
+  simplify_out_of_core(path, opt, ooc, &report);
+  EXPECT_TRUE(report.unread.empty());
+  fs::remove(path);
+  EXPECT_EQ(entries(dir), 0u);
+}
+
 // A sheet made two-sided by a reversed copy of each face: every clustered triple comes out twice,
 // once a side, which the mod-2 rule for folds dropped, whole: the output had no face at all. The
 // copies of one input triangle count once; phase 2 keeps one side and puts the rims' twins back.

@@ -66,6 +66,9 @@ struct OutOfCoreReport {
   std::uint64_t peak_memory_bytes = 0;  ///< peak resident set of the process (VmHWM)
   unsigned parts = 1;                   ///< parts of phase 2
   std::vector<OutOfCorePhase> phases;
+  /// What of the input the two phases do not carry (positions and faces only): a PLY's other
+  /// vertex and face properties ("vertex red", "face red"...) and other elements, by name.
+  std::vector<std::string> unread;
 };
 
 /// Half of the memory the kernel reports available (MemAvailable in /proc/meminfo), at least

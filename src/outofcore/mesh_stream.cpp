@@ -309,6 +309,26 @@ std::uint64_t MeshStream::file_size() const { return impl_->size; }
 std::uint64_t MeshStream::bytes_read() const { return impl_->read_total; }
 const std::string& MeshStream::path() const { return impl_->path; }
 
+std::vector<std::string> MeshStream::unread() const {
+  const Impl& m = *impl_;
+  std::vector<std::string> out;
+  if (!m.ply) return out;
+  for (std::size_t e = 0; e < m.elements.size(); ++e) {
+    const Element& element = m.elements[e];
+    if (int(e) != m.vertex_element && int(e) != m.face_element) {
+      if (element.count > 0) out.push_back(element.name);
+      continue;
+    }
+    for (std::size_t k = 0; k < element.props.size(); ++k) {
+      const bool read = int(e) == m.vertex_element
+                            ? int(k) == m.axis[0] || int(k) == m.axis[1] || int(k) == m.axis[2]
+                            : int(k) == m.face_list;
+      if (!read) out.push_back(element.name + " " + element.props[k].name);
+    }
+  }
+  return out;
+}
+
 bool MeshStream::float_vertex_layout(std::uint64_t& offset, std::size_t& row, std::size_t at[3]) const {
   const Impl& m = *impl_;
   if (!m.ply || m.swap) return false;

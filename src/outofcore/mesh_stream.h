@@ -8,6 +8,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace qem::outofcore {
 
@@ -31,6 +32,11 @@ class MeshStream {
   /// Bytes read from the file so far (all passes), for progress reports.
   std::uint64_t bytes_read() const;
   const std::string& path() const;
+
+  /// PLY: what the stream does not read of the vertex and face elements (their other properties:
+  /// normals, colours, texture coordinates...), as "element property"; other elements are named
+  /// whole. Empty for an STL.
+  std::vector<std::string> unread() const;
 
   /// PLY: every vertex in order, a chunk at a time: `xyz` holds 3 * n coordinates.
   void read_vertices(const std::function<void(const double* xyz, std::size_t n)>& chunk);

@@ -489,6 +489,7 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
   MeshStream in(path);
   report.input_faces = in.face_count();
   report.input_vertices = in.vertex_count();
+  report.unread = in.unread();
   const bool soup = !in.indexed();
   // A ratio is of the input's faces, not of the clustered mesh phase 2 starts from.
   SimplifyOptions options = input_options;
