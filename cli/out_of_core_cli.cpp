@@ -60,13 +60,13 @@ int run_out_of_core(const std::string& input, const std::string& output, const S
   Stopwatch total;
   OutOfCoreReport report;
   SimplifyResult r = simplify_out_of_core(input, options, ooc, &report);
+  if (show && tty) std::fprintf(stderr, "\n");
   if (!report.unread.empty() && !out.quiet) {  // nothing dropped without a word
     std::string names;
     for (const std::string& n : report.unread) names += (names.empty() ? "" : ", ") + n;
     std::fprintf(stderr, "qem: note: %s: out of core keeps positions and faces only; not carried: %s\n",
                  input.c_str(), names.c_str());
   }
-  if (show && tty) std::fprintf(stderr, "\n");
   SaveOptions save;
   save.binary = !out.ascii;
   save.double_precision = out.double_values;
