@@ -9,6 +9,9 @@
 #include <utility>
 #include <vector>
 
+#include "core/same_position.h"
+#include "core/valid_pairs.h"
+
 namespace qem {
 namespace {
 
@@ -22,27 +25,12 @@ Point position(const Mesh& m, std::size_t v) {
 /// Whether each vertex of `m` lies on a border: an edge of one face, the mesh welded by position
 /// (its seams, vertices split at one position, are not borders).
 std::vector<std::uint8_t> border_vertices(const Mesh& m) {
-  std::map<Point, std::uint32_t> weld;
-  std::vector<std::uint32_t> id(m.vertex_count());
-  for (std::size_t v = 0; v < id.size(); ++v)
-    id[v] = weld.try_emplace(position(m, v), std::uint32_t(weld.size())).first->second;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
-  edges.reserve(m.indices.size());
-  for (std::size_t f = 0; f < m.face_count(); ++f)
-    for (int c = 0; c < 3; ++c) {
-      const std::uint32_t a = id[m.indices[3 * f + c]], b = id[m.indices[3 * f + (c + 1) % 3]];
-      if (a != b) edges.emplace_back(std::min(a, b), std::max(a, b));
-    }
-  std::sort(edges.begin(), edges.end());
-  std::vector<std::uint8_t> welded_border(weld.size(), 0);
-  for (std::size_t i = 0; i < edges.size();) {
-    std::size_t j = i;
-    while (j < edges.size() && edges[j] == edges[i]) ++j;
-    if (j - i == 1) welded_border[edges[i].first] = welded_border[edges[i].second] = 1;
-    i = j;
-  }
-  std::vector<std::uint8_t> border(id.size());
-  for (std::size_t v = 0; v < id.size(); ++v) border[v] = welded_border[id[v]];
+  const std::vector<std::uint32_t> first = core::first_at_same_position(MeshView(m), 1);
+  std::vector<std::uint32_t> welded(m.indices.size());
+  for (std::size_t i = 0; i < welded.size(); ++i) welded[i] = first[m.indices[i]];
+  const std::vector<std::uint8_t> on = core::border_vertices(welded, m.vertex_count(), 1);
+  std::vector<std::uint8_t> border(m.vertex_count());
+  for (std::size_t v = 0; v < border.size(); ++v) border[v] = on[first[v]];
   return border;
 }
 

@@ -49,6 +49,14 @@ std::size_t entries(const std::string& dir) {
   return std::size_t(std::distance(fs::directory_iterator(dir), fs::directory_iterator()));
 }
 
+/// Out-of-core options with `memory_limit` bytes and the temporary files in `dir`.
+OutOfCoreOptions limited(std::uint64_t memory_limit, const std::string& dir) {
+  OutOfCoreOptions ooc;
+  ooc.memory_limit = memory_limit;
+  ooc.temp_dir = dir;
+  return ooc;
+}
+
 /// The 327,680-face bumpy sphere (closed), streamed to disk once.
 const std::string& big_sphere() {
   static const std::string path = [] {
@@ -84,9 +92,7 @@ TEST(OutOfCore, ForcedRunMeetsTargetWithoutCracksAndNearInCoreError) {
   ASSERT_EQ(test::boundary_edges(input), 0u);
   SimplifyOptions opt;
   opt.target_faces = 5000;
-  OutOfCoreOptions ooc;
-  ooc.memory_limit = kTinyLimit;
-  ooc.temp_dir = dir;
+  OutOfCoreOptions ooc = limited(kTinyLimit, dir);
   OutOfCoreReport report;
   SimplifyResult r = simplify_out_of_core(big_sphere(), opt, ooc, &report);
   EXPECT_EQ(entries(dir), 0u);
@@ -138,9 +144,7 @@ TEST(OutOfCore, NoisySurfaceKeepsTheInCoreHausdorffDistance) {
   const Mesh input = load_mesh(path);  // as float, the precision both runs read
   SimplifyOptions opt;
   opt.target_ratio = 0.1;
-  OutOfCoreOptions ooc;
-  ooc.memory_limit = std::uint64_t(32) << 20;  // ~80k clustered faces: 2.4x the target
-  ooc.temp_dir = dir;
+  OutOfCoreOptions ooc = limited(std::uint64_t(32) << 20, dir);  // ~80k clustered faces: 2.4x the target
   OutOfCoreReport report;
   const SimplifyResult r = simplify_out_of_core(path, opt, ooc, &report);
   const SimplifyResult in_core = simplify(input, opt);
@@ -174,9 +178,7 @@ TEST(OutOfCore, OpenSurfaceKeepsItsBorder) {
   const Mesh input = load_mesh(path);
   SimplifyOptions opt;
   opt.target_ratio = 0.1;
-  OutOfCoreOptions ooc;
-  ooc.memory_limit = std::uint64_t(32) << 20;
-  ooc.temp_dir = dir;
+  OutOfCoreOptions ooc = limited(std::uint64_t(32) << 20, dir);
   OutOfCoreReport report;
   const SimplifyResult r = simplify_out_of_core(path, opt, ooc, &report);
   const SimplifyResult in_core = simplify(input, opt);
@@ -223,9 +225,7 @@ TEST(OutOfCore, ReportsWhatItDoesNotCarry) {
   save_mesh(path, m);
   SimplifyOptions opt;
   opt.target_ratio = 0.1;
-  OutOfCoreOptions ooc;
-  ooc.memory_limit = std::uint64_t(32) << 20;
-  ooc.temp_dir = dir;
+  OutOfCoreOptions ooc = limited(std::uint64_t(32) << 20, dir);
   OutOfCoreReport report;
   simplify_out_of_core(path, opt, ooc, &report);
   EXPECT_EQ(report.unread, (std::vector<std::string>{"vertex red", "vertex green", "vertex blue", "face red",
@@ -251,9 +251,7 @@ TEST(OutOfCore, TwoSidedSheetIsKeptWithItsRimClosed) {
   ASSERT_EQ(test::open_edges_welded(sheet), 0u);
   SimplifyOptions opt;
   opt.target_faces = 2000;
-  OutOfCoreOptions ooc;
-  ooc.memory_limit = std::uint64_t(16) << 20;
-  ooc.temp_dir = dir;
+  OutOfCoreOptions ooc = limited(std::uint64_t(16) << 20, dir);
   OutOfCoreReport report;
   const SimplifyResult r = simplify_out_of_core(path, opt, ooc, &report);
   EXPECT_LT(report.clustered_faces, sheet.face_count() / 2);  // it really clustered
@@ -284,9 +282,7 @@ TEST(OutOfCore, RefitFitsTheInputNotTheClusteredMesh) {
   opt.refit_rounds = 2;
   opt.refit_points_per_vertex = 8;
   opt.refit_by_reduction = true;
-  OutOfCoreOptions ooc;
-  ooc.memory_limit = std::uint64_t(32) << 20;
-  ooc.temp_dir = dir;
+  OutOfCoreOptions ooc = limited(std::uint64_t(32) << 20, dir);
   OutOfCoreReport report;
   const SimplifyResult r = simplify_out_of_core(path, opt, ooc, &report);
   EXPECT_EQ(entries(dir), 1u);  // the input; no temporary left
@@ -318,9 +314,7 @@ TEST(OutOfCore, DistanceBoundIsRefusedBeforeAnyWork) {
   SimplifyOptions opt;
   opt.target_faces = 5000;
   opt.max_distance = 0.01;
-  OutOfCoreOptions ooc;
-  ooc.memory_limit = kTinyLimit;
-  ooc.temp_dir = dir;
+  OutOfCoreOptions ooc = limited(kTinyLimit, dir);
   try {
     simplify_out_of_core(big_sphere(), opt, ooc);
     ADD_FAILURE() << "a distance bound out of core was accepted";
@@ -334,9 +328,8 @@ TEST(OutOfCore, FloatPositionsAreMappedFromTheInputOthersFromATemporaryFile) {
   const std::string dir = fresh_dir("mapped");
   SimplifyOptions opt;
   opt.target_faces = 3000;
-  OutOfCoreOptions ooc;
-  ooc.memory_limit = std::uint64_t(4) << 20;  // the 163,842 positions (1.9 MB) exceed a third of it
-  ooc.temp_dir = dir;
+  OutOfCoreOptions ooc =
+      limited(std::uint64_t(4) << 20, dir);  // the 163,842 positions (1.9 MB) exceed a third of it
   // The generator's PLY holds float x, y, z: mapped from the file itself, only the clustered
   // faces (three 8-byte cell keys each) reach the temporary folder.
   OutOfCoreReport mapped;
@@ -371,9 +364,7 @@ TEST(OutOfCore, SameResultOnAnyNumberOfThreads) {
   const std::string dir = fresh_dir("threads");
   SimplifyOptions opt;
   opt.target_faces = 4000;
-  OutOfCoreOptions ooc;
-  ooc.memory_limit = kTinyLimit;
-  ooc.temp_dir = dir;
+  OutOfCoreOptions ooc = limited(kTinyLimit, dir);
   ooc.parts = 2;
   std::vector<Mesh> results;
   for (unsigned threads : {1u, 2u, 3u}) {
@@ -400,9 +391,7 @@ TEST(OutOfCore, Phase2InputIsAMultipleOfTheTarget) {
   const std::string dir = fresh_dir("phase2_cap");
   SimplifyOptions opt;
   opt.target_faces = 1000;
-  OutOfCoreOptions ooc;
-  ooc.memory_limit = std::uint64_t(1) << 30;
-  ooc.temp_dir = dir;
+  OutOfCoreOptions ooc = limited(std::uint64_t(1) << 30, dir);
   ooc.parts = 1;
   ooc.phase2_faces_per_target = 8;
   OutOfCoreReport capped, free;
@@ -421,9 +410,7 @@ TEST(OutOfCore, FullDiskMidwayLeavesNoTemporaryFile) {
   const std::string dir = fresh_dir("full_disk");
   SimplifyOptions opt;
   opt.target_faces = 5000;
-  OutOfCoreOptions ooc;
-  ooc.memory_limit = kTinyLimit;
-  ooc.temp_dir = dir;
+  OutOfCoreOptions ooc = limited(kTinyLimit, dir);
   // The clustered faces take ~1 MB: fail after the first 64 KB of them reach the disk.
   outofcore::inject_write_failure_after(outofcore::temp_bytes_written() + 65536);
   try {
@@ -441,9 +428,7 @@ TEST(OutOfCore, CancelLeavesNoTemporaryFile) {
   const std::string dir = fresh_dir("cancel");
   SimplifyOptions opt;
   opt.target_faces = 5000;
-  OutOfCoreOptions ooc;
-  ooc.memory_limit = kTinyLimit;
-  ooc.temp_dir = dir;
+  OutOfCoreOptions ooc = limited(kTinyLimit, dir);
   ooc.progress = [](const OutOfCoreProgress& p) { return std::string(p.phase) != "simplifying"; };
   EXPECT_THROW(simplify_out_of_core(big_sphere(), opt, ooc), Error);
   EXPECT_EQ(entries(dir), 0u);
@@ -471,9 +456,7 @@ TEST(OutOfCore, StlSoupAndRatioOfTheInput) {
   save_mesh(stl, outofcore::bumpy_sphere(80000));
   SimplifyOptions opt;
   opt.target_ratio = 0.02;  // of the input's 81,920 faces, not of the clustered mesh's
-  OutOfCoreOptions ooc;
-  ooc.memory_limit = std::uint64_t(4) << 20;
-  ooc.temp_dir = dir;
+  OutOfCoreOptions ooc = limited(std::uint64_t(4) << 20, dir);
   OutOfCoreReport report;
   SimplifyResult r = simplify_out_of_core(stl, opt, ooc, &report);
   EXPECT_EQ(report.input_faces, 81920u);
@@ -491,9 +474,7 @@ TEST(OutOfCore, TruncatedOrBrokenInputIsAClearError) {
   const std::string bytes = slurp(big_sphere());
   SimplifyOptions opt;
   opt.target_faces = 5000;
-  OutOfCoreOptions ooc;
-  ooc.memory_limit = kTinyLimit;
-  ooc.temp_dir = dir;
+  OutOfCoreOptions ooc = limited(kTinyLimit, dir);
   auto error_of = [&](const std::string& contents) {
     const std::string p = dir + "/broken.ply";
     std::ofstream(p, std::ios::binary) << contents;
