@@ -66,14 +66,16 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
       ->delimiter(',');
   sub->add_option(
          "--seams", a.seams,
-         "With attributes, seams (UV seams, normal creases, colour and material boundaries): strict "
-         "(a collapse runs only along a seam, both sides together), creases (as strict along UV seams "
-         "and material boundaries, but a collapse may cross a normal crease or a colour boundary when "
-         "its error, the attribute error included, allows; gltfpack's -sp), or "
-         "permissive (UV seams may be crossed too: reaches targets that many small UV charts block, at "
-         "some UV quality, and can smear a texture or lose a feature drawn in a small chart); "
-         "docs/attributes.md")
-      ->check(CLI::IsMember({"strict", "permissive", "creases"}))
+         "With attributes, seams (UV seams, normal creases, colour and material boundaries): junctions "
+         "(a collapse runs only along a seam, both sides together, except that a vertex where three or "
+         "more charts, creases or colours meet may merge into a neighbouring such vertex when its "
+         "error, the attribute error included, allows: meshoptimizer's default), strict (as junctions, "
+         "but those vertices never move), creases (as strict along UV seams and material boundaries, "
+         "but a collapse may cross a normal crease or a colour boundary when its error allows; "
+         "gltfpack's -sp), or permissive (UV seams may be crossed too: reaches targets that many small "
+         "UV charts block, at some UV quality, and can smear a texture or lose a feature drawn in a "
+         "small chart); docs/attributes.md")
+      ->check(CLI::IsMember({"junctions", "strict", "permissive", "creases"}))
       ->capture_default_str();
   sub->add_option("--lock", a.lock,
                   "Vertices that never move and are never removed: seams (every position with more than "
@@ -204,6 +206,7 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
   }
   opt.permissive_seams = a.seams == "permissive" || a.seams == "creases";
   opt.permissive_keeps_uv_seams = a.seams == "creases";
+  opt.fixed_seam_junctions = a.seams == "strict";
   opt.fit_attributes = a.attribute_fit;
   for (const std::string& what : a.lock) {
     if (what == "seams") opt.lock_seams = true;

@@ -51,6 +51,17 @@ std::vector<std::uint8_t> seam_vertices(const Mesh& m) {
   return seam;
 }
 
+// The positions on faces of more than one material.
+std::set<Point> on_material_boundary(const Mesh& m) {
+  std::map<Point, std::set<std::uint32_t>> at;
+  for (std::size_t f = 0; f < m.face_count(); ++f)
+    for (int k = 0; k < 3; ++k) at[position(m, m.indices[3 * f + k])].insert(m.face_materials[f]);
+  std::set<Point> out;
+  for (const auto& [p, materials] : at)
+    if (materials.size() > 1) out.insert(p);
+  return out;
+}
+
 }  // namespace
 
 TEST(Seams, UvCubeAndSphereStayClosedThroughTheRefit) {
@@ -204,20 +215,13 @@ TEST(Seams, PermissiveCrossesSeamsToReachTheTarget) {
   // merging the two materials.
   const Mesh in = uv_cube(16, 0.1, false, 2);
   ASSERT_EQ(open_edges_welded(in), 0u);
-  const auto both_materials = [](const Mesh& m) {
-    std::map<Point, std::set<std::uint32_t>> at;
-    for (std::size_t f = 0; f < m.face_count(); ++f)
-      for (int k = 0; k < 3; ++k) at[position(m, m.indices[3 * f + k])].insert(m.face_materials[f]);
-    std::set<Point> out;
-    for (const auto& [p, materials] : at)
-      if (materials.size() > 1) out.insert(p);
-    return out;
-  };
-  const std::set<Point> boundary = both_materials(in);
+  const std::set<Point> boundary = on_material_boundary(in);
   SimplifyOptions o;
   o.target_faces = 150;
+  o.fixed_seam_junctions = true;
   const SimplifyResult strict = simplify(in, o);
   EXPECT_GT(strict.mesh.face_count(), 2 * o.target_faces) << "the mesh does not test what it should";
+  o.fixed_seam_junctions = false;
   o.permissive_seams = true;
   o.refit_rounds = 2;
   for (Scheme scheme : {Scheme::Passes, Scheme::Greedy}) {
@@ -230,9 +234,55 @@ TEST(Seams, PermissiveCrossesSeamsToReachTheTarget) {
     ASSERT_EQ(r.mesh.face_materials.size(), r.mesh.face_count());
     for (std::size_t f = 0; f < r.mesh.face_count(); ++f)
       EXPECT_EQ(r.mesh.face_materials[f], in.face_materials[r.face_source[f]]);
-    for (const Point& p : both_materials(r.mesh))
+    for (const Point& p : on_material_boundary(r.mesh))
       EXPECT_TRUE(boundary.count(p)) << "a point of both materials left the material boundary";
   }
+}
+
+TEST(Seams, JunctionsMergeIntoJunctionsAndNothingElseCrosses) {
+  // The default seams (fixed_seam_junctions false): a vertex where three or more charts meet may
+  // collapse onto another such vertex, so a cube of 2 x 2-cell charts, two materials, goes further
+  // than with junctions fixed, with no crack and the materials apart, and every output vertex
+  // stays on the input's seams where it was one.
+  const Mesh in = uv_cube(16, 0.1, false, 2);
+  const std::set<Point> boundary = on_material_boundary(in);
+  SimplifyOptions o;
+  o.target_faces = 150;
+  o.fixed_seam_junctions = true;
+  const SimplifyResult fixed = simplify(in, o);
+  o.fixed_seam_junctions = false;
+  std::set<Point> seams;
+  const std::vector<std::uint8_t> on_seam = seam_vertices(in);
+  for (std::uint32_t v = 0; v < in.vertex_count(); ++v)
+    if (on_seam[v]) seams.insert(position(in, v));
+  for (Scheme scheme : {Scheme::Passes, Scheme::Greedy}) {
+    o.scheme = scheme;
+    const SimplifyResult r = simplify(in, o);
+    SCOPED_TRACE(to_string(scheme));
+    EXPECT_LT(r.mesh.face_count(), fixed.mesh.face_count() * 3 / 4) << "no junction merged";
+    EXPECT_EQ(open_edges_welded(r.mesh), 0u) << "a crack opened";
+    for (std::size_t f = 0; f < r.mesh.face_count(); ++f)
+      EXPECT_EQ(r.mesh.face_materials[f], in.face_materials[r.face_source[f]]);
+    for (const Point& p : on_material_boundary(r.mesh))
+      EXPECT_TRUE(boundary.count(p)) << "a point of both materials left the material boundary";
+    const std::vector<std::uint8_t> out_seam = seam_vertices(r.mesh);
+    for (std::uint32_t v = 0; v < r.mesh.vertex_count(); ++v)
+      if (out_seam[v]) {
+        EXPECT_TRUE(seams.count(position(r.mesh, v))) << "a seam left its line";
+      }
+  }
+  // One junction only (four charts meeting at the middle of a grid): nothing to merge it into, so
+  // the run is exactly that with junctions fixed; a seam of two charts is never crossed.
+  const Mesh quarters = chart_grid(16, 8);
+  o.scheme = Scheme::Passes;
+  o.target_faces = 1;
+  const SimplifyResult merged = simplify(quarters, o);
+  o.fixed_seam_junctions = true;
+  const SimplifyResult kept = simplify(quarters, o);
+  EXPECT_GT(kept.mesh.face_count(), o.target_faces) << "the mesh does not test what it should";
+  EXPECT_EQ(merged.mesh.indices, kept.mesh.indices);
+  EXPECT_EQ(merged.mesh.positions, kept.mesh.positions);
+  EXPECT_EQ(merged.mesh.attributes[0].values, kept.mesh.attributes[0].values);
 }
 
 TEST(Seams, ProtectedVerticesKeepTheirSeamsInPermissiveMode) {
@@ -241,6 +291,7 @@ TEST(Seams, ProtectedVerticesKeepTheirSeamsInPermissiveMode) {
   const std::vector<std::uint8_t> all(in.vertex_count(), 1);
   SimplifyOptions o;
   o.target_faces = 40;
+  o.fixed_seam_junctions = true;
   const SimplifyResult strict = simplify(in, o);
   EXPECT_GT(strict.mesh.face_count(), o.target_faces) << "the mesh does not test what it should";
   o.permissive_seams = true;
@@ -264,6 +315,7 @@ TEST(Seams, CreasesModeCrossesCreasesButNoUvSeam) {
   // exactly what permissive makes, which crosses them to go further than strict.
   SimplifyOptions o;
   o.target_faces = 40;
+  o.fixed_seam_junctions = true;
   const Mesh charts = chart_grid(24, 3);
   const SimplifyResult strict = simplify(charts, o);
   EXPECT_GT(strict.mesh.face_count(), o.target_faces) << "the mesh does not test what it should";
@@ -461,7 +513,8 @@ TEST(Seams, CommandLinePermissiveReachesTheTarget) {
   const std::string dir = test::temp_dir();
   const std::string obj = dir + "/seams_charts.obj", out = dir + "/seams_charts_out.obj";
   save_mesh(obj, chart_grid(40, 2));
-  CliRun strict = run_cli("simplify " + obj + " " + out + " --faces 160 --json --quiet --force");
+  CliRun strict =
+      run_cli("simplify " + obj + " " + out + " --faces 160 --seams strict --json --quiet --force");
   ASSERT_EQ(strict.exit_code, 0) << strict.out;
   EXPECT_EQ(strict.out.find("\"out_faces\":160"), std::string::npos) << strict.out;
   CliRun permissive = run_cli("simplify " + obj + " " + out + " --faces 160 --seams permissive --json --quiet --force");

@@ -177,6 +177,17 @@ struct SimplifyOptions {
   /// With attributes: every vertex on a seam (UV seam, normal crease, colour or material boundary,
   /// mirror line: any position with more than one attribute set) is locked as by vertex_lock.
   bool lock_seams = false;
+  /// With attributes, without permissive_seams: true = a vertex where three or more wedges meet (a
+  /// junction of UV charts, creases or colour regions) never moves and is never removed (`--seams
+  /// strict`). false (default, `--seams junctions`): such a junction may collapse along an
+  /// edge onto another junction, its wedges that meet none of the survivor's on the edge's faces
+  /// merging into the survivor's wedge of the same material nearest in value, when the cost, which
+  /// then includes ten times the attribute error of those merges, allows (meshoptimizer's default
+  /// for its "complex" vertices). Every other seam vertex still moves only along its seam, both
+  /// sides together. Junctions that may never merge block targets on meshes with many charts or
+  /// creases; the error term keeps a merge to where its attributes differ little
+  /// (docs/attributes.md, "Seam junctions").
+  bool fixed_seam_junctions = false;
   /// With attributes: a collapse may cross a UV seam, normal crease or colour boundary (never a
   /// material boundary, never at a protected vertex) when its cost, which then includes the
   /// attribute error of merging the two sides, allows (meshoptimizer's SimplifyPermissive). Reaches

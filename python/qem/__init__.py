@@ -232,7 +232,7 @@ def _options(*, target_faces, target_ratio, target_vertices, max_error, max_erro
              threshold_relative, weighting, placement, boundary_weight, lock_border, inversion, max_turn,
              allow_non_manifold, scheme, refit, threads, record, keep_components=True, prune=None,
              prune_relative=None, exact_border=True, forget=_FORGET, forget_attributes=False, two_sided="rims",
-             seams="strict"):
+             seams="junctions"):
     o = _qem.SimplifyOptions()
 
     def count(name, value):
@@ -316,10 +316,11 @@ def _options(*, target_faces, target_ratio, target_vertices, max_error, max_erro
         raise ValueError(f"forget: expected a factor in [0, 1) (0 = never), got {forget!r}")
     o.forget = float(forget)
     o.forget_attributes = bool(forget_attributes)
-    if seams not in ("strict", "creases", "permissive"):
-        raise ValueError(f"seams: expected one of strict, creases, permissive, got {seams!r}")
-    o.permissive_seams = seams != "strict"
+    if seams not in ("junctions", "strict", "creases", "permissive"):
+        raise ValueError(f"seams: expected one of junctions, strict, creases, permissive, got {seams!r}")
+    o.permissive_seams = seams in ("creases", "permissive")
     o.permissive_keeps_uv_seams = seams == "creases"
+    o.fixed_seam_junctions = seams == "strict"
 
     if refit in (None, False):
         refit = "none"
@@ -362,7 +363,7 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
              prune_relative: Optional[float] = None, exact_border: bool = True, attributes: Optional[dict] = None,
              attribute_weights: Optional[dict] = None, fit_attributes: bool = False, vertex_lock=None,
              return_mapping: bool = False, far_repair: Optional[bool] = None, two_sided: str = "rims",
-             seams: str = "strict", record: bool = False, progress: Optional[Callable[[float], Optional[bool]]] = None) -> SimplifyResult:
+             seams: str = "junctions", record: bool = False, progress: Optional[Callable[[float], Optional[bool]]] = None) -> SimplifyResult:
     """Simplifies a triangle mesh by quadric-error pair contraction (Garland & Heckbert 1997).
 
     vertices: (n, 3) array, any float dtype; faces: (m, 3) array of vertex indices, any integer dtype.
@@ -426,8 +427,11 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
         (NORMAL, TEXCOORD_0, COLOR_0, ...) when not given. Returned in result.attributes by the
         simplified mesh: one vertex per wedge (a position may carry several attribute sets, split at
         seams), seams kept closed and in place, normals unit, colours in [0, 1].
-      seams: "strict" (the default): a collapse runs along a seam only, both sides together;
-        "creases": so along UV seams and material boundaries, but a normal crease or a colour
+      seams: "junctions" (the default): a collapse runs along a seam only, both sides together,
+        but a vertex where three or more charts, creases or colours meet may merge into a
+        neighbouring such vertex where the error allows (docs/attributes.md, "Seam junctions");
+        "strict": those vertices never move;
+        "creases": as strict along UV seams and material boundaries, but a normal crease or a colour
         boundary may be crossed where the error allows (lower E on hard-surface assets);
         "permissive": UV seams too, at the risk of smearing a texture (docs/attributes.md,
         "Permissive seams").
@@ -495,7 +499,7 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
 def simplify_gltf(input, output, *, target_faces: Optional[int] = None, target_ratio: Optional[float] = None,
                   target_vertices: Optional[int] = None, max_error: Optional[float] = None,
                   max_error_relative: Optional[float] = None, max_distance: Optional[float] = None,
-                  max_distance_relative: Optional[float] = None, per_mesh: bool = False, seams: str = "strict",
+                  max_distance_relative: Optional[float] = None, per_mesh: bool = False, seams: str = "junctions",
                   attribute_weights: Optional[dict] = None, refit="none", far_repair: Optional[bool] = None,
                   threads: int = 0, **options) -> dict:
     """Simplifies a glTF document (.glb, or .gltf with its buffers) into another, as `qem simplify

@@ -164,7 +164,7 @@ def simplify(
     return_mapping: bool = ...,
     far_repair: Optional[bool] = ...,
     two_sided: Literal["rims", "all", "none"] = ...,
-    seams: Literal["strict", "creases", "permissive"] = ...,
+    seams: Literal["junctions", "strict", "creases", "permissive"] = ...,
     record: bool = ...,
     progress: Optional[Callable[[float], Optional[bool]]] = ...,
 ) -> SimplifyResult: ...
@@ -180,7 +180,7 @@ def simplify_gltf(
     max_distance: Optional[float] = ...,
     max_distance_relative: Optional[float] = ...,
     per_mesh: bool = ...,
-    seams: Literal["strict", "creases", "permissive"] = ...,
+    seams: Literal["junctions", "strict", "creases", "permissive"] = ...,
     attribute_weights: Optional[Mapping[str, float]] = ...,
     refit: _Refit = ...,
     far_repair: Optional[bool] = ...,

@@ -163,6 +163,7 @@ void bind_simplify(py::module_& m) {
       .def_readwrite("fit_attributes", &SimplifyOptions::fit_attributes)
       .def_readwrite("permissive_seams", &SimplifyOptions::permissive_seams)
       .def_readwrite("permissive_keeps_uv_seams", &SimplifyOptions::permissive_keeps_uv_seams)
+      .def_readwrite("fixed_seam_junctions", &SimplifyOptions::fixed_seam_junctions)
       .def_readwrite("map_input_vertices", &SimplifyOptions::map_input_vertices)
       .def_property(
           "attribute_weights",

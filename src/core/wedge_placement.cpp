@@ -29,7 +29,8 @@ bool place_with_wedges(const Context& c, std::uint32_t a, std::uint32_t b, const
       for (const auto& [r, s] : map)
         if (s == w) partners.push_back(r);
       if (crossed && !free)
-        crossing_error += wg.error_at(w, partners.data(), partners.size(), m.pos[survivor]);
+        crossing_error += (wg.permissive ? 1 : kJunctionCrossingWeight) *
+                          wg.error_at(w, partners.data(), partners.size(), m.pos[survivor]);
       else
         total += wg.reduced(w, partners.data(), partners.size());
       w = wg.next[w];

@@ -345,6 +345,7 @@ Wedges build_wedges(MeshView in, const std::vector<std::uint32_t>& internal, Wor
     }
   }
   wg.permissive = options.permissive_seams;
+  wg.junctions = !options.fixed_seam_junctions;
   if (!options.vertex_protect.empty()) {
     if (options.vertex_protect.size() != in.vertex_count())
       throw Error("vertex_protect has " + std::to_string(options.vertex_protect.size()) + " entries for " +
@@ -494,7 +495,8 @@ bool map_wedges(const WorkingMesh& m, const Wedges& wg, std::uint32_t survivor, 
         strict = false;
   if (strict) return true;
   const bool protect = !wg.protect.empty() && (wg.protect[survivor] || wg.protect[removed]);
-  if (!wg.permissive || protect || !map_crossing(m, wg, survivor, removed, map)) return false;
+  const bool may_cross = wg.permissive || (wg.junctions && wg.junction(removed) && wg.junction(survivor));
+  if (!may_cross || protect || !map_crossing(m, wg, survivor, removed, map)) return false;
   if (crossed) *crossed = true;
   return true;
 }

@@ -44,12 +44,20 @@ struct Wedges {
   std::vector<std::uint32_t> material;  ///< the face material of each wedge (0 without materials)
   /// SeamPolicy::Permissive: a collapse may cross a seam (map_wedges), never a material boundary.
   bool permissive = false;
+  /// Not SimplifyOptions::fixed_seam_junctions: a junction (three or more wedges) may collapse onto
+  /// another junction, crossing the seams there (map_wedges).
+  bool junctions = false;
   /// Per working vertex (empty: none), SimplifyOptions::vertex_protect: its seams are never
   /// crossed, even when permissive.
   std::vector<std::uint8_t> protect;
 
   std::size_t count() const { return vertex.size(); }
   bool single(std::uint32_t v) const { return next[first[v]] == first[v]; }
+  /// Three or more wedges at v: where UV charts, creases or colour regions meet.
+  bool junction(std::uint32_t v) const {
+    const std::uint32_t a = first[v], b = next[a];
+    return b != a && next[b] != a;
+  }
   /// The reduced quadric of wedge w (or of w and w2 merged, w2 != kNoVertex): its attribute error
   /// with every channel at its optimum, as a quadric in the position (weight 0: it adds error, not
   /// surface).
@@ -96,6 +104,14 @@ struct Wedges {
   std::vector<std::uint32_t> of_input;  ///< the (first) wedge of each input vertex
 };
 
+/// What a crossing between two junctions costs (wedges.junctions, not permissive), in multiples of
+/// the attribute error of its merged wedges. That error prices a corner that takes another chart's
+/// texture coordinates as a smooth deviation of area x difference squared, while the texture drawn
+/// on its faces now runs across the atlas. Measured on docs/benchmarks.md's attribute table
+/// ("Seam junctions" there): at 1x and 3x the merges came early enough to raise beast.obj's UV
+/// error at 1 % above meshoptimizer's; 10x is the lowest tried (10, 30) that kept every row's.
+inline constexpr double kJunctionCrossingWeight = 10;
+
 /// The wedges of `input` (one per referenced input vertex and face material) on the working
 /// vertices `internal` (per input vertex), their attribute quadrics from the working faces, and the
 /// wedge of every face corner (mesh.corner_wedge). Weights per kind from `options`.
@@ -114,7 +130,8 @@ Wedges build_wedges(MeshView input, const std::vector<std::uint32_t>& internal, 
 /// Permissive (wedges.permissive, neither end protected): where those rules fail, each removed
 /// wedge goes to the survivor's wedge it meets on an edge face, else to the survivor's wedge of the
 /// same material nearest in weighted attribute values, and `crossed` (if given) is set; still
-/// false if a material would merge into another.
+/// false if a material would merge into another. The same crossing between two junctions
+/// (wedges.junctions, both ends Wedges::junction, neither protected) when not permissive.
 bool map_wedges(const WorkingMesh& mesh, const Wedges& wedges, std::uint32_t survivor, std::uint32_t removed,
                 std::vector<std::pair<std::uint32_t, std::uint32_t>>& map, bool* crossed = nullptr);
 
