@@ -75,7 +75,7 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
          "gltfpack's -sp), or permissive (UV seams may be crossed too: reaches targets that many small "
          "UV charts block, at some UV quality, and can smear a texture or lose a feature drawn in a "
          "small chart); docs/attributes.md")
-      ->check(CLI::IsMember({"junctions", "strict", "permissive", "creases"}))
+      ->check(CLI::IsMember(option_names<SeamMode>()))
       ->capture_default_str();
   sub->add_option("--lock", a.lock,
                   "Vertices that never move and are never removed: seams (every position with more than "
@@ -204,9 +204,7 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
                   item + "'");
     *weight = w;
   }
-  opt.permissive_seams = a.seams == "permissive" || a.seams == "creases";
-  opt.permissive_keeps_uv_seams = a.seams == "creases";
-  opt.fixed_seam_junctions = a.seams == "strict";
+  opt.seams = parsed<SeamMode>("--seams", a.seams);
   opt.fit_attributes = a.attribute_fit;
   for (const std::string& what : a.lock) {
     if (what == "seams") opt.lock_seams = true;

@@ -40,7 +40,7 @@ struct AlgorithmArgs {
   bool no_far_repair = false;  // --no-far-repair: not even with the refit
   std::string two_sided = to_string(SimplifyOptions{}.two_sided);  // --two-sided rims|all|none
   std::vector<std::string> attribute_weights;  // --attribute-weight KIND=W, ...
-  std::string seams = "junctions";  // --seams junctions|strict|creases|permissive (docs/attributes.md)
+  std::string seams = to_string(SimplifyOptions{}.seams);  // --seams junctions|strict|creases|permissive
   std::vector<std::string> lock;               // --lock seams,borders
   std::string lock_property;                   // --lock-property NAME
   /// --refit, --refit-rounds or --refit-sample given (rather than the default's light refit).

@@ -29,6 +29,10 @@ constexpr Named<InversionPolicy> kInversion[] = {{InversionPolicy::Forbid, "forb
                                                  {InversionPolicy::Penalize, "penalize"},
                                                  {InversionPolicy::Ignore, "off"}};
 constexpr Named<TwoSided> kTwoSided[] = {{TwoSided::Rims, "rims"}, {TwoSided::All, "all"}, {TwoSided::None, "none"}};
+constexpr Named<SeamMode> kSeamMode[] = {{SeamMode::Junctions, "junctions"},
+                                         {SeamMode::Strict, "strict"},
+                                         {SeamMode::Creases, "creases"},
+                                         {SeamMode::Permissive, "permissive"}};
 // Stop reasons are reported, never parsed: their names are phrases.
 constexpr Named<StopReason> kStopReason[] = {
     {StopReason::TargetReached, "target reached"},
@@ -43,6 +47,7 @@ std::span<const Named<Placement>> table(Placement) { return kPlacement; }
 std::span<const Named<Scheme>> table(Scheme) { return kScheme; }
 std::span<const Named<InversionPolicy>> table(InversionPolicy) { return kInversion; }
 std::span<const Named<TwoSided>> table(TwoSided) { return kTwoSided; }
+std::span<const Named<SeamMode>> table(SeamMode) { return kSeamMode; }
 std::span<const Named<StopReason>> table(StopReason) { return kStopReason; }
 
 template <class Enum>
@@ -70,12 +75,14 @@ const char* to_string(Placement p) { return name_of(p); }
 const char* to_string(Scheme s) { return name_of(s); }
 const char* to_string(InversionPolicy policy) { return name_of(policy); }
 const char* to_string(TwoSided t) { return name_of(t); }
+const char* to_string(SeamMode s) { return name_of(s); }
 
 bool from_string(const std::string& name, Weighting& out) { return value_of(name, out); }
 bool from_string(const std::string& name, Placement& out) { return value_of(name, out); }
 bool from_string(const std::string& name, Scheme& out) { return value_of(name, out); }
 bool from_string(const std::string& name, InversionPolicy& out) { return value_of(name, out); }
 bool from_string(const std::string& name, TwoSided& out) { return value_of(name, out); }
+bool from_string(const std::string& name, SeamMode& out) { return value_of(name, out); }
 
 template <class Enum>
 std::vector<std::string> option_names() {
@@ -88,5 +95,6 @@ template std::vector<std::string> option_names<Placement>();
 template std::vector<std::string> option_names<Scheme>();
 template std::vector<std::string> option_names<InversionPolicy>();
 template std::vector<std::string> option_names<TwoSided>();
+template std::vector<std::string> option_names<SeamMode>();
 
 }  // namespace qem

@@ -444,7 +444,7 @@ TEST(GltfSimplify, MergedPrimitiveThatWouldVanishIsKept) {
   const std::size_t open = qem::test::open_edges_welded(doc.scene_mesh());
   qem::SimplifyOptions opt;
   opt.target_ratio = 0.01;
-  opt.permissive_seams = true;
+  opt.seams = qem::SeamMode::Permissive;
   const qem::GltfSimplifyReport r = qem::simplify_document(doc, opt, {});
   EXPECT_EQ(r.simplified, 4u);
   EXPECT_EQ(doc.mesh(2).face_count(), trim);

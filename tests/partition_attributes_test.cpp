@@ -280,7 +280,7 @@ TEST(PartitionAttributes, ProtectedVerticesReachTheParts) {
   for (std::size_t v = 0; v < protect.size(); v += 5) protect[v] = 1;
   SimplifyOptions o = ratio(0.1);
   o.vertex_protect = protect;
-  o.permissive_seams = true;
+  o.seams = SeamMode::Permissive;
   const std::vector<MeshPart> parts = split_mesh(in, o, 2);
   for (const MeshPart& p : parts) {
     ASSERT_EQ(p.protect.size(), p.input_vertex.size());

@@ -218,11 +218,10 @@ TEST(Seams, PermissiveCrossesSeamsToReachTheTarget) {
   const std::set<Point> boundary = on_material_boundary(in);
   SimplifyOptions o;
   o.target_faces = 150;
-  o.fixed_seam_junctions = true;
+  o.seams = SeamMode::Strict;
   const SimplifyResult strict = simplify(in, o);
   EXPECT_GT(strict.mesh.face_count(), 2 * o.target_faces) << "the mesh does not test what it should";
-  o.fixed_seam_junctions = false;
-  o.permissive_seams = true;
+  o.seams = SeamMode::Permissive;
   o.refit_rounds = 2;
   for (Scheme scheme : {Scheme::Passes, Scheme::Greedy}) {
     o.scheme = scheme;
@@ -240,7 +239,7 @@ TEST(Seams, PermissiveCrossesSeamsToReachTheTarget) {
 }
 
 TEST(Seams, JunctionsMergeIntoJunctionsAndNothingElseCrosses) {
-  // The default seams (fixed_seam_junctions false): a vertex where three or more charts meet may
+  // The default seams (SeamMode::Junctions): a vertex where three or more charts meet may
   // collapse onto another such vertex, so a cube of 2 x 2-cell charts, two materials, goes further
   // than with junctions fixed, with no crack and the materials apart, and every output vertex
   // stays on the input's seams where it was one.
@@ -248,9 +247,9 @@ TEST(Seams, JunctionsMergeIntoJunctionsAndNothingElseCrosses) {
   const std::set<Point> boundary = on_material_boundary(in);
   SimplifyOptions o;
   o.target_faces = 150;
-  o.fixed_seam_junctions = true;
+  o.seams = SeamMode::Strict;
   const SimplifyResult fixed = simplify(in, o);
-  o.fixed_seam_junctions = false;
+  o.seams = SeamMode::Junctions;
   std::set<Point> seams;
   const std::vector<std::uint8_t> on_seam = seam_vertices(in);
   for (std::uint32_t v = 0; v < in.vertex_count(); ++v)
@@ -277,7 +276,7 @@ TEST(Seams, JunctionsMergeIntoJunctionsAndNothingElseCrosses) {
   o.scheme = Scheme::Passes;
   o.target_faces = 1;
   const SimplifyResult merged = simplify(quarters, o);
-  o.fixed_seam_junctions = true;
+  o.seams = SeamMode::Strict;
   const SimplifyResult kept = simplify(quarters, o);
   EXPECT_GT(kept.mesh.face_count(), o.target_faces) << "the mesh does not test what it should";
   EXPECT_EQ(merged.mesh.indices, kept.mesh.indices);
@@ -291,10 +290,10 @@ TEST(Seams, ProtectedVerticesKeepTheirSeamsInPermissiveMode) {
   const std::vector<std::uint8_t> all(in.vertex_count(), 1);
   SimplifyOptions o;
   o.target_faces = 40;
-  o.fixed_seam_junctions = true;
+  o.seams = SeamMode::Strict;
   const SimplifyResult strict = simplify(in, o);
   EXPECT_GT(strict.mesh.face_count(), o.target_faces) << "the mesh does not test what it should";
-  o.permissive_seams = true;
+  o.seams = SeamMode::Permissive;
   o.vertex_protect = all;
   const SimplifyResult protect = simplify(in, o);
   EXPECT_EQ(protect.mesh.indices, strict.mesh.indices);
@@ -310,16 +309,16 @@ TEST(Seams, ProtectedVerticesKeepTheirSeamsInPermissiveMode) {
 }
 
 TEST(Seams, CreasesModeCrossesCreasesButNoUvSeam) {
-  // permissive_keeps_uv_seams (`--seams creases`). A grid of UV charts has UV seams only: the mode
+  // SeamMode::Creases (`--seams creases`). A grid of UV charts has UV seams only: the mode
   // makes exactly what strict makes. A flat-shaded cube without its UVs has normal creases only:
   // exactly what permissive makes, which crosses them to go further than strict.
   SimplifyOptions o;
   o.target_faces = 40;
-  o.fixed_seam_junctions = true;
+  o.seams = SeamMode::Strict;
   const Mesh charts = chart_grid(24, 3);
   const SimplifyResult strict = simplify(charts, o);
   EXPECT_GT(strict.mesh.face_count(), o.target_faces) << "the mesh does not test what it should";
-  o.permissive_seams = o.permissive_keeps_uv_seams = true;
+  o.seams = SeamMode::Creases;
   const SimplifyResult kept = simplify(charts, o);
   EXPECT_EQ(kept.mesh.indices, strict.mesh.indices);
   EXPECT_EQ(kept.mesh.positions, strict.mesh.positions);
@@ -329,11 +328,11 @@ TEST(Seams, CreasesModeCrossesCreasesButNoUvSeam) {
   std::erase_if(cube.attributes, [](const VertexAttribute& a) { return a.kind == AttributeKind::TexCoord; });
   ASSERT_EQ(cube.attributes.size(), 1u);
   o.target_faces = 4;
-  o.permissive_seams = o.permissive_keeps_uv_seams = false;
+  o.seams = SeamMode::Strict;
   const SimplifyResult cube_strict = simplify(cube, o);
-  o.permissive_seams = true;
+  o.seams = SeamMode::Permissive;
   const SimplifyResult cube_permissive = simplify(cube, o);
-  o.permissive_keeps_uv_seams = true;
+  o.seams = SeamMode::Creases;
   const SimplifyResult creases = simplify(cube, o);
   EXPECT_LT(cube_permissive.mesh.face_count(), cube_strict.mesh.face_count()) << "permissive crossed nothing";
   EXPECT_EQ(creases.mesh.indices, cube_permissive.mesh.indices);

@@ -48,6 +48,33 @@ enum class TwoSided {
   None,  ///< every twin stays out: one side
 };
 
+/// With attributes, what a collapse may do at a seam (UV seam, normal crease, colour or material
+/// boundary, mirror line: a position with more than one attribute set; SimplifyOptions::seams,
+/// docs/attributes.md). No mode crosses a material boundary or opens a crack (positions stay shared).
+enum class SeamMode {
+  /// As Strict, except that a junction (a vertex where three or more wedges meet: UV charts,
+  /// creases or colour regions meeting at a point) may collapse along an edge onto another
+  /// junction, its wedges that meet none of the survivor's on the edge's faces merging into the
+  /// survivor's wedge of the same material nearest in value, when the cost, which then includes
+  /// ten times the attribute error of those merges, allows (meshoptimizer's default for its
+  /// "complex" vertices). Junctions that never merge block targets on meshes with many charts or
+  /// creases; the error term keeps a merge to where its attributes differ little ("Seam junctions").
+  Junctions,
+  /// A collapse runs only along a seam, both sides together, and a junction never moves.
+  Strict,
+  /// As Permissive, but UV seams are never crossed (every vertex where texture coordinates jump is
+  /// protected, as by vertex_protect): only normal creases and colour boundaries are, when the
+  /// error allows (gltfpack's `-sp`); crossing a crease smooths its shading.
+  Creases,
+  /// A collapse may cross a UV seam, normal crease or colour boundary (never at a protected
+  /// vertex) when its cost, which then includes the attribute error of merging the two sides,
+  /// allows (meshoptimizer's SimplifyPermissive). Reaches targets that strict seams block (many
+  /// small UV charts), at the price of attribute quality along the seams it crosses: joining two
+  /// charts' coordinates on the faces round it can smear the texture or lose a small feature drawn
+  /// in its own chart ("Permissive seams").
+  Permissive,
+};
+
 /// Why simplification stopped.
 enum class StopReason {
   TargetReached,    ///< a face / vertex count target was met
@@ -63,6 +90,7 @@ const char* to_string(Scheme s);
 // The names above and below come from one table per enum (src/option_names.cpp).
 const char* to_string(InversionPolicy policy);
 const char* to_string(TwoSided t);
+const char* to_string(SeamMode s);
 /// The value called `name` (a to_string name, which is also the command line's: "area", "off"):
 /// true and `out` set, or false and `out` unchanged if no value has that name.
 bool from_string(const std::string& name, Weighting& out);
@@ -70,8 +98,9 @@ bool from_string(const std::string& name, Placement& out);
 bool from_string(const std::string& name, Scheme& out);
 bool from_string(const std::string& name, InversionPolicy& out);
 bool from_string(const std::string& name, TwoSided& out);
+bool from_string(const std::string& name, SeamMode& out);
 /// The names of all values of an option enum (Weighting, Placement, Scheme, InversionPolicy,
-/// TwoSided; no other is defined), in declaration order: the choices a front end offers.
+/// TwoSided, SeamMode; no other is defined), in declaration order: the choices a front end offers.
 template <class Enum>
 std::vector<std::string> option_names();
 
@@ -170,36 +199,15 @@ struct SimplifyOptions {
   /// its vertices is. The caller's buffer must outlive the call.
   std::span<const std::uint8_t> vertex_lock;
   /// Per input vertex (empty: none), nonzero = protected: with attributes, the seams at it are
-  /// never crossed, even with permissive_seams (meshoptimizer's meshopt_SimplifyVertex_Protect). It
+  /// never crossed, even by SeamMode::Permissive (meshoptimizer's meshopt_SimplifyVertex_Protect). It
   /// may still be removed, or move, along its seam as any seam vertex does. Same size and lifetime
   /// rules as vertex_lock.
   std::span<const std::uint8_t> vertex_protect;
   /// With attributes: every vertex on a seam (UV seam, normal crease, colour or material boundary,
   /// mirror line: any position with more than one attribute set) is locked as by vertex_lock.
   bool lock_seams = false;
-  /// With attributes, without permissive_seams: true = a vertex where three or more wedges meet (a
-  /// junction of UV charts, creases or colour regions) never moves and is never removed (`--seams
-  /// strict`). false (default, `--seams junctions`): such a junction may collapse along an
-  /// edge onto another junction, its wedges that meet none of the survivor's on the edge's faces
-  /// merging into the survivor's wedge of the same material nearest in value, when the cost, which
-  /// then includes ten times the attribute error of those merges, allows (meshoptimizer's default
-  /// for its "complex" vertices). Every other seam vertex still moves only along its seam, both
-  /// sides together. Junctions that may never merge block targets on meshes with many charts or
-  /// creases; the error term keeps a merge to where its attributes differ little
-  /// (docs/attributes.md, "Seam junctions").
-  bool fixed_seam_junctions = false;
-  /// With attributes: a collapse may cross a UV seam, normal crease or colour boundary (never a
-  /// material boundary, never at a protected vertex) when its cost, which then includes the
-  /// attribute error of merging the two sides, allows (meshoptimizer's SimplifyPermissive). Reaches
-  /// targets that strict seams block (many small UV charts), at the price of attribute quality
-  /// along the seams it crosses (docs/attributes.md). Welded by position, no crack opens either way.
-  bool permissive_seams = false;
-  /// With permissive_seams: UV seams are still never crossed (every vertex where texture
-  /// coordinates jump is protected, as by vertex_protect); only normal creases and colour
-  /// boundaries are, when the error allows (gltfpack's `-sp`). Crossing a UV seam joins two charts'
-  /// coordinates on the faces round it, which can smear the texture or lose a small feature drawn
-  /// in its own chart (docs/attributes.md, "Permissive"); crossing a crease smooths its shading.
-  bool permissive_keeps_uv_seams = false;
+  /// With attributes: what a collapse may do at a seam (SeamMode; `--seams`).
+  SeamMode seams = SeamMode::Junctions;
   InversionPolicy inversion = InversionPolicy::Forbid;
   /// A face that turns by more than this (degrees) counts as an inversion; must be < 90.
   double max_normal_turn_degrees = 75;

@@ -183,15 +183,15 @@ class SimplifyResult(Mesh):
 
 
 def option_names(option: str) -> list:
-    """The accepted values of `weighting`, `placement`, `scheme`, `inversion` or `two_sided`."""
+    """The accepted values of `weighting`, `placement`, `scheme`, `inversion`, `two_sided` or `seams`."""
     if option not in _OPTION_NAMES:
-        raise ValueError(f"option: expected weighting, placement, scheme, inversion or two_sided, got {option!r}")
+        raise ValueError(f"option: expected weighting, placement, scheme, inversion, two_sided or seams, got {option!r}")
     return list(_OPTION_NAMES[option])
 
 
 # The library's names (src/option_names.cpp): one list, written once.
 _OPTION_NAMES = {option: tuple(_qem.option_names(option)) for option in ("weighting", "placement", "scheme", "inversion",
-                                                                             "two_sided")}
+                                                                             "two_sided", "seams")}
 
 # The command line's default refit (cli/algorithm_options.h): two rounds, about 8 input vertices
 # per output vertex, fewer at mild reductions (SimplifyOptions::refit_by_reduction), made only
@@ -300,7 +300,7 @@ def _options(*, target_faces, target_ratio, target_vertices, max_error, max_erro
     else:
         o.threshold = number("threshold", threshold)
     for name, value in (("weighting", weighting), ("placement", placement), ("inversion", inversion),
-                        ("scheme", scheme), ("two_sided", two_sided)):
+                        ("scheme", scheme), ("two_sided", two_sided), ("seams", seams)):
         if not isinstance(value, str):
             raise ValueError(f"{name}: expected one of {', '.join(_OPTION_NAMES[name])}, got {value!r}")
         setattr(o, name, value)
@@ -316,11 +316,6 @@ def _options(*, target_faces, target_ratio, target_vertices, max_error, max_erro
         raise ValueError(f"forget: expected a factor in [0, 1) (0 = never), got {forget!r}")
     o.forget = float(forget)
     o.forget_attributes = bool(forget_attributes)
-    if seams not in ("junctions", "strict", "creases", "permissive"):
-        raise ValueError(f"seams: expected one of junctions, strict, creases, permissive, got {seams!r}")
-    o.permissive_seams = seams in ("creases", "permissive")
-    o.permissive_keeps_uv_seams = seams == "creases"
-    o.fixed_seam_junctions = seams == "strict"
 
     if refit in (None, False):
         refit = "none"

@@ -127,7 +127,7 @@ class Level(Mesh):
     contractions: int
     max_error: float
 
-def option_names(option: Literal["weighting", "placement", "scheme", "inversion"]) -> list[str]: ...
+def option_names(option: Literal["weighting", "placement", "scheme", "inversion", "two_sided", "seams"]) -> list[str]: ...
 def simplify(
     vertices: _Vertices,
     faces: _Faces,

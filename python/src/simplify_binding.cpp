@@ -161,9 +161,8 @@ void bind_simplify(py::module_& m) {
       .def_property("two_sided", [](const SimplifyOptions& o) { return to_string(o.two_sided); },
                     [](SimplifyOptions& o, const std::string& s) { o.two_sided = enum_named<TwoSided>("two_sided", s); })
       .def_readwrite("fit_attributes", &SimplifyOptions::fit_attributes)
-      .def_readwrite("permissive_seams", &SimplifyOptions::permissive_seams)
-      .def_readwrite("permissive_keeps_uv_seams", &SimplifyOptions::permissive_keeps_uv_seams)
-      .def_readwrite("fixed_seam_junctions", &SimplifyOptions::fixed_seam_junctions)
+      .def_property("seams", [](const SimplifyOptions& o) { return to_string(o.seams); },
+                    [](SimplifyOptions& o, const std::string& s) { o.seams = enum_named<SeamMode>("seams", s); })
       .def_readwrite("map_input_vertices", &SimplifyOptions::map_input_vertices)
       .def_property(
           "attribute_weights",
@@ -195,7 +194,8 @@ void bind_simplify(py::module_& m) {
     if (option == "scheme") return option_names<Scheme>();
     if (option == "inversion") return option_names<InversionPolicy>();
     if (option == "two_sided") return option_names<TwoSided>();
-    throw py::value_error("option: expected weighting, placement, scheme, inversion or two_sided, got '" + option + "'");
+    if (option == "seams") return option_names<SeamMode>();
+    throw py::value_error("option: expected weighting, placement, scheme, inversion, two_sided or seams, got '" + option + "'");
   });
 
   py::class_<Record>(m, "Record", "qem::Record: the base mesh and the contraction sequence of one run")

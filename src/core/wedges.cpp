@@ -255,7 +255,7 @@ std::uint32_t Wedges::final_wedge_of_input(std::uint32_t v) const {
 
 namespace {
 
-// SimplifyOptions::permissive_keeps_uv_seams: every vertex whose wedges' texture coordinates
+// SeamMode::Creases: every vertex whose wedges' texture coordinates
 // differ is protected, so that only creases and colour boundaries are crossed.
 void protect_uv_seams(Wedges& wg, std::uint32_t vertices) {
   if (wg.protect.empty()) wg.protect.assign(vertices, 0);
@@ -344,8 +344,8 @@ Wedges build_wedges(MeshView in, const std::vector<std::uint32_t>& internal, Wor
       wg.next[w] = wg.next[head], wg.next[head] = w;
     }
   }
-  wg.permissive = options.permissive_seams;
-  wg.junctions = !options.fixed_seam_junctions;
+  wg.permissive = options.seams == SeamMode::Creases || options.seams == SeamMode::Permissive;
+  wg.junctions = options.seams == SeamMode::Junctions;
   if (!options.vertex_protect.empty()) {
     if (options.vertex_protect.size() != in.vertex_count())
       throw Error("vertex_protect has " + std::to_string(options.vertex_protect.size()) + " entries for " +
@@ -354,7 +354,7 @@ Wedges build_wedges(MeshView in, const std::vector<std::uint32_t>& internal, Wor
     for (std::uint32_t w = 0; w < wg.count(); ++w)
       if (options.vertex_protect[wg.source[w]]) wg.protect[wg.vertex[w]] = 1;
   }
-  if (wg.permissive && options.permissive_keeps_uv_seams) protect_uv_seams(wg, m.vertex_count());
+  if (options.seams == SeamMode::Creases) protect_uv_seams(wg, m.vertex_count());
   wg.corners.assign(wg.count(), 0);
   for (std::uint32_t w : m.corner_wedge) ++wg.corners[w];
   wg.renew_quadrics(m);

@@ -42,10 +42,11 @@ struct Wedges {
   std::vector<double> value;          ///< `width` per wedge, as given (the quadrics hold the weights)
   std::vector<double> quadric;        ///< `quadric_width` per wedge (see wedges.cpp)
   std::vector<std::uint32_t> material;  ///< the face material of each wedge (0 without materials)
-  /// SeamPolicy::Permissive: a collapse may cross a seam (map_wedges), never a material boundary.
+  /// SeamMode::Permissive or Creases: a collapse may cross a seam (map_wedges), never a material
+  /// boundary.
   bool permissive = false;
-  /// Not SimplifyOptions::fixed_seam_junctions: a junction (three or more wedges) may collapse onto
-  /// another junction, crossing the seams there (map_wedges).
+  /// SeamMode::Junctions: a junction (three or more wedges) may collapse onto another junction,
+  /// crossing the seams there (map_wedges).
   bool junctions = false;
   /// Per working vertex (empty: none), SimplifyOptions::vertex_protect: its seams are never
   /// crossed, even when permissive.
