@@ -31,9 +31,10 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
   sub->add_option("--greedy-below", a.greedy_below,
                   "With --scheme passes, finish in the greedy order below this many faces (0 = never)")
       ->capture_default_str();
-  sub->add_option("--forget", a.forget,
-                  "Renew every quadric from the current faces each time the faces fall by this factor (0 = never, "
-                  "GH97's quadrics; off with --max-error, and with attributes unless --forget-attributes)")
+  sub->add_option(
+         "--forget", a.forget,
+         "Renew every quadric from the current faces each time the faces fall by this factor (0 = never, "
+         "GH97's quadrics; off with --max-error, and with attributes that vary unless --forget-attributes)")
       ->check(CLI::Range(0.0, 0.999999))
       ->capture_default_str();
   sub->add_flag("--forget-attributes", a.forget_attributes,

@@ -118,6 +118,41 @@ TEST(Forget, OffUnderAnErrorLimitAndWithAttributesUnlessAsked) {
   EXPECT_NE(simplify(sphere, asked).mesh.positions, c.mesh.positions);
 }
 
+// Attributes that never vary have no error to shift, so such a mesh forgets by default: faces'
+// materials alone (carried through the core as a constant attribute), or a constant colour. Each
+// run equals the one that asks for forget_attributes and differs from GH97's remembering run, and
+// the materials stay apart.
+TEST(Forget, ConstantAttributesAndMaterialsAloneForget) {
+  Mesh materials = test::uv_sphere(40, 80);
+  materials.attributes.clear();
+  for (std::size_t f = 0; f < materials.face_count(); ++f) {
+    const std::uint32_t* t = &materials.indices[3 * f];
+    const double z = materials.positions[3 * t[0] + 2] + materials.positions[3 * t[1] + 2] +
+                     materials.positions[3 * t[2] + 2];
+    materials.face_materials.push_back(z > 0 ? 1 : 0);
+  }
+  Mesh constant = test::uv_sphere(40, 80);
+  constant.attributes = {{"COLOR_0", AttributeKind::Color, 3, {}}};
+  for (std::size_t v = 0; v < constant.vertex_count(); ++v)
+    constant.attributes[0].values.insert(constant.attributes[0].values.end(), {0.2, 0.5, 0.9});
+  for (const Mesh* in : {&materials, &constant}) {
+    SimplifyOptions asked = forgetting(600, 0.85);
+    asked.forget_attributes = true;
+    const SimplifyResult remember = simplify(*in, forgetting(600, 0)),
+                         by_default = simplify(*in, forgetting(600, 0.85)), forget = simplify(*in, asked);
+    EXPECT_NE(by_default.mesh.positions, remember.mesh.positions);
+    EXPECT_EQ(by_default.mesh.positions, forget.mesh.positions);
+    EXPECT_EQ(by_default.mesh.indices, forget.mesh.indices);
+    EXPECT_EQ(test::open_edges_welded(by_default.mesh), 0u) << "a crack opened";
+    if (in == &materials) {
+      ASSERT_EQ(by_default.mesh.face_materials.size(), by_default.mesh.face_count());
+      EXPECT_TRUE(by_default.mesh.attributes.empty());
+      for (std::size_t f = 0; f < by_default.mesh.face_count(); ++f)  // each face keeps its side
+        EXPECT_EQ(by_default.mesh.face_materials[f], materials.face_materials[by_default.face_source[f]]);
+    }
+  }
+}
+
 // With attributes, the wedges' quadrics and the seam planes are renewed with the positions': the
 // rules of the wedges still hold (seams closed and on their line, UVs in the chart, unit normals),
 // in the passes and in the greedy order, with the same output for any thread count.

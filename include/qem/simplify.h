@@ -218,8 +218,8 @@ struct SimplifyOptions {
   /// heap is then small enough to stay in cache, and the last contractions shape a coarse result
   /// the most (0 = passes to the end).
   std::size_t greedy_below_faces = 20000;
-  /// Forgetting (no max_error; with attributes only with forget_attributes): each time the faces have fallen by
-  /// this factor since the last time (at the start of a pass, or at once in the greedy order),
+  /// Forgetting (no max_error; with attributes that vary only with forget_attributes): each time the faces
+  /// have fallen by this factor since the last time (at the start of a pass, or at once in the greedy order),
   /// every vertex's quadric is made again from its current faces and border edges (as at the
   /// start: GH97 §5-6, HG99 §2) and every pair is costed afresh. GH97's quadrics remember every
   /// plane a vertex ever stood for, so late contractions are ranked by the distance to long-gone
@@ -227,15 +227,16 @@ struct SimplifyOptions {
   /// memoryless cost does, which lowers the mean error at the same face count (docs/benchmarks.md,
   /// "Forgetting"). Not below 700 faces, where the mesh's own faces no longer stand for the
   /// surface and the memory keeps its shape. 0 = GH97 as published (never); in [0, 1); the
-  /// command line's and Python's default is kRecommendedForget. Off under max_error (the contraction error bounds the
-  /// distance to the input only with whole quadrics). The schedule follows the face count, never
+  /// command line's and Python's default is kRecommendedForget. Off under max_error (the contraction error
+  /// bounds the distance to the input only with whole quadrics). The schedule follows the face count, never
   /// the target, so a contraction record still replays to a direct run's mesh.
   double forget = 0;
   /// Forgetting with attributes too: the wedges' attribute quadrics (Hoppe 1999) are renewed from
   /// their current values and the seam planes from the current seams, with the positions'. Off by
   /// default: on the textured and coloured assets it lowers E (geometric mean 0.86x) and most
   /// attribute errors, but shifts error into the attributes on some (the Duck at 50 %: normals
-  /// 1.84 against 1.27 degrees; docs/benchmarks.md, "Forgetting with attributes").
+  /// 1.84 against 1.27 degrees; docs/benchmarks.md, "Forgetting with attributes"). Not needed
+  /// where no attribute varies (faces' materials alone, a constant colour): nothing to shift.
   bool forget_attributes = false;
   /// Threads for the parts that split without changing the result (0 = all hardware threads).
   unsigned threads = 0;

@@ -52,6 +52,17 @@ void lock_vertices(std::span<const std::uint8_t> lock, MeshView input, const Wed
   }
 }
 
+// Whether some attribute takes more than one value. Forgetting with attributes is off by default
+// because renewed attribute quadrics may shift error into the attributes; constant ones (the
+// material carrier of a mesh whose only appearance is its faces' materials) have none to shift, and
+// their seams are the material boundaries, whose planes forgetting renews as the border's.
+bool any_varies(std::span<const VertexAttribute> attributes) {
+  for (const VertexAttribute& a : attributes)
+    for (std::size_t i = a.components; i < a.values.size(); ++i)
+      if (a.values[i] != a.values[i % a.components]) return true;
+  return false;
+}
+
 }  // namespace
 
 SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHooks& hooks) {
@@ -61,6 +72,7 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   WorkingMesh mesh = prepare_input(input, &internal);  // check, drop degenerate and duplicate faces, frame
   std::optional<Wedges> wedges;  // with attributes, on the input's vertices (Hoppe 1999)
   if (!input.attributes.empty()) wedges.emplace(build_wedges(input, internal, mesh, options));
+  const bool varying_attributes = wedges && any_varies(input.attributes);  // before they are consumed
   const bool keep_input = hooks.reversed_twins && !mesh.reversed_twins.empty();
   if (hooks.reversed_twins) *hooks.reversed_twins = mesh.reversed_twins;
   if (wedges && hooks.consumed_attributes && !keep_input)
@@ -70,7 +82,8 @@ SimplifyResult run(MeshView input, const SimplifyOptions& options, const RunHook
   if (wedges && options.lock_seams) lock_seam_vertices(*wedges, mesh);
   result.input_faces = mesh.faces_alive, result.input_vertices = mesh.vertices_alive;
   result.dropped_degenerate_faces = mesh.dropped_degenerate, result.dropped_duplicate_faces = mesh.dropped_duplicate;
-  const Settings settings = resolve(options, mesh, wedges.has_value());  // targets from the input, before pruning
+  // targets from the input, before pruning
+  const Settings settings = resolve(options, mesh, varying_attributes);
   // Without pruning, the component guard (made below, on the same faces) counts the input's
   // components; otherwise they are counted here, before the pruning.
   const bool guard_counts = settings.keep_components && settings.prune_size == 0;
