@@ -83,14 +83,19 @@ int run_out_of_core(const std::string& input, const std::string& output, const S
       unread += std::string(unread.size() > 1 ? "," : "") + json_string(n);
     unread += "]";
     std::printf(
-        "{\"tool\":\"qem\",\"out_of_core\":true,\"in_faces\":%llu,\"target_faces\":%zu,\"out_faces\":%zu,"
-        "\"out_vertices\":%zu,\"clustered_faces\":%llu,\"grid_resolution\":%llu,\"grid_coarsenings\":%u,"
+        "{\"tool\":\"qem\",\"out_of_core\":true,\"method\":%s,\"in_faces\":%llu,\"target_faces\":%zu,\"out_"
+        "faces\":%zu,"
+        "\"out_vertices\":%zu,\"clustered_faces\":%llu,\"merged_faces\":%llu,\"shared_vertices\":%llu,\"grid_"
+        "resolution\":%llu,\"grid_coarsenings\":%u,"
         "\"memory_limit_bytes\":%llu,"
         "\"peak_memory_bytes\":%llu,\"temp_bytes_written\":%llu,\"parts\":%u,\"total_s\":%s,\"cpu_s\":%s,"
         "\"peak_rss_mb\":%s,"
         "\"max_error\":%s,\"max_error_rel\":%s,\"stop\":\"%s\",\"phases\":%s,\"not_carried\":%s}\n",
-        static_cast<unsigned long long>(report.input_faces), out.target_faces, r.mesh.face_count(),
-        r.mesh.vertex_count(), static_cast<unsigned long long>(report.clustered_faces),
+        json_string(report.method).c_str(), static_cast<unsigned long long>(report.input_faces),
+        out.target_faces, r.mesh.face_count(), r.mesh.vertex_count(),
+        static_cast<unsigned long long>(report.clustered_faces),
+        static_cast<unsigned long long>(report.merged_faces),
+        static_cast<unsigned long long>(report.shared_vertices),
         static_cast<unsigned long long>(report.grid_resolution), report.grid_coarsenings,
         static_cast<unsigned long long>(report.memory_limit),
         static_cast<unsigned long long>(report.peak_memory_bytes),
@@ -99,7 +104,16 @@ int run_out_of_core(const std::string& input, const std::string& output, const S
         json_number(peak_rss_mb()).c_str(), json_number(r.max_error).c_str(),
         json_number(r.max_error_relative).c_str(), to_string(r.stop_reason), phases.c_str(), unread.c_str());
   }
-  if (!out.quiet)
+  if (!out.quiet && report.method == "parts")
+    std::fprintf(
+        stderr,
+        "qem: %llu -> %zu faces out of core (by %u parts on disk, %llu vertices on their cuts, welded "
+        "to %llu faces), %.3f s, peak memory %.0f MB, %.0f MB of temporary files\n",
+        static_cast<unsigned long long>(report.input_faces), r.mesh.face_count(), report.parts,
+        static_cast<unsigned long long>(report.shared_vertices),
+        static_cast<unsigned long long>(report.merged_faces), total.seconds(),
+        double(report.peak_memory_bytes) / 1e6, double(report.temp_bytes_written) / 1e6);
+  else if (!out.quiet)
     std::fprintf(
         stderr,
         "qem: %llu -> %zu faces out of core (clustered to %llu faces on a grid of %llu, %u parts), %.3f s, "

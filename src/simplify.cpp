@@ -66,12 +66,10 @@ std::vector<std::uint8_t> border_points_for(const Mesh& mesh, std::span<const st
   return core::points_on_border(faces, points.source, threads);
 }
 
-// The far-place repair of `mesh` with `options`' turn limit and threads (core/far_repair.h), against
-// the input (`positions`) as `points` and `surface`, `on_border` per point (border_points_for;
-// empty: found by the repair when it needs them, unless the mesh has vertex properties),
-// `closest_faces` per point (empty: none) as FarRepairOptions::point_faces. A
-// relocated vertex that stands at an input vertex takes its exact coordinates (on a border: on the
-// input's border, as exact borders promise).
+}  // namespace
+
+// On a border a relocated vertex at an input vertex is on the input's border, as exact borders
+// promise.
 core::FarRepairResult repair_mesh(Mesh& mesh, const SimplifyOptions& options, MeshView input,
                                   std::span<const std::uint8_t> on_border,
                                   const refit_detail::FitPoints& points, const core::SurfaceDistance& surface,
@@ -103,8 +101,6 @@ core::FarRepairResult repair_mesh(Mesh& mesh, const SimplifyOptions& options, Me
           for (int k = 0; k < 3; ++k) mesh.positions[3 * std::size_t(v) + k] = positions[3 * std::size_t(points.source[r.point]) + k];
   return made;
 }
-
-}  // namespace
 
 void refit_levels(MeshView original, std::span<ReplayLevel> levels, const SimplifyOptions& options,
                   std::size_t input_vertices) {

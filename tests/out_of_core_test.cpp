@@ -259,6 +259,14 @@ TEST(OutOfCore, TwoSidedSheetIsKeptWithItsRimClosed) {
   EXPECT_LE(r.mesh.face_count(), 2000u);
   EXPECT_GT(r.twin_faces, 0u);
   EXPECT_EQ(test::open_edges_welded(r.mesh), 0u) << "the rim is closed, as in the input";
+  // A limit and target that would go by parts: the parts' runs drop the reversed copies, which only
+  // a whole run puts back, so it clusters after all.
+  opt.target_faces = sheet.face_count() / 10;
+  ooc.memory_limit = std::uint64_t(64) << 20;
+  const SimplifyResult by_parts = simplify_out_of_core(path, opt, ooc, &report);
+  EXPECT_EQ(report.method, "clustering");
+  EXPECT_GT(by_parts.twin_faces, 0u);
+  EXPECT_EQ(test::open_edges_welded(by_parts.mesh), 0u) << "the rim is closed, as in the input";
   fs::remove(path);
   EXPECT_EQ(entries(dir), 0u);
 }
@@ -382,6 +390,53 @@ TEST(OutOfCore, SameResultOnAnyNumberOfThreads) {
   EXPECT_EQ(test::validity_problem(welded), "");
   EXPECT_EQ(test::boundary_edges(welded), 0u);  // the parts' borders met: no crack
   EXPECT_EQ(entries(dir), 0u);
+}
+
+// By parts (outofcore/streamed_parts.h): a limit a little below what the in-core run needs, with a
+// target the clustering's phase 2 would get too few faces for under it, sends the input through
+// parts on disk instead: issue 20's bar against the in-core run (E at most 1.1x, Hausdorff at most
+// 1.2x), the target met, no crack where the parts met, the same bytes on any number of threads, and
+// no temporary file left.
+TEST(OutOfCore, ByPartsMeetsTheInCoreBarWithoutCracks) {
+  const std::string dir = fresh_dir("by_parts");
+  const Mesh input = load_mesh(big_sphere());
+  SimplifyOptions opt;  // the command line's defaults: forgetting, the light refit, the far-place repair
+  opt.target_ratio = 0.1;
+  opt.forget = kRecommendedForget;
+  opt.refit_rounds = 2, opt.refit_points_per_vertex = 8, opt.refit_by_reduction = true;
+  opt.far_repair = true;
+  OutOfCoreOptions ooc = limited(std::uint64_t(64) << 20, dir);
+  std::vector<Mesh> results;
+  for (unsigned threads : {1u, 2u}) {
+    opt.threads = threads;
+    OutOfCoreReport report;
+    results.push_back(simplify_out_of_core(big_sphere(), opt, ooc, &report).mesh);
+    EXPECT_EQ(report.method, "parts");
+    EXPECT_GE(report.parts, 2u);
+    EXPECT_GT(report.shared_vertices, 0u);
+    EXPECT_GT(report.merged_faces, input.face_count() / 10);
+    EXPECT_EQ(report.clustered_faces, 0u);
+    EXPECT_EQ(entries(dir), 0u);
+  }
+  EXPECT_EQ(results[1].positions, results[0].positions);
+  EXPECT_EQ(results[1].indices, results[0].indices);
+  const Mesh& out = results[0];
+  EXPECT_LE(out.face_count(), input.face_count() / 10);
+  EXPECT_GE(out.face_count(), input.face_count() / 10 - 2);
+  Mesh welded = out;
+  weld_exact(welded);
+  EXPECT_EQ(test::validity_problem(welded), "");
+  EXPECT_EQ(test::boundary_edges(welded), 0u);  // the input is closed: no crack
+  opt.threads = 0;
+  const SimplifyResult in_core = simplify(input, opt);
+  MeasureOptions mo;
+  mo.seed = 7;
+  const MeasureResult m_parts = measure(input, out, mo), m_in = measure(input, in_core.mesh, mo);
+  EXPECT_LE(m_parts.E, 1.1 * m_in.E) << "by parts " << m_parts.E << " vs in core " << m_in.E;
+  EXPECT_LE(m_parts.hausdorff, 1.2 * m_in.hausdorff)
+      << "by parts " << m_parts.hausdorff << " vs in core " << m_in.hausdorff;
+  std::printf("by parts: E %.3fx, Hausdorff %.3fx the in-core run's\n", m_parts.E / m_in.E,
+              m_parts.hausdorff / m_in.hausdorff);
 }
 
 // Phase 2's input is bounded by a multiple of the target as well as by memory: with plenty of
@@ -540,11 +595,22 @@ TEST(OutOfCoreCli, MemoryLimitSendsALargeInputOutOfCore) {
   CliRun r = run("simplify " + big_sphere() + " " + out + " --faces 3000 --memory-limit 16M --temp-dir " +
                  dir + " --json --quiet");
   ASSERT_EQ(r.exit_code, 0) << r.out;
-  for (const char* field : {"\"out_of_core\":true", "\"out_faces\":", "\"peak_memory_bytes\":",
-                            "\"temp_bytes_written\":", "\"phases\":[{\"name\":\"bounds\""})
+  for (const char* field :
+       {"\"out_of_core\":true", "\"method\":\"clustering\"", "\"out_faces\":", "\"peak_memory_bytes\":",
+        "\"temp_bytes_written\":", "\"phases\":[{\"name\":\"bounds\""})
     EXPECT_NE(r.out.find(field), std::string::npos) << field << " missing in " << r.out;
   EXPECT_LE(load_mesh(out).face_count(), 3000u);
   EXPECT_EQ(entries(dir), 1u);  // the output only
+  // A limit a little short of the in-core run's, and a target phase 2 would get too few faces for
+  // under it: by parts on disk (docs/out-of-core.md, "By parts").
+  r = run("simplify " + big_sphere() + " " + out + " --ratio 0.1 --memory-limit 60M --temp-dir " + dir +
+          " --json --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  for (const char* field : {"\"method\":\"parts\"",
+                            "\"merged_faces\":", "\"shared_vertices\":", "\"phases\":[{\"name\":\"bounds\""})
+    EXPECT_NE(r.out.find(field), std::string::npos) << field << " missing in " << r.out;
+  EXPECT_LE(load_mesh(out).face_count(), 32768u);
+  EXPECT_EQ(entries(dir), 1u);
   // Enough memory: the in-core path, whose JSON has no out_of_core field.
   r = run("simplify " + big_sphere() + " " + out + " --faces 3000 --memory-limit 2G --json --quiet");
   ASSERT_EQ(r.exit_code, 0) << r.out;

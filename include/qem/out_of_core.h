@@ -7,6 +7,10 @@
 // part by part with qem/partition.h when large) of that clustered mesh down to the target. The
 // grid is as fine as the memory budget allows, up to a multiple of the target (phase 2's time), so
 // that phase 2, which decides quality, starts from a mesh tens of times larger than the target.
+// Where the budget cannot give phase 2 that many and the input is within a few budgets, the input
+// goes by parts on disk instead: the partitioned scheme of qem/partition.h, each part read back and
+// simplified with its cut locked, the welded parts simplified to the target, then refitted and
+// repaired part by part against the input (docs/out-of-core.md, "By parts").
 #pragma once
 
 #include <cstddef>
@@ -64,7 +68,12 @@ struct OutOfCoreReport {
   std::uint64_t clustered_faces = 0;     ///< faces handed to phase 2 (after dropping duplicates)
   std::uint64_t temp_bytes_written = 0;
   std::uint64_t peak_memory_bytes = 0;  ///< peak resident set of the process (VmHWM)
-  unsigned parts = 1;                   ///< parts of phase 2
+  unsigned parts = 1;                   ///< parts of phase 2, or of the run by parts
+  /// "clustering" (the two phases) or "parts" (by parts on disk: an input within a few budgets
+  /// whose budget would starve phase 2; docs/out-of-core.md, "By parts").
+  std::string method = "clustering";
+  std::uint64_t shared_vertices = 0;  ///< by parts: input vertices on a cut, locked in the parts
+  std::uint64_t merged_faces = 0;     ///< by parts: faces of the welded parts, the final pass's input
   std::vector<OutOfCorePhase> phases;
   /// What of the input the two phases do not carry (positions and faces only): a PLY's other
   /// vertex and face properties ("vertex red", "face red"...) and other elements, by name.
@@ -84,8 +93,8 @@ std::uint64_t parse_memory_size(const std::string& text);
 /// False also needs MeshStream to read the file (binary PLY or STL); other formats always say true.
 bool fits_in_memory(const std::string& path, std::uint64_t memory_limit);
 
-/// Simplifies the mesh file `path` in the two phases, whatever its size, under the options'
-/// budget. `options` are those of qem::simplify and apply to phase 2 (its quadrics are recomputed
+/// Simplifies the mesh file `path` in the two phases (or by parts, see the top of this file),
+/// whatever its size, under the options' budget. `options` are those of qem::simplify and apply to phase 2 (its quadrics are recomputed
 /// from the clustered faces); with refit_by_reduction, where phase 2 starts from fewer than 6
 /// clustered faces an output face, the refit fits the output to the input's points instead
 /// (one round, a fourth phase "refitting"; docs/out-of-core.md); target_ratio counts the input's faces; vertex_lock is refused; the

@@ -29,6 +29,7 @@
 #include "outofcore/cell_table.h"
 #include "outofcore/mesh_stream.h"
 #include "outofcore/parallel_clustering.h"
+#include "outofcore/streamed_parts.h"
 #include "outofcore/temp_file.h"
 #include "qem/error.h"
 #include "qem/partition.h"
@@ -42,14 +43,12 @@ using outofcore::CellKey;
 using outofcore::CellSet;
 using outofcore::CellTable;
 using outofcore::Grid;
+using outofcore::kInCoreBytesPerFace;
 using outofcore::MeshStream;
 using outofcore::ParallelClustering;
 using outofcore::PositionSource;
 using outofcore::TempFile;
 
-/// Peak memory of the in-core path per input face (load, working mesh, heap, refit), the figure
-/// measured for issue 20; the decision in-core / out-of-core uses it.
-constexpr double kInCoreBytesPerFace = 180;
 /// Phase 1 per occupied cell: its quadric, corner sum and edge sums (21 doubles) and its hash
 /// slot (at most half full). Phase 2 per cell: about 1.6 faces (measured on the spheres), each taking the
 /// in-core path's bytes plus the clustered mesh handed to it and the pairing of its faces; 2 GB
@@ -528,6 +527,9 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
   // Never fewer cells than the target's vertices, or phase 2 would have nothing to choose from.
   const std::uint64_t floor_cells =
       std::max<std::uint64_t>({options.target_faces, options.target_vertices * 2, 1024});
+  // Whether the budget, not the time bound, sizes phase 2: then it gets fewer than the goal's
+  // multiple of the target, and its result suffers (docs/out-of-core.md, "Why two phases").
+  const bool budget_binds = max_cells < goal_by_time;
   max_cells = std::max(max_cells, floor_cells);
   // The grid aims at the goal; the clustering coarsens it when the cells pass twice the goal (the
   // time bound is soft) or the budget's (a hard bound).
@@ -581,122 +583,158 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
   const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-30});
   lap("bounds");
 
-  // --- phase 1: Lindstrom 2000 clustering, the grid sized by a sample ------------------------------
-  progress.phase("clustering", 2);
-  Grid fine;
-  std::copy(lo, lo + 3, fine.lo);
-  fine.size = starting_cell_size(sample, lo, extent, goal_cells);
-  std::vector<float>().swap(sample);
-  TempFile faces(temp_dir, "faces");
+  // By parts (outofcore/streamed_parts.h) where the budget would starve phase 2 and the input is
+  // within a few budgets: every face contracted, as the partitioned in-memory run does; else (and
+  // when the parts find a two-sided sheet) the two phases.
   const unsigned threads =
       options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
-  ParallelClustering clustering(fine, hard_cells, threads, faces);
   // Mapped positions: their pages are given back whenever they pass a quarter of the budget.
   const std::uint64_t mapped_allowance =
       std::max<std::uint64_t>(std::uint64_t(budget / 4), std::uint64_t(32) << 20);
-  clustering.after_block = [&, blocks = 0]() mutable {
-    if (store && store->mapped() && ++blocks % 16 == 0 && resident_file_bytes() > mapped_allowance)
-      store->drop_pages();
-    progress.read(in.bytes_read());
+  const auto give_back_pages = [&] {
+    if (store && store->mapped() && resident_file_bytes() > mapped_allowance) store->drop_pages();
   };
-  if (soup) {
-    in.read_soup([&](const double* xyz, std::size_t n) {
-      clustering.add_soup(xyz, n);
-      progress.read(in.bytes_read());
-    });
-  } else {
-    in.read_triangles([&](const std::uint32_t* tri, std::size_t n) {
-      clustering.add_indexed(tri, n, positions);
-      progress.read(in.bytes_read());
-    });
-  }
-  clustering.finish();
-  report.grid_coarsenings = unsigned(clustering.levels());
-  if (store) store->release();
-  CellTable& cells = clustering.cells();
-  report.clustered_vertices = cells.size();
-  const double cell_size = fine.size * std::ldexp(1.0, clustering.levels());
-  report.grid_resolution = std::uint64_t(std::ceil(extent / cell_size));
-
-  // Each cell's representative: the minimum of its quadric around the corners' mean, kept inside
-  // the cell (Lindstrom & Silva 2001 §4: a point outside would fold neighbouring cells' faces).
-  // Each cell on its own, so the threads share them in ranges without changing a bit.
-  Mesh clustered_mesh;
-  clustered_mesh.positions.resize(3 * std::size_t(cells.size()));
-  auto place_cells = [&](std::uint32_t begin, std::uint32_t end) {
-    for (std::uint32_t i = begin; i < end; ++i) {
-      const auto& cell = cells.cell(i);
-      const double mean[3] = {cell.sum[0] / cell.corners, cell.sum[1] / cell.corners,
-                              cell.sum[2] / cell.corners};
-      double x[3];
-      const core::Quadric q = with_border(cell, cell_size);
-      cluster_detail::minimize_around(q, mean, x);
-      std::uint64_t k[3];
-      outofcore::unpack_cell(cells.key(i), k);
-      const double c0[3] = {double(k[0]) * cell_size, double(k[1]) * cell_size, double(k[2]) * cell_size};
-      const double c1[3] = {c0[0] + cell_size, c0[1] + cell_size, c0[2] + cell_size};
-      pull_into_cell(q, mean, c0, c1, x);
-      for (int a = 0; a < 3; ++a) clustered_mesh.positions[3 * i + a] = lo[a] + x[a];
-    }
-  };
-  {
-    std::vector<std::thread> helpers;
-    const std::uint32_t n = cells.size(), per = n / threads + 1;
-    for (unsigned t = 1; t < threads && t * per < n; ++t)
-      helpers.emplace_back(place_cells, t * per, std::min<std::uint32_t>(n, (t + 1) * per));
-    place_cells(0, std::min(n, per));
-    for (std::thread& h : helpers) h.join();
-  }
-  std::vector<std::uint64_t> shapes;  // per clustered face, its input triangle's
-  clustered_mesh.indices = outofcore::read_clustered_faces(clustering, faces, shapes);
-  cells.release();
-  drop_paired_faces(clustered_mesh.indices, shapes);
-  std::vector<std::uint64_t>().swap(shapes);
-  report.clustered_faces = clustered_mesh.face_count();
-  report.temp_bytes_written = outofcore::temp_bytes_written() - temp_bytes_before;
-  lap("clustering");
-
-  // --- phase 2: GH97 in core on the clustered mesh, part by part when it is large -------------------
-  progress.phase("simplifying", 3);
-  progress.start_phase2();
-  // Where the memory limit leaves phase 2 fewer than 6 clustered faces an output face, its own
-  // refit (to the clustered mesh) gets fewer rounds than an in-core run's or none (below 3): the
-  // refit then fits the output to the input's points after phase 2 instead, the clustered surface
-  // having lost what the cells averaged away besides (a one-pixel spike on the terrain). From 6
-  // up phase 2 refits as before: its refit to the clustered mesh has the input's area weights and
-  // the guard against moving off the surface, which the streamed points lack, and came out
-  // better (the generated 1.3M sphere to 1 %, 35x: E 1.06x the in-core run's, 1.08x fitted to the input).
-  const double target_faces_estimate =
-      options.target_faces ? double(options.target_faces) : 2.0 * double(options.target_vertices);
-  const bool refit_to_input = options.refit_rounds > 0 && options.refit_by_reduction &&
-                              double(report.clustered_faces) < 6 * target_faces_estimate;
-  const SimplifyOptions phase2_options = [&] {
-    SimplifyOptions o = options;
-    if (refit_to_input) o.refit_rounds = 0;
-    o.far_repair = false;  // not measured out of core (docs/benchmarks.md, "Far places")
-    return o;
-  }();
-  const unsigned parts = ooc.parts ? ooc.parts
-                         : partition_refusal(clustered_mesh, options).empty()
-                             ? automatic_parts(clustered_mesh.face_count())
-                             : 1;
+  const outofcore::StreamedPartsPlan plan =
+      !soup && budget_binds && ooc.parts == 0 && partition_refusal(Mesh{}, options).empty()
+          ? outofcore::plan_streamed_parts(report.input_faces, nv, std::size_t(target), budget,
+                                           positions_in_memory ? 12.0 * double(nv) : double(mapped_allowance),
+                                           threads)
+          : outofcore::StreamedPartsPlan{};
   SimplifyResult r;
-  if (parts > 1) {
-    PartitionOptions po;
-    po.parts = parts;
-    po.progress = [&](unsigned done, unsigned all) {
-      progress.fraction(0.9 * double(done) / double(all));
-      return true;
-    };
-    PartitionReport pr;
-    r = simplify_partitioned(clustered_mesh, phase2_options, po, &pr);
-    report.parts = pr.parts;
-  } else {
-    Phase2Observer observer(progress);
-    r = simplify(std::move(clustered_mesh), phase2_options, &observer);
-    report.parts = 1;
+  bool refit_to_input = false;
+  bool by_parts = false;
+  if (plan.parts > 0) {
+    progress.phase("parts", 2);
+    progress.start_phase2();
+    outofcore::StreamedPartsReport parts_report;
+    by_parts = outofcore::simplify_streamed_parts(
+        path, positions, lo, extent, options, plan, temp_dir,
+        [&](double f) {
+          give_back_pages();
+          progress.fraction(f);
+        },
+        r, &parts_report);
+    if (by_parts) {
+      if (store) store->release();
+      report.method = "parts";
+      report.parts = parts_report.parts;
+      report.shared_vertices = parts_report.shared_vertices;
+      report.merged_faces = parts_report.merged_faces;
+      report.temp_bytes_written = outofcore::temp_bytes_written() - temp_bytes_before;
+      lap("parts");
+    }
   }
-  lap("simplifying");
+  if (!by_parts) {
+    // --- phase 1: Lindstrom 2000 clustering, the grid sized by a sample ----------------------------
+    progress.phase("clustering", 2);
+    Grid fine;
+    std::copy(lo, lo + 3, fine.lo);
+    fine.size = starting_cell_size(sample, lo, extent, goal_cells);
+    std::vector<float>().swap(sample);
+    TempFile faces(temp_dir, "faces");
+    ParallelClustering clustering(fine, hard_cells, threads, faces);
+    clustering.after_block = [&, blocks = 0]() mutable {
+      if (++blocks % 16 == 0) give_back_pages();
+      progress.read(in.bytes_read());
+    };
+    if (soup) {
+      in.read_soup([&](const double* xyz, std::size_t n) {
+        clustering.add_soup(xyz, n);
+        progress.read(in.bytes_read());
+      });
+    } else {
+      in.read_triangles([&](const std::uint32_t* tri, std::size_t n) {
+        clustering.add_indexed(tri, n, positions);
+        progress.read(in.bytes_read());
+      });
+    }
+    clustering.finish();
+    report.grid_coarsenings = unsigned(clustering.levels());
+    if (store) store->release();
+    CellTable& cells = clustering.cells();
+    report.clustered_vertices = cells.size();
+    const double cell_size = fine.size * std::ldexp(1.0, clustering.levels());
+    report.grid_resolution = std::uint64_t(std::ceil(extent / cell_size));
+
+    // Each cell's representative: the minimum of its quadric around the corners' mean, kept inside
+    // the cell (Lindstrom & Silva 2001 §4: a point outside would fold neighbouring cells' faces).
+    // Each cell on its own, so the threads share them in ranges without changing a bit.
+    Mesh clustered_mesh;
+    clustered_mesh.positions.resize(3 * std::size_t(cells.size()));
+    auto place_cells = [&](std::uint32_t begin, std::uint32_t end) {
+      for (std::uint32_t i = begin; i < end; ++i) {
+        const auto& cell = cells.cell(i);
+        const double mean[3] = {cell.sum[0] / cell.corners, cell.sum[1] / cell.corners,
+                                cell.sum[2] / cell.corners};
+        double x[3];
+        const core::Quadric q = with_border(cell, cell_size);
+        cluster_detail::minimize_around(q, mean, x);
+        std::uint64_t k[3];
+        outofcore::unpack_cell(cells.key(i), k);
+        const double c0[3] = {double(k[0]) * cell_size, double(k[1]) * cell_size, double(k[2]) * cell_size};
+        const double c1[3] = {c0[0] + cell_size, c0[1] + cell_size, c0[2] + cell_size};
+        pull_into_cell(q, mean, c0, c1, x);
+        for (int a = 0; a < 3; ++a) clustered_mesh.positions[3 * i + a] = lo[a] + x[a];
+      }
+    };
+    {
+      std::vector<std::thread> helpers;
+      const std::uint32_t n = cells.size(), per = n / threads + 1;
+      for (unsigned t = 1; t < threads && t * per < n; ++t)
+        helpers.emplace_back(place_cells, t * per, std::min<std::uint32_t>(n, (t + 1) * per));
+      place_cells(0, std::min(n, per));
+      for (std::thread& h : helpers) h.join();
+    }
+    std::vector<std::uint64_t> shapes;  // per clustered face, its input triangle's
+    clustered_mesh.indices = outofcore::read_clustered_faces(clustering, faces, shapes);
+    cells.release();
+    drop_paired_faces(clustered_mesh.indices, shapes);
+    std::vector<std::uint64_t>().swap(shapes);
+    report.clustered_faces = clustered_mesh.face_count();
+    report.temp_bytes_written = outofcore::temp_bytes_written() - temp_bytes_before;
+    lap("clustering");
+
+    // --- phase 2: GH97 in core on the clustered mesh, part by part when it is large -------------------
+    progress.phase("simplifying", 3);
+    progress.start_phase2();
+    // Where the memory limit leaves phase 2 fewer than 6 clustered faces an output face, its own
+    // refit (to the clustered mesh) gets fewer rounds than an in-core run's or none (below 3): the
+    // refit then fits the output to the input's points after phase 2 instead, the clustered surface
+    // having lost what the cells averaged away besides (a one-pixel spike on the terrain). From 6
+    // up phase 2 refits as before: its refit to the clustered mesh has the input's area weights and
+    // the guard against moving off the surface, which the streamed points lack, and came out
+    // better (the generated 1.3M sphere to 1 %, 35x: E 1.06x the in-core run's, 1.08x fitted to the input).
+    const double target_faces_estimate =
+        options.target_faces ? double(options.target_faces) : 2.0 * double(options.target_vertices);
+    refit_to_input = options.refit_rounds > 0 && options.refit_by_reduction &&
+                     double(report.clustered_faces) < 6 * target_faces_estimate;
+    const SimplifyOptions phase2_options = [&] {
+      SimplifyOptions o = options;
+      if (refit_to_input) o.refit_rounds = 0;
+      o.far_repair = false;  // not measured out of core (docs/benchmarks.md, "Far places")
+      return o;
+    }();
+    const unsigned parts = ooc.parts ? ooc.parts
+                           : partition_refusal(clustered_mesh, options).empty()
+                               ? automatic_parts(clustered_mesh.face_count())
+                               : 1;
+    if (parts > 1) {
+      PartitionOptions po;
+      po.parts = parts;
+      po.progress = [&](unsigned done, unsigned all) {
+        progress.fraction(0.9 * double(done) / double(all));
+        return true;
+      };
+      PartitionReport pr;
+      r = simplify_partitioned(clustered_mesh, phase2_options, po, &pr);
+      report.parts = pr.parts;
+    } else {
+      Phase2Observer observer(progress);
+      r = simplify(std::move(clustered_mesh), phase2_options, &observer);
+      report.parts = 1;
+    }
+    lap("simplifying");
+  }
   // The refit against the input (see phase2_options): whether it runs and its points a vertex
   // follow the reduction from the input, as an in-core run's would; its points fit in the budget.
   RefitOptions refit = refit_options_for(options, std::size_t(std::min<std::uint64_t>(report.input_vertices, SIZE_MAX)),

@@ -171,6 +171,17 @@ std::size_t TempFile::read(void* data, std::size_t n) {
   return done;
 }
 
+void TempFile::read_at(std::uint64_t offset, void* data, std::size_t n) const {
+  std::size_t done = 0;
+  while (done < n) {
+    ssize_t k = ::pread(fd_, static_cast<char*>(data) + done, n - done, off_t(offset + done));
+    if (k < 0 && errno == EINTR) continue;
+    if (k < 0) throw Error(path_ + ": cannot read back: " + std::strerror(errno));
+    if (k == 0) throw Error(path_ + ": cannot read back: the file ends early");
+    done += static_cast<std::size_t>(k);
+  }
+}
+
 // --- AtomicOutput ---------------------------------------------------------------------------------
 
 AtomicOutput::AtomicOutput(const std::string& path) : target_(path) {

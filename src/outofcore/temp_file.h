@@ -52,6 +52,9 @@ class TempFile : public BufferedWriter {
   void rewind_for_reading();
   /// Reads up to n bytes; returns how many (0 at the end).
   std::size_t read(void* data, std::size_t n);
+  /// After rewind_for_reading: reads n bytes at `offset`, from any thread (it moves no file
+  /// position); fewer than n is an error naming the file.
+  void read_at(std::uint64_t offset, void* data, std::size_t n) const;
 
  private:
   int slot_ = -1;

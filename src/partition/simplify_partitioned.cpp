@@ -190,13 +190,7 @@ SimplifyResult finish(MeshView input, const SimplifyOptions& options, std::span<
   // (the caller's locks still are).
   // A ratio is of the faces the parts simplified (their duplicates dropped), as the core's is.
   const partition_detail::Targets total = partition_detail::resolve_targets(options, nondegenerate - part_dups);
-  SimplifyOptions o = options;
-  o.target_faces = total.faces;
-  o.target_ratio = 0;
-  o.target_vertices = total.vertices;
-  o.refit_rounds = 0;
-  o.far_repair = false;
-  o.fit_attributes = false;
+  SimplifyOptions o = partition_detail::final_pass_options(options, total);
   o.map_input_vertices = true;
   std::vector<std::uint8_t> lock, protect;
   if (!options.vertex_lock.empty()) {

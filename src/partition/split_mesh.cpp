@@ -55,6 +55,44 @@ Targets resolve_targets(const SimplifyOptions& o, std::size_t faces) {
   return t;
 }
 
+SimplifyOptions final_pass_options(const SimplifyOptions& options, const Targets& total) {
+  SimplifyOptions o = options;
+  o.target_faces = total.faces;
+  o.target_ratio = 0;
+  o.target_vertices = total.vertices;
+  o.refit_rounds = 0;
+  o.far_repair = false;
+  o.fit_attributes = false;
+  return o;
+}
+
+Targets part_targets(const Targets& total, std::size_t part_faces, std::size_t all_faces,
+                     std::size_t part_vertices, std::size_t all_vertices, std::size_t locked) {
+  // The part's share of the target, in proportion to its faces (vertices), plus two per cut
+  // vertex: the strip along the locked cut keeps faces that the final pass removes, and which must
+  // not be taken out of the part's interior (it would end up coarser than the rest). With one per
+  // cut vertex the final pass had too little left to undo the cut's strip: after the closed-form
+  // placement and the input-normal guard landed, the bumpy sphere's Hausdorff distance in 4 parts
+  // rose to 1.21x the in-core run's (Partition.ErrorStaysNearTheInCoreRun); with two it is within.
+  // The share itself is 1.25x the part's proportion: the final pass makes its quadrics afresh
+  // from the welded parts and, since the parts forget (SimplifyOptions::forget), it needs room
+  // of its own to reach the in-core run's mean error; with the bare proportion the 10M torus to
+  // 1 % in 16 parts had E 1.12x the in-core run's, with 1.25x 1.01x (and 0.996-1.033x over the
+  // four meshes of docs/benchmarks.md's issue-20 table at 10 % and 1 %, for no measurable time).
+  // At least 1 (0 means unused): a part whose share rounds to nothing goes as far as it can.
+  constexpr double kShareSlack = 1.25;
+  Targets t;
+  if (total.faces > 0)
+    t.faces = std::max<std::size_t>(1, std::size_t(kShareSlack * double(total.faces) * double(part_faces) /
+                                                   double(std::max<std::size_t>(1, all_faces))) +
+                                           2 * locked);
+  if (total.vertices > 0)
+    t.vertices = std::max<std::size_t>(1, std::size_t(double(total.vertices) * double(part_vertices) /
+                                                      double(std::max<std::size_t>(1, all_vertices))) +
+                                              locked);
+  return t;
+}
+
 }  // namespace partition_detail
 
 namespace {
@@ -261,28 +299,9 @@ std::vector<MeshPart> split_mesh(MeshView input, const SimplifyOptions& options,
         part.mesh.indices.push_back(*id);
       }
     }
-    // The part's share of the target, in proportion to its faces (vertices), plus two per cut
-    // vertex: the strip along the locked cut keeps faces that the final pass removes, and which must
-    // not be taken out of the part's interior (it would end up coarser than the rest). With one per
-    // cut vertex the final pass had too little left to undo the cut's strip: after the closed-form
-    // placement and the input-normal guard landed, the bumpy sphere's Hausdorff distance in 4 parts
-    // rose to 1.21x the in-core run's (Partition.ErrorStaysNearTheInCoreRun); with two it is within.
-    // The share itself is 1.25x the part's proportion: the final pass makes its quadrics afresh
-    // from the welded parts and, since the parts forget (SimplifyOptions::forget), it needs room
-    // of its own to reach the in-core run's mean error; with the bare proportion the 10M torus to
-    // 1 % in 16 parts had E 1.12x the in-core run's, with 1.25x 1.01x (and 0.996-1.033x over the
-    // four meshes of docs/benchmarks.md's issue-20 table at 10 % and 1 %, for no measurable time).
-    // At least 1 (0 means unused): a part whose share rounds to nothing goes as far as it can.
-    constexpr double kShareSlack = 1.25;
-    const std::size_t part_faces = end - begin, part_vertices = part.input_vertex.size();
-    if (total.faces > 0)
-      part.target_faces = std::max<std::size_t>(
-          1, std::size_t(kShareSlack * double(total.faces) * double(part_faces) / double(std::max<std::size_t>(1, n))) +
-                 2 * locked_count);
-    if (total.vertices > 0)
-      part.target_vertices = std::max<std::size_t>(
-          1, std::size_t(double(total.vertices) * double(part_vertices) / double(std::max<std::size_t>(1, referenced))) +
-                 locked_count);
+    const partition_detail::Targets mine = partition_detail::part_targets(
+        total, end - begin, n, part.input_vertex.size(), referenced, locked_count);
+    part.target_faces = mine.faces, part.target_vertices = mine.vertices;
   });
   if (report) {
     report->parts = part_count;

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "core/distance_bound.h"
-
+#include "core/far_repair.h"
 #include "qem/mesh.h"
 #include "qem/progressive.h"
 #include "qem/refit.h"
@@ -39,6 +39,18 @@ void refit_levels(MeshView original, std::span<ReplayLevel> levels, const Simpli
 /// leave as it is. Either span may be shorter (empty: none).
 std::vector<std::uint8_t> seam_or_locked(std::span<const std::uint8_t> on_seam, std::span<const std::uint8_t> fixed,
                                          std::size_t vertices);
+
+/// The far-place repair of `mesh` with `options`' turn limit and threads (core/far_repair.h),
+/// against the input (`input`'s positions) as `points` and `surface`; `on_border` per point (1:
+/// on the input's border; empty: found by the repair when it needs them, unless the mesh has vertex
+/// properties; all zero: no relocation at a border); `closest_faces` per point (empty: none) as
+/// FarRepairOptions::point_faces. A relocated vertex that stands at an input vertex takes its exact
+/// coordinates.
+core::FarRepairResult repair_mesh(Mesh& mesh, const SimplifyOptions& options, MeshView input,
+                                  std::span<const std::uint8_t> on_border,
+                                  const refit_detail::FitPoints& points, const core::SurfaceDistance& surface,
+                                  std::span<const std::uint8_t> held,
+                                  std::span<const std::uint32_t> closest_faces);
 
 /// The far-place repair (core/far_repair.h) of `result` after its refit, against the input (its
 /// positions and the faces the run used) as points and surface (those of the refit), `held`
