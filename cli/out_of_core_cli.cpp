@@ -17,7 +17,9 @@ void add_out_of_core_options(CLI::App* sub, OutOfCoreArgs& args) {
   sub->add_option("--memory-limit", args.memory_limit,
                   "Memory budget, e.g. 2G or 512M (default: half of the available memory). A binary PLY or "
                   "STL whose in-memory run would exceed it is simplified out of core: clustered while "
-                  "streamed (Lindstrom 2000), then simplified in memory (docs/out-of-core.md)");
+                  "streamed (Lindstrom 2000), then simplified in memory; or, when it is within a few budgets "
+                  "and the budget would leave that second phase too few faces, part by part on disk "
+                  "(docs/out-of-core.md)");
   sub->add_option("--temp-dir", args.temp_dir,
                   "Folder for the out-of-core run's temporary files (default: $TMPDIR, else the output's "
                   "folder); they are removed at the end, on failure and on Ctrl-C");
