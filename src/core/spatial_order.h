@@ -30,6 +30,19 @@ inline std::uint64_t spread_bits_3d(std::uint64_t x) {
   return x;
 }
 
+/// The Morton code of point p (21 bits an axis) on the grid of cubic cells whose corner is `lo`,
+/// `scale` cells a unit. Each coordinate is clamped before the conversion (NaN, inf and
+/// out-of-range doubles must never reach the cast: undefined behaviour, found by fuzz_simplify
+/// with coordinates near 1e308).
+inline std::uint64_t morton_code(const double p[3], const double lo[3], double scale) {
+  std::uint64_t code = 0;
+  for (int a = 0; a < 3; ++a) {
+    const double c = (p[a] - lo[a]) * scale;
+    code |= spread_bits_3d(c >= 0 ? std::uint64_t(std::min(c, double((1 << 21) - 1))) : 0) << a;
+  }
+  return code;
+}
+
 /// Indices 0..n-1 sorted by the Morton code of point_of(i) (a Vec3) over the points' bounding
 /// box, ties by index: the order is fully determined by the input. The box and the codes are made
 /// in fixed chunks on up to `threads` threads (per-chunk boxes merged in chunk order: min and max
@@ -57,14 +70,8 @@ std::vector<std::uint32_t> morton_order(std::size_t n, PointOf point_of, unsigne
   for_chunks(n, kChunk, threads, [&](std::size_t, std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       const Vec3 p = point_of(i);
-      // Clamped before the conversion (NaN, inf and out-of-range doubles must never reach the
-      // cast: undefined behaviour, found by fuzz_simplify with coordinates near 1e308).
-      const auto cell = [&](double x, double l) {
-        const double c = (x - l) * scale;
-        return c >= 0 ? std::uint64_t(std::min(c, double((1 << 21) - 1))) : std::uint64_t(0);
-      };
-      code[i] = spread_bits_3d(cell(p.x, lo.x)) | spread_bits_3d(cell(p.y, lo.y)) << 1 |
-                spread_bits_3d(cell(p.z, lo.z)) << 2;
+      const double xyz[3] = {p.x, p.y, p.z}, corner[3] = {lo.x, lo.y, lo.z};
+      code[i] = morton_code(xyz, corner, scale);
       order[i] = std::uint32_t(i);
     }
   });

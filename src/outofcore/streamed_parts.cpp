@@ -52,15 +52,10 @@ double estimated_cut_vertices(double faces, unsigned parts) { return 4 * std::sq
 /// The Morton code of a face's centroid (21 bits an axis over the bounding box), as split_mesh's.
 std::uint64_t centroid_code(const PositionSource& positions, const std::uint32_t* t, const double lo[3],
                             double scale) {
-  double p[3][3];
+  double p[3][3], centroid[3];
   for (int k = 0; k < 3; ++k) positions.get(t[k], p[k]);
-  std::uint64_t code = 0;
-  for (int a = 0; a < 3; ++a) {
-    const double x = (p[0][a] + p[1][a] + p[2][a]) / 3;
-    const double cell = std::clamp((x - lo[a]) * scale, 0.0, double((1 << 21) - 1));
-    code |= core::spread_bits_3d(std::uint64_t(cell)) << a;
-  }
-  return code;
+  for (int a = 0; a < 3; ++a) centroid[a] = (p[0][a] + p[1][a] + p[2][a]) / 3;
+  return core::morton_code(centroid, lo, scale);
 }
 
 bool degenerate(const std::uint32_t* t) { return t[0] == t[1] || t[1] == t[2] || t[0] == t[2]; }

@@ -132,14 +132,13 @@ Array<std::uint64_t> centroid_codes(MeshView input, const std::vector<std::uint3
         code[f] = UINT64_MAX;
         continue;
       }
-      std::uint64_t c = 0;
-      for (int k = 0; k < 3; ++k) {
-        const double x = (input.positions[3 * std::size_t(t[0]) + k] + input.positions[3 * std::size_t(t[1]) + k] +
-                          input.positions[3 * std::size_t(t[2]) + k]) / 3;
-        const double cell = std::clamp((x - box.lo[k]) * scale, 0.0, double((1 << 21) - 1));
-        c |= core::spread_bits_3d(std::uint64_t(cell)) << k;
-      }
-      code[f] = c;
+      double centroid[3];
+      for (int k = 0; k < 3; ++k)
+        centroid[k] =
+            (input.positions[3 * std::size_t(t[0]) + k] + input.positions[3 * std::size_t(t[1]) + k] +
+             input.positions[3 * std::size_t(t[2]) + k]) /
+            3;
+      code[f] = core::morton_code(centroid, box.lo, scale);
     }
   });
   return code;
