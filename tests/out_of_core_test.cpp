@@ -19,6 +19,7 @@
 
 #include "mesh_checks.h"
 #include "outofcore/mesh_generator.h"
+#include "outofcore/streamed_parts.h"
 #include "outofcore/temp_file.h"
 #include "qem/io.h"
 #include "qem/measure.h"
@@ -390,6 +391,27 @@ TEST(OutOfCore, SameResultOnAnyNumberOfThreads) {
   EXPECT_EQ(test::validity_problem(welded), "");
   EXPECT_EQ(test::boundary_edges(welded), 0u);  // the parts' borders met: no crack
   EXPECT_EQ(entries(dir), 0u);
+}
+
+// The plan by parts: the fewest parts that fit, each given the larger share of the target (1.6x
+// its proportion) where it and the final pass over the welded parts then fit the budget, else the
+// in-memory run's 1.25x, else no plan. A 2M-face input to 1M faces: the final pass takes about
+// 180 bytes a face of 1.6M + the cut's faces (more than 270M) or of 1.25M (less, but more than
+// 200M).
+TEST(OutOfCore, ByPartsTakesTheLargerShareThatFits) {
+  const std::uint64_t faces = 2000000, vertices = 1000000;
+  const double resident = 12.0 * vertices;
+  const outofcore::StreamedPartsPlan ample =
+      outofcore::plan_streamed_parts(faces, vertices, 1000000, 600e6, resident, 2);
+  EXPECT_GE(ample.parts, 2u);
+  EXPECT_EQ(ample.share_slack, 1.6);
+  const outofcore::StreamedPartsPlan tight =
+      outofcore::plan_streamed_parts(faces, vertices, 1000000, 270e6, resident, 2);
+  EXPECT_GE(tight.parts, ample.parts);
+  EXPECT_EQ(tight.share_slack, 1.25);
+  EXPECT_EQ(outofcore::plan_streamed_parts(faces, vertices, 1000000, 200e6, resident, 2).parts, 0u);
+  // A small target leaves room for the larger share under the tight budget.
+  EXPECT_EQ(outofcore::plan_streamed_parts(faces, vertices, 200000, 270e6, resident, 2).share_slack, 1.6);
 }
 
 // By parts (outofcore/streamed_parts.h): a limit a little below what the in-core run needs, with a

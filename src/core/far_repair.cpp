@@ -1242,39 +1242,46 @@ class Repairer {
       s.faces = {{t[0], t[1], kNew}, {t[1], t[2], kNew}, {t[2], t[0], kNew}};
       s.parent = {f, f, f};
     }
-    if (!keeps_facing(s, s.y)) {
-      // A lone spike of the input (one vertex far above its neighbours, an outlier pixel of a
-      // terrain): the faces up to its tip would turn by more than the limit. Part of the way up
-      // still cuts the largest distance (by the part), as far as the limit allows.
-      if (s.border || s.crack) return false;
-      const Vec3 base = near, tip = s.y;
-      bool lifted = false;
-      for (double part : {0.75, 0.5, 0.25})
-        if (keeps_facing(s, base + (tip - base) * part)) {
-          s.y = base + (tip - base) * part, s.at_point = false, lifted = true;
-          break;
-        }
-      if (!lifted) return false;
+    // The values at the new vertex's foot on the faces it divides (of an edge's two, the nearer),
+    // and whether the plan mends the far place: its new faces nearer the input than it, and the
+    // input near them.
+    const auto mends = [&] {
+      s.from = {t[0], t[1], t[2]};
+      s.share = measure_detail::closest_point_weights(s.y, a, b, c);
+      if (s.old.size() == 2 && !s.crack) {
+        const std::uint32_t* o = &tri_[3 * g];
+        const auto on = [&](const std::uint32_t* q, const std::array<double, 3>& w) {
+          return x_[q[0]] * w[0] + x_[q[1]] * w[1] + x_[q[2]] * w[2];
+        };
+        const std::array<double, 3> w =
+            measure_detail::closest_point_weights(s.y, x_[o[0]], x_[o[1]], x_[o[2]]);
+        if (measure_detail::squared_distance(s.y, on(o, w)) <
+            measure_detail::squared_distance(s.y, on(t, s.share)))
+          s.from = {o[0], o[1], o[2]}, s.share = w;
+      }
+      if (s.crack) {  // the twin at the same place along the twin edge
+        const Vec3 along = x_[eb] - x_[ea];
+        const double u = std::clamp(dot(s.y - x_[ea], along) / std::max(dot(along, along), 1e-300), 0.0, 1.0);
+        s.twin_from = {twin_[ea], twin_[eb], twin_[ea]};
+        s.share_twin = {1 - u, u, 0};
+      }
+      return score_plan(s, s.y, HUGE_VAL) && s.most < local(f) && input_stays_near(s, s.y, local(f));
+    };
+    // A lone spike of the input (one vertex far above its neighbours, an outlier pixel of a
+    // terrain): the faces up to its tip may turn by more than the limit, or, where the far place is
+    // the input's point, pass farther from the input round it than the place they mend. Part of
+    // the way up still cuts the largest distance (by the part), as far as the limit allows.
+    const Vec3 base = near, tip = s.y;
+    const bool faces_tip = keeps_facing(s, s.y);
+    if (faces_tip && mends()) return true;
+    if (s.border || s.crack || (faces_tip && !s.at_point)) return false;
+    for (double part : {0.75, 0.5, 0.25}) {
+      const Vec3 y = base + (tip - base) * part;
+      if (!keeps_facing(s, y)) continue;
+      s.y = y, s.at_point = false;
+      if (mends()) return true;
     }
-    // The values at the new vertex's foot on the faces it divides (of an edge's two, the nearer).
-    s.from = {t[0], t[1], t[2]};
-    s.share = measure_detail::closest_point_weights(s.y, a, b, c);
-    if (s.old.size() == 2 && !s.crack) {
-      const std::uint32_t* o = &tri_[3 * g];
-      const auto on = [&](const std::uint32_t* q, const std::array<double, 3>& w) {
-        return x_[q[0]] * w[0] + x_[q[1]] * w[1] + x_[q[2]] * w[2];
-      };
-      const std::array<double, 3> w = measure_detail::closest_point_weights(s.y, x_[o[0]], x_[o[1]], x_[o[2]]);
-      if (measure_detail::squared_distance(s.y, on(o, w)) < measure_detail::squared_distance(s.y, on(t, s.share)))
-        s.from = {o[0], o[1], o[2]}, s.share = w;
-    }
-    if (s.crack) {  // the twin at the same place along the twin edge
-      const Vec3 along = x_[eb] - x_[ea];
-      const double u = std::clamp(dot(s.y - x_[ea], along) / std::max(dot(along, along), 1e-300), 0.0, 1.0);
-      s.twin_from = {twin_[ea], twin_[eb], twin_[ea]};
-      s.share_twin = {1 - u, u, 0};
-    }
-    return score_plan(s, s.y, HUGE_VAL) && s.most < local(f) && input_stays_near(s, s.y, local(f));
+    return false;
   }
 
   // The vertices adjacent to v (ascending, once each).

@@ -36,6 +36,13 @@ constexpr double kPartBytesPerFace = kInCoreBytesPerFace + 64;
 constexpr double kOutputBytesPerFace = 100;
 /// Rings of faces along a cut that the refit by parts holds (refit_by_parts).
 constexpr int kCutRings = 2;
+/// A part's share of the target over its proportion (partition_detail::part_targets), larger than
+/// the in-memory run's: the final pass has more to choose from, and here the refit goes part by
+/// part with the cuts' bands held. Over the four rows of docs/benchmarks.md's "By parts" (to 10 %),
+/// E / in-core 1.00-1.02x and Hausdorff 0.97-1.10x, against 0.99-1.10x and 1.04-1.08x with 1.25x;
+/// with 2x the 10M torus's Hausdorff rose to 1.22x. Where the final pass would not fit the budget
+/// with it, the in-memory run's share.
+constexpr double kShareSlack = 1.6;
 /// Faces a part gathers in memory before they go to the file: 256 KB a part.
 constexpr std::size_t kBlockFaces = 16384;
 
@@ -261,15 +268,19 @@ StreamedPartsPlan plan_streamed_parts(std::uint64_t faces, std::uint64_t vertice
   for (unsigned parts = 2; parts <= kMaxParts; parts *= 2) {
     const double part_faces =
         1.02 * double(faces) / parts;  // the cut's sample: equal within a percent or two
-    const double merged = 1.25 * double(target_faces) + 2 * estimated_cut_vertices(double(faces), parts);
-    const double fixed = resident + 5.0 * double(vertices) + parts * kBlockFaces * sizeof(FaceRecord) +
-                         kOutputBytesPerFace * merged;
-    const double room = budget - fixed;
-    if (room < kPartBytesPerFace * part_faces) continue;
-    if (kInCoreBytesPerFace * merged + resident + double(vertices) > budget) return {};  // the final pass
-    const unsigned concurrent = unsigned(
-        std::clamp(std::floor(room / (kPartBytesPerFace * part_faces)), 1.0, double(std::max(1u, threads))));
-    return {parts, std::min(concurrent, parts)};
+    // The fewest parts, and for them the larger share that fits (kShareSlack, else the in-memory
+    // run's).
+    for (const double slack : {kShareSlack, partition_detail::kPartShareSlack}) {
+      const double merged = slack * double(target_faces) + 2 * estimated_cut_vertices(double(faces), parts);
+      const double fixed = resident + 5.0 * double(vertices) + parts * kBlockFaces * sizeof(FaceRecord) +
+                           kOutputBytesPerFace * merged;
+      const double room = budget - fixed;
+      if (room < kPartBytesPerFace * part_faces) continue;
+      if (kInCoreBytesPerFace * merged + resident + double(vertices) > budget) continue;  // the final pass
+      const unsigned concurrent = unsigned(std::clamp(std::floor(room / (kPartBytesPerFace * part_faces)),
+                                                      1.0, double(std::max(1u, threads))));
+      return {parts, std::min(concurrent, parts), slack};
+    }
   }
   return {};
 }
@@ -392,7 +403,7 @@ bool simplify_streamed_parts(const std::string& path, const PositionSource& posi
       locked += part.locked[l];
     }
     const partition_detail::Targets mine = partition_detail::part_targets(
-        total, part_faces[p], all_faces, vertices.size(), vertex_count, locked);
+        total, part_faces[p], all_faces, vertices.size(), vertex_count, locked, plan.share_slack);
     part.target_faces = mine.faces, part.target_vertices = mine.vertices;
     MeshPartResult r = simplify_part(part, one);
     if (r.dropped_duplicate_faces > 0) duplicates = true;

@@ -25,14 +25,17 @@ inline constexpr double kInCoreBytesPerFace = 180;
 struct StreamedPartsPlan {
   unsigned parts = 0;       ///< 0: not by parts (cluster instead)
   unsigned concurrent = 1;  ///< parts simplified at once, one a thread
+  double share_slack = 0;   ///< a part's share of the target over its proportion (part_targets)
 };
 
 /// Parts for `faces` triangles on `vertices` vertices to `target_faces` under `budget` bytes, of
 /// which `resident` are already taken (positions kept in memory), on `threads` threads: the fewest
 /// (a power of two, at most 64) such that the parts being simplified at once, the per-vertex
-/// arrays of the cut and the final pass fit. {0} when the input is more than kMaxBudgets budgets
-/// (clustering is then much faster, and its phase 2 gets tens of times the target anyway at the
-/// sizes where this would be slow) or no such count exists.
+/// arrays of the cut and the final pass fit, the parts given the larger of two shares of the
+/// target with which they do (streamed_parts.cpp's kShareSlack, else the in-memory run's). {0}
+/// when the input is more than kMaxBudgets budgets (clustering is then much faster, and its phase 2
+/// gets tens of times the target anyway at the sizes where this would be slow) or no such count
+/// exists.
 StreamedPartsPlan plan_streamed_parts(std::uint64_t faces, std::uint64_t vertices, std::size_t target_faces,
                                       double budget, double resident, unsigned threads);
 

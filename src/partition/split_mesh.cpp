@@ -67,23 +67,21 @@ SimplifyOptions final_pass_options(const SimplifyOptions& options, const Targets
 }
 
 Targets part_targets(const Targets& total, std::size_t part_faces, std::size_t all_faces,
-                     std::size_t part_vertices, std::size_t all_vertices, std::size_t locked) {
+                     std::size_t part_vertices, std::size_t all_vertices, std::size_t locked,
+                     double share_slack) {
   // The part's share of the target, in proportion to its faces (vertices), plus two per cut
   // vertex: the strip along the locked cut keeps faces that the final pass removes, and which must
   // not be taken out of the part's interior (it would end up coarser than the rest). With one per
   // cut vertex the final pass had too little left to undo the cut's strip: after the closed-form
   // placement and the input-normal guard landed, the bumpy sphere's Hausdorff distance in 4 parts
   // rose to 1.21x the in-core run's (Partition.ErrorStaysNearTheInCoreRun); with two it is within.
-  // The share itself is 1.25x the part's proportion: the final pass makes its quadrics afresh
-  // from the welded parts and, since the parts forget (SimplifyOptions::forget), it needs room
-  // of its own to reach the in-core run's mean error; with the bare proportion the 10M torus to
-  // 1 % in 16 parts had E 1.12x the in-core run's, with 1.25x 1.01x (and 0.996-1.033x over the
-  // four meshes of docs/benchmarks.md's issue-20 table at 10 % and 1 %, for no measurable time).
+  // The share itself is `share_slack` times the part's proportion (kPartShareSlack in memory):
+  // the final pass makes its quadrics afresh from the welded parts and, since the parts forget
+  // (SimplifyOptions::forget), it needs room of its own to reach the in-core run's mean error.
   // At least 1 (0 means unused): a part whose share rounds to nothing goes as far as it can.
-  constexpr double kShareSlack = 1.25;
   Targets t;
   if (total.faces > 0)
-    t.faces = std::max<std::size_t>(1, std::size_t(kShareSlack * double(total.faces) * double(part_faces) /
+    t.faces = std::max<std::size_t>(1, std::size_t(share_slack * double(total.faces) * double(part_faces) /
                                                    double(std::max<std::size_t>(1, all_faces))) +
                                            2 * locked);
   if (total.vertices > 0)
@@ -298,8 +296,9 @@ std::vector<MeshPart> split_mesh(MeshView input, const SimplifyOptions& options,
         part.mesh.indices.push_back(*id);
       }
     }
-    const partition_detail::Targets mine = partition_detail::part_targets(
-        total, end - begin, n, part.input_vertex.size(), referenced, locked_count);
+    const partition_detail::Targets mine =
+        partition_detail::part_targets(total, end - begin, n, part.input_vertex.size(), referenced,
+                                       locked_count, partition_detail::kPartShareSlack);
     part.target_faces = mine.faces, part.target_vertices = mine.vertices;
   });
   if (report) {
