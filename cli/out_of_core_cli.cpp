@@ -69,6 +69,13 @@ int run_out_of_core(const std::string& input, const std::string& output, const S
     std::fprintf(stderr, "qem: note: %s: out of core keeps positions and faces only; not carried: %s\n",
                  input.c_str(), names.c_str());
   }
+  if (report.memory_needed > 0 && !out.quiet)  // the target wins over the limit, with a word
+    std::fprintf(
+        stderr,
+        "qem: note: %s: --memory-limit %.3g MB is below what the target (%zu faces) needs out of core, "
+        "about %.3g MB; the run took what it needed (peak %.3g MB) rather than end below the target\n",
+        input.c_str(), double(report.memory_limit) / 1e6, report.target_faces,
+        double(report.memory_needed) / 1e6, double(report.peak_memory_bytes) / 1e6);
   SaveOptions save;
   save.binary = !out.ascii;
   save.double_precision = out.double_values;
@@ -90,17 +97,19 @@ int run_out_of_core(const std::string& input, const std::string& output, const S
         "\"out_vertices\":%zu,\"clustered_faces\":%llu,\"merged_faces\":%llu,\"shared_vertices\":%llu,\"grid_"
         "resolution\":%llu,\"grid_coarsenings\":%u,"
         "\"memory_limit_bytes\":%llu,"
-        "\"peak_memory_bytes\":%llu,\"temp_bytes_written\":%llu,\"parts\":%u,\"total_s\":%s,\"cpu_s\":%s,"
+        "\"peak_memory_bytes\":%llu,\"memory_needed_bytes\":%llu,\"temp_bytes_written\":%llu,\"parts\":%u,"
+        "\"total_s\":%s,\"cpu_s\":%s,"
         "\"peak_rss_mb\":%s,"
         "\"max_error\":%s,\"max_error_rel\":%s,\"stop\":\"%s\",\"phases\":%s,\"not_carried\":%s}\n",
         json_string(report.method).c_str(), static_cast<unsigned long long>(report.input_faces),
-        out.target_faces, r.mesh.face_count(), r.mesh.vertex_count(),
+        report.target_faces, r.mesh.face_count(), r.mesh.vertex_count(),
         static_cast<unsigned long long>(report.clustered_faces),
         static_cast<unsigned long long>(report.merged_faces),
         static_cast<unsigned long long>(report.shared_vertices),
         static_cast<unsigned long long>(report.grid_resolution), report.grid_coarsenings,
         static_cast<unsigned long long>(report.memory_limit),
         static_cast<unsigned long long>(report.peak_memory_bytes),
+        static_cast<unsigned long long>(report.memory_needed),
         static_cast<unsigned long long>(report.temp_bytes_written), report.parts,
         json_number(total.seconds()).c_str(), json_number(process_cpu_seconds()).c_str(),
         json_number(peak_rss_mb()).c_str(), json_number(r.max_error).c_str(),

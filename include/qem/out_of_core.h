@@ -74,6 +74,11 @@ struct OutOfCoreReport {
   std::string method = "clustering";
   std::uint64_t shared_vertices = 0;  ///< by parts: input vertices on a cut, locked in the parts
   std::uint64_t merged_faces = 0;     ///< by parts: faces of the welded parts, the final pass's input
+  /// Where the limit is below what the target needs (phase 2 never gets fewer cells than the
+  /// target's faces): about the limit that would do, which the run takes instead of ending below
+  /// the target. 0 when the limit is enough.
+  std::uint64_t memory_needed = 0;
+  std::size_t target_faces = 0;  ///< the face target, a ratio resolved against the input's faces
   std::vector<OutOfCorePhase> phases;
   /// What of the input the two phases do not carry (positions and faces only): a PLY's other
   /// vertex and face properties ("vertex red", "face red"...) and other elements, by name.

@@ -497,6 +497,7 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
     options.target_faces = options.target_faces ? std::min(options.target_faces, by_ratio) : by_ratio;
     options.target_ratio = 0;
   }
+  report.target_faces = options.target_faces;
   Progress progress(ooc, 3);
   // The passes over the file: PLY once (vertices, then faces), STL twice (bounds, clusters).
   progress.set_total(soup ? 2 * in.file_size() : in.file_size());
@@ -530,14 +531,27 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
   // Whether the budget, not the time bound, sizes phase 2: then it gets fewer than the goal's
   // multiple of the target, and its result suffers (docs/out-of-core.md, "Why two phases").
   const bool budget_binds = max_cells < goal_by_time;
+  // A budget below the floor: the target wins and the run takes more than the limit, which the
+  // report says (with about the limit the floor needs).
+  if (max_cells < floor_cells) {
+    const double resident = positions_in_memory ? 12.0 * double(nv) : 0.0;
+    const double needed = std::max(resident + double(floor_cells) * kClusterBytesPerCell,
+                                   double(floor_cells) * kPhase2BytesPerCell);
+    report.memory_needed = std::uint64_t(std::ceil(needed / 0.9));
+  }
   max_cells = std::max(max_cells, floor_cells);
   // The grid aims at the goal; the clustering coarsens it when the cells pass twice the goal (the
   // time bound is soft) or the budget's (a hard bound).
   // When the budget binds, the grid aims at 75 % of it: an estimate a little short then still fits,
   // where a coarsening would leave a quarter of the cells (the sample's estimate came within
   // 0.87-1.2x of the cells on the spheres and tori of docs/benchmarks.md).
-  const std::uint64_t hard_cells =
-      goal_by_time < max_cells / 2 ? std::max(2 * goal_by_time, floor_cells) : max_cells;
+  // A coarsening leaves about a quarter of the cells (a surface's cells go with the square of the
+  // resolution): the hard bound is at least twice the floor, so that one leaves at least half the
+  // floor's cells, about the target's faces at two faces a cell (the fandisk, 12,946 faces, to 10 %
+  // under 600 KB: a grid aimed at the floor's 1,294 cells passed it, was coarsened, and left 676
+  // faces; now 2,664 and no coarsening).
+  const std::uint64_t hard_cells = std::max(
+      goal_by_time < max_cells / 2 ? std::max(2 * goal_by_time, floor_cells) : max_cells, 2 * floor_cells);
   const std::uint64_t goal_cells = std::max(
       goal_by_time < max_cells / 2 ? goal_by_time : std::uint64_t(0.75 * double(max_cells)), floor_cells);
 
