@@ -64,6 +64,9 @@ struct OutOfCoreReport {
   std::uint64_t memory_limit = 0;        ///< the budget used (after the default)
   std::uint64_t grid_resolution = 0;     ///< cells along the bounding box's longest side
   unsigned grid_coarsenings = 0;         ///< times the sampled grid was too fine and was halved
+  /// Times the grid was too coarse for the target and the faces were clustered again on a finer
+  /// one (an input whose vertices lie along lines, as a CAD model's).
+  unsigned grid_refinements = 0;
   std::uint64_t clustered_vertices = 0;  ///< occupied cells
   std::uint64_t clustered_faces = 0;     ///< faces handed to phase 2 (after dropping duplicates)
   std::uint64_t temp_bytes_written = 0;
