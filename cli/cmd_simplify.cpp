@@ -11,6 +11,7 @@
 #include "cli_util.h"
 #include "command.h"
 #include "out_of_core_cli.h"
+#include "partition/partition_targets.h"
 #include "partition_cli.h"
 #include "qem/error.h"
 #include "qem/gltf.h"
@@ -242,22 +243,28 @@ int run_simplify(const SimplifyArgs& a) {
         "{\"tool\":\"qem\",\"in_faces\":%zu,\"target_faces\":%zu,\"out_faces\":%zu,\"out_vertices\":%zu,"
         "\"load_s\":%s,\"simplify_s\":%s,\"simplify_cpu_s\":%s,\"write_s\":%s,\"total_s\":%s,"
         "\"peak_rss_mb\":%s,\"max_error\":%s,\"max_error_rel\":%s,\"contractions\":%zu,\"virtual_pairs\":%zu,"
-        "\"rejected_topology\":%zu,\"rejected_inversion\":%zu,\"rejected_error\":%zu,\"rejected_component\":%zu,"
+        "\"rejected_topology\":%zu,\"rejected_inversion\":%zu,\"rejected_error\":%zu,\"rejected_component\":%"
+        "zu,"
         "\"rejected_distance\":%zu,\"output_to_input_distance\":%s,"
         "\"in_components\":%zu,\"out_components\":%zu,\"pruned_components\":%zu,\"refit_rounds\":%zu,"
-        "\"refit_rms_before\":%s,\"refit_rms_after\":%s,\"edge_flips\":%zu,\"vertex_moves\":%zu,\"vertex_relocations\":%zu,\"dropped_degenerate\":%zu,\"dropped_duplicate\":%zu,\"twin_faces\":%zu,"
-        "\"parts\":%u,\"split_s\":%s,\"parts_s\":%s,\"final_pass_s\":%s,\"parts_cpu_s\":%s,\"busiest_thread_cpu_s\":%s,\"stop\":\"%s\"}\n",
-        in_faces, a.faces.value_or(0), r.mesh.face_count(), r.mesh.vertex_count(), json_number(load_s).c_str(),
-        json_number(simplify_s).c_str(), json_number(simplify_cpu_s).c_str(), json_number(write_s).c_str(),
+        "\"refit_rms_before\":%s,\"refit_rms_after\":%s,\"edge_flips\":%zu,\"vertex_moves\":%zu,\"vertex_"
+        "relocations\":%zu,\"dropped_degenerate\":%zu,\"dropped_duplicate\":%zu,\"twin_faces\":%zu,"
+        "\"parts\":%u,\"split_s\":%s,\"parts_s\":%s,\"final_pass_s\":%s,\"parts_cpu_s\":%s,\"busiest_thread_"
+        "cpu_s\":%s,\"stop\":\"%s\"}\n",
+        in_faces, partition_detail::resolve_targets(opt, in_faces).faces, r.mesh.face_count(),
+        r.mesh.vertex_count(), json_number(load_s).c_str(), json_number(simplify_s).c_str(),
+        json_number(simplify_cpu_s).c_str(), json_number(write_s).c_str(),
         json_number(total.seconds()).c_str(), json_number(peak_rss_mb()).c_str(),
         json_number(r.max_error).c_str(), json_number(r.max_error_relative).c_str(), r.contractions,
         r.virtual_pairs, r.rejected_topology, r.rejected_inversion, r.rejected_error, r.rejected_component,
-        r.rejected_distance, json_number(r.output_to_input_distance).c_str(),
-        r.input_components, r.output_components, r.pruned_components, r.refit_rounds,
-        json_number(r.refit_rms_before).c_str(), json_number(r.refit_rms_after).c_str(), r.edge_flips, r.vertex_moves, r.vertex_relocations,
+        r.rejected_distance, json_number(r.output_to_input_distance).c_str(), r.input_components,
+        r.output_components, r.pruned_components, r.refit_rounds, json_number(r.refit_rms_before).c_str(),
+        json_number(r.refit_rms_after).c_str(), r.edge_flips, r.vertex_moves, r.vertex_relocations,
         r.dropped_degenerate_faces, r.dropped_duplicate_faces, r.twin_faces, parts,
-        json_number(partition_report.split_seconds).c_str(), json_number(partition_report.parts_seconds).c_str(),
-        json_number(partition_report.final_seconds).c_str(), json_number(partition_report.parts_cpu_seconds).c_str(),
+        json_number(partition_report.split_seconds).c_str(),
+        json_number(partition_report.parts_seconds).c_str(),
+        json_number(partition_report.final_seconds).c_str(),
+        json_number(partition_report.parts_cpu_seconds).c_str(),
         json_number(partition_report.busiest_thread_cpu_seconds).c_str(), to_string(r.stop_reason));
   }
   if (!a.quiet)
