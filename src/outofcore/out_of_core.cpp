@@ -94,9 +94,15 @@ class Progress {
     report(true);
   }
   void set_total(std::uint64_t bytes) { p_.bytes_total = bytes; }
+  /// One more pass over `bytes` of the file (a refined grid), counted after what was read: read()
+  /// takes that pass's own count from then on.
+  void add_pass(std::uint64_t bytes) {
+    base_ = p_.bytes_total;
+    p_.bytes_total += bytes;
+  }
   void read(std::uint64_t bytes_read) {
     // A pass may read a buffer's worth past its element: the total counts each byte once.
-    p_.bytes_read = std::min(bytes_read, p_.bytes_total);
+    p_.bytes_read = std::min(base_ + bytes_read, p_.bytes_total);
     report(false);
   }
   /// Phase 2: the simplifier's fraction done.
@@ -127,6 +133,7 @@ class Progress {
   OutOfCoreProgress p_;
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
   double last_ = -1, phase2_start_ = 0;
+  std::uint64_t base_ = 0;
 };
 
 /// Forwards the in-core simplifier's progress.
@@ -702,6 +709,7 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
       fine.size = std::max(extent / kFinestResolution, fine.size / std::clamp(finer, 1.5, 8.0));
       previous_faces = faces_now;
       ++report.grid_refinements;
+      progress.add_pass(in.file_size());
     }
     report.grid_coarsenings = unsigned(clustering->levels());
     if (store) store->release();
