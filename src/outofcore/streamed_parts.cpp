@@ -39,7 +39,7 @@ constexpr int kCutRings = 2;
 /// A part's share of the target over its proportion (partition_detail::part_targets), larger than
 /// the in-memory run's: the final pass has more to choose from, and here the refit goes part by
 /// part with the cuts' bands held. Over the four rows of docs/benchmarks.md's "By parts" (to 10 %),
-/// E / in-core 1.00-1.02x and Hausdorff 0.97-1.10x, against 0.99-1.10x and 1.04-1.08x with 1.25x;
+/// E / in-core 0.99-1.02x and Hausdorff 0.83-1.10x, against 0.99-1.10x and 1.04-1.08x with 1.25x;
 /// with 2x the 10M torus's Hausdorff rose to 1.22x. Where the final pass would not fit the budget
 /// with it, the in-memory run's share.
 constexpr double kShareSlack = 1.6;
