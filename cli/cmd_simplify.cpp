@@ -240,17 +240,19 @@ int run_simplify(const SimplifyArgs& a) {
 
   if (a.json) {
     std::printf(
+        // clang-format off (one group of fields a line, no name split)
         "{\"tool\":\"qem\",\"in_faces\":%zu,\"target_faces\":%zu,\"out_faces\":%zu,\"out_vertices\":%zu,"
         "\"load_s\":%s,\"simplify_s\":%s,\"simplify_cpu_s\":%s,\"write_s\":%s,\"total_s\":%s,"
         "\"peak_rss_mb\":%s,\"max_error\":%s,\"max_error_rel\":%s,\"contractions\":%zu,\"virtual_pairs\":%zu,"
-        "\"rejected_topology\":%zu,\"rejected_inversion\":%zu,\"rejected_error\":%zu,\"rejected_component\":%"
-        "zu,"
+        "\"rejected_topology\":%zu,\"rejected_inversion\":%zu,\"rejected_error\":%zu,"
+        "\"rejected_component\":%zu,"
         "\"rejected_distance\":%zu,\"output_to_input_distance\":%s,"
         "\"in_components\":%zu,\"out_components\":%zu,\"pruned_components\":%zu,\"refit_rounds\":%zu,"
-        "\"refit_rms_before\":%s,\"refit_rms_after\":%s,\"edge_flips\":%zu,\"vertex_moves\":%zu,\"vertex_"
-        "relocations\":%zu,\"dropped_degenerate\":%zu,\"dropped_duplicate\":%zu,\"twin_faces\":%zu,"
-        "\"parts\":%u,\"split_s\":%s,\"parts_s\":%s,\"final_pass_s\":%s,\"parts_cpu_s\":%s,\"busiest_thread_"
-        "cpu_s\":%s,\"stop\":\"%s\"}\n",
+        "\"refit_rms_before\":%s,\"refit_rms_after\":%s,\"edge_flips\":%zu,\"vertex_moves\":%zu,"
+        "\"vertex_relocations\":%zu,\"dropped_degenerate\":%zu,\"dropped_duplicate\":%zu,\"twin_faces\":%zu,"
+        "\"parts\":%u,\"split_s\":%s,\"parts_s\":%s,\"final_pass_s\":%s,\"parts_cpu_s\":%s,"
+        "\"busiest_thread_cpu_s\":%s,\"stop\":\"%s\"}\n",
+        // clang-format on
         in_faces, partition_detail::resolve_targets(opt, in_faces).faces, r.mesh.face_count(),
         r.mesh.vertex_count(), json_number(load_s).c_str(), json_number(simplify_s).c_str(),
         json_number(simplify_cpu_s).c_str(), json_number(write_s).c_str(),

@@ -92,15 +92,14 @@ int run_out_of_core(const std::string& input, const std::string& output, const S
       unread += std::string(unread.size() > 1 ? "," : "") + json_string(n);
     unread += "]";
     std::printf(
-        "{\"tool\":\"qem\",\"out_of_core\":true,\"method\":%s,\"in_faces\":%llu,\"target_faces\":%zu,\"out_"
-        "faces\":%zu,"
-        "\"out_vertices\":%zu,\"clustered_faces\":%llu,\"merged_faces\":%llu,\"shared_vertices\":%llu,\"grid_"
-        "resolution\":%llu,\"grid_coarsenings\":%u,\"grid_refinements\":%u,"
-        "\"memory_limit_bytes\":%llu,"
-        "\"peak_memory_bytes\":%llu,\"memory_needed_bytes\":%llu,\"temp_bytes_written\":%llu,\"parts\":%u,"
-        "\"total_s\":%s,\"cpu_s\":%s,"
-        "\"peak_rss_mb\":%s,"
+        // clang-format off (one group of fields a line, no name split)
+        "{\"tool\":\"qem\",\"out_of_core\":true,\"method\":%s,\"in_faces\":%llu,\"target_faces\":%zu,"
+        "\"out_faces\":%zu,\"out_vertices\":%zu,\"clustered_faces\":%llu,\"merged_faces\":%llu,"
+        "\"shared_vertices\":%llu,\"grid_resolution\":%llu,\"grid_coarsenings\":%u,\"grid_refinements\":%u,"
+        "\"memory_limit_bytes\":%llu,\"peak_memory_bytes\":%llu,\"memory_needed_bytes\":%llu,"
+        "\"temp_bytes_written\":%llu,\"parts\":%u,\"total_s\":%s,\"cpu_s\":%s,\"peak_rss_mb\":%s,"
         "\"max_error\":%s,\"max_error_rel\":%s,\"stop\":\"%s\",\"phases\":%s,\"not_carried\":%s}\n",
+        // clang-format on
         json_string(report.method).c_str(), static_cast<unsigned long long>(report.input_faces),
         report.target_faces, r.mesh.face_count(), r.mesh.vertex_count(),
         static_cast<unsigned long long>(report.clustered_faces),

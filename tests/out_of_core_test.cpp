@@ -78,6 +78,14 @@ OutOfCoreOptions limited(std::uint64_t memory_limit, const std::string& dir) {
   return ooc;
 }
 
+/// limited(), held to the two phases: the tests of the clustering give it inputs within a few
+/// budgets, which would otherwise go by parts.
+OutOfCoreOptions two_phases(std::uint64_t memory_limit, const std::string& dir) {
+  OutOfCoreOptions ooc = limited(memory_limit, dir);
+  ooc.parts = 1;
+  return ooc;
+}
+
 /// The 327,680-face bumpy sphere (closed), streamed to disk once.
 const std::string& big_sphere() {
   static const std::string path = [] {
@@ -113,8 +121,7 @@ TEST(OutOfCore, ForcedRunMeetsTargetWithoutCracksAndNearInCoreError) {
   ASSERT_EQ(test::boundary_edges(input), 0u);
   SimplifyOptions opt;
   opt.target_faces = 5000;
-  OutOfCoreOptions ooc = limited(kTinyLimit, dir);
-  ooc.parts = 1;  // the two phases (the input is within a few budgets: it would go by parts)
+  OutOfCoreOptions ooc = two_phases(kTinyLimit, dir);
   OutOfCoreReport report;
   SimplifyResult r = simplify_out_of_core(big_sphere(), opt, ooc, &report);
   EXPECT_EQ(entries(dir), 0u);
@@ -166,8 +173,7 @@ TEST(OutOfCore, NoisySurfaceKeepsTheInCoreHausdorffDistance) {
   const Mesh input = load_mesh(path);  // as float, the precision both runs read
   SimplifyOptions opt;
   opt.target_ratio = 0.1;
-  OutOfCoreOptions ooc = limited(std::uint64_t(32) << 20, dir);  // ~80k clustered faces: 2.4x the target
-  ooc.parts = 1;  // the two phases (the input is within a few budgets: it would go by parts)
+  OutOfCoreOptions ooc = two_phases(std::uint64_t(32) << 20, dir);  // ~80k clustered faces: 2.4x the target
   OutOfCoreReport report;
   const SimplifyResult r = simplify_out_of_core(path, opt, ooc, &report);
   const SimplifyResult in_core = simplify(input, opt);
@@ -201,8 +207,7 @@ TEST(OutOfCore, OpenSurfaceKeepsItsBorder) {
   const Mesh input = load_mesh(path);
   SimplifyOptions opt;
   opt.target_ratio = 0.1;
-  OutOfCoreOptions ooc = limited(std::uint64_t(32) << 20, dir);
-  ooc.parts = 1;  // the two phases (the input is within a few budgets: it would go by parts)
+  OutOfCoreOptions ooc = two_phases(std::uint64_t(32) << 20, dir);
   OutOfCoreReport report;
   const SimplifyResult r = simplify_out_of_core(path, opt, ooc, &report);
   const SimplifyResult in_core = simplify(input, opt);
@@ -314,8 +319,7 @@ TEST(OutOfCore, RefitFitsTheInputNotTheClusteredMesh) {
   opt.refit_rounds = 2;
   opt.refit_points_per_vertex = 8;
   opt.refit_by_reduction = true;
-  OutOfCoreOptions ooc = limited(std::uint64_t(32) << 20, dir);
-  ooc.parts = 1;  // the two phases (the input is within a few budgets: it would go by parts)
+  OutOfCoreOptions ooc = two_phases(std::uint64_t(32) << 20, dir);
   OutOfCoreReport report;
   const SimplifyResult r = simplify_out_of_core(path, opt, ooc, &report);
   EXPECT_EQ(entries(dir), 1u);  // the input; no temporary left
@@ -397,8 +401,7 @@ TEST(OutOfCore, SameResultOnAnyNumberOfThreads) {
   const std::string dir = fresh_dir("threads");
   SimplifyOptions opt;
   opt.target_faces = 4000;
-  OutOfCoreOptions ooc = limited(kTinyLimit, dir);
-  ooc.parts = 1;  // the two phases (the input is within a few budgets: it would go by parts)
+  OutOfCoreOptions ooc = two_phases(kTinyLimit, dir);
   ooc.parts = 2;
   std::vector<Mesh> results;
   for (unsigned threads : {1u, 2u, 3u}) {

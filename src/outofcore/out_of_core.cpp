@@ -593,18 +593,21 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
     }
     progress.read(in.bytes_read());
   };
+  const auto new_store = [&] {
+    return map_input ? std::make_unique<PositionStore>(path, layout_offset, layout_row, layout_at, nv)
+                     : std::make_unique<PositionStore>(nv, positions_in_memory, temp_dir);
+  };
   std::unique_ptr<PositionStore> store;
   if (soup) {
     in.read_soup([&](const double* xyz, std::size_t n) { grow(xyz, 3 * n); });
   } else {
-    store = map_input ? std::make_unique<PositionStore>(path, layout_offset, layout_row, layout_at, nv)
-                      : std::make_unique<PositionStore>(nv, positions_in_memory, temp_dir);
+    store = new_store();
     in.read_vertices([&](const double* xyz, std::size_t n) {
       if (store->copied()) store->append(xyz, n);
       grow(xyz, n);
     });
   }
-  const PositionSource positions = store ? store->finish() : PositionSource{};
+  PositionSource positions = store ? store->finish() : PositionSource{};
   if (report.input_faces == 0 || !(lo[0] <= hi[0])) throw Error(path + ": no faces to simplify");
   const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-30});
   lap("bounds");
@@ -676,7 +679,15 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
       faces.emplace(temp_dir, "faces");
       clustering.emplace(fine, hard_cells, threads, *faces);
       std::optional<MeshStream> again;  // the faces once more, for a refined grid
-      if (pass > 0) again.emplace(path);
+      if (pass > 0) {
+        again.emplace(path);
+        if (!soup) {  // the positions again (released after each pass, as the faces are read back)
+          store = new_store();
+          if (store->copied())
+            again->read_vertices([&](const double* xyz, std::size_t n) { store->append(xyz, n); });
+          positions = store->finish();
+        }
+      }
       MeshStream& source = again ? *again : in;
       clustering->after_block = [&, blocks = 0]() mutable {
         if (++blocks % 16 == 0) give_back_pages();
@@ -694,6 +705,7 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
         });
       }
       clustering->finish();
+      if (store) store->release();
       // The faces on this grid (a thin plate's two sides clustered into one face pair drop out),
       // against the floor (about two a cell).
       shapes.clear();
@@ -712,7 +724,6 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
       progress.add_pass(in.file_size());
     }
     report.grid_coarsenings = unsigned(clustering->levels());
-    if (store) store->release();
     CellTable& cells = clustering->cells();
     report.clustered_vertices = cells.size();
     const double cell_size = fine.size * std::ldexp(1.0, clustering->levels());
