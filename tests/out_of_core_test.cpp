@@ -583,6 +583,26 @@ TEST(OutOfCore, AGridTooCoarseForTheTargetIsRefined) {
   EXPECT_EQ(entries(dir), 1u);  // the input copy, no temporary left
 }
 
+// The Stanford dragon at res4 is closed (every edge has two faces or more) but not manifold, and
+// holds two-sided sheets: under a tight limit its folds put sheets' faces and their backs on the
+// same cells as other faces, which opened 64 boundary edges where each pair counted as one face.
+TEST(OutOfCore, SheetsFoldedOntoTheSurfaceOpenNoCrack) {
+  const std::string dir = fresh_dir("dragon");
+  const std::string path = test::shared_data("stanford_dragon_vrip_res4.ply");
+  if (path.empty()) GTEST_SKIP() << "../shared/data not found";
+  Mesh input = load_mesh(path);
+  weld_exact(input);
+  ASSERT_EQ(test::boundary_edges(input), 0u);
+  const std::string ply = dir + "/dragon.ply";
+  save_mesh(ply, input);
+  SimplifyOptions opt;
+  opt.target_ratio = 0.1;
+  OutOfCoreReport report;
+  const SimplifyResult r = simplify_out_of_core(ply, opt, limited(400000, dir), &report);
+  EXPECT_EQ(report.method, "clustering");
+  expect_closed_at_target(r.mesh, report.target_faces);
+}
+
 TEST(OutOfCore, FullDiskMidwayLeavesNoTemporaryFile) {
   const std::string dir = fresh_dir("full_disk");
   SimplifyOptions opt;

@@ -103,3 +103,35 @@ TEST(ParallelClustering, SameBitsOnAnyNumberOfThreads) {
 }
 
 }  // namespace
+
+// The triples that come out of the clustering, their input triangles' shapes, and what stays: a
+// face alone; a fold (a triple twice, from two triangles) drops out; a two-sided sheet's face
+// and its reversed copy (one shape) stay both; such a pair folded onto a third triangle, and three
+// triangles on one triple, leave one face, the first. Each edge's count stays even.
+TEST(ParallelClustering, PairedTriplesDropOutAndEveryEdgeKeepsItsParity) {
+  std::vector<std::uint32_t> ids = {
+      0,  1,  2,                           // alone
+      3,  4,  5,  5,  4,  3,               // a fold: two triangles
+      6,  7,  8,  8,  7,  6,               // a two-sided sheet's face and its back
+      9,  10, 11, 11, 10, 9,  9,  11, 10,  // the sheet folded onto another triangle
+      12, 13, 14, 14, 13, 12, 12, 13, 14,  // three triangles
+  };
+  const std::vector<std::uint64_t> shapes = {1, 2, 3, 4, 4, 5, 5, 6, 7, 8, 9, 10};
+  const auto edge_parity = [](const std::vector<std::uint32_t>& f) {
+    std::map<std::pair<std::uint32_t, std::uint32_t>, int> n;
+    for (std::size_t i = 0; i < f.size(); i += 3)
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t a = f[i + k], b = f[i + (k + 1) % 3];
+        n[{std::min(a, b), std::max(a, b)}] ^= 1;
+      }
+    std::map<std::pair<std::uint32_t, std::uint32_t>, int> odd;
+    for (const auto& [e, p] : n)
+      if (p) odd[e] = 1;
+    return odd;
+  };
+  const auto before = edge_parity(ids);
+  drop_paired_faces(ids, shapes);
+  const std::vector<std::uint32_t> expected = {0, 1, 2, 6, 7, 8, 8, 7, 6, 9, 10, 11, 12, 13, 14};
+  EXPECT_EQ(ids, expected);
+  EXPECT_EQ(edge_parity(ids), before);
+}

@@ -324,58 +324,6 @@ void pull_into_cell(const core::Quadric& q, const double mean[3], const double c
   std::copy_n(error(clamped) < error(pulled) ? clamped : pulled, 3, x);
 }
 
-/// Clustering maps the closed input surface onto a surface that is closed in the mod-2 sense:
-/// every edge of the cell triples is used an even number of times (the image of a cycle is a
-/// cycle). Where a thin part or a fold collapses, the same three cells come out twice (or four
-/// times...); the in-core simplifier would keep one of them and open a crack. Dropping the triples
-/// that come out an even number of times and keeping one of those that come out an odd number
-/// keeps every edge's count even: no boundary edge the input did not have.
-/// Copies of one input triangle (`shapes`: the same corners; a sheet made two-sided by a reversed
-/// copy of each face) count once: a two-sided sheet is one surface, not a fold, and dropping its
-/// pairs dropped the whole sheet. Its copies are all kept, for phase 2, whose core keeps one and
-/// puts the reversed twins back along the rims (SimplifyOptions::two_sided).
-void drop_paired_faces(std::vector<std::uint32_t>& indices, const std::vector<std::uint64_t>& shapes) {
-  const std::size_t nf = indices.size() / 3;
-  // Each face as its sorted corners and its place in the file: sorting these groups the copies of
-  // a face, the first in file order leading each group.
-  std::vector<std::array<std::uint32_t, 4>> order(nf);
-  for (std::size_t f = 0; f < nf; ++f) {
-    std::array<std::uint32_t, 4>& t = order[f];
-    t = {indices[3 * f], indices[3 * f + 1], indices[3 * f + 2], std::uint32_t(f)};
-    std::sort(t.begin(), t.begin() + 3);
-  }
-  std::sort(order.begin(), order.end());
-  std::vector<bool> keep(nf, false);
-  auto same_face = [&](std::size_t i, std::size_t j) {
-    return order[i][0] == order[j][0] && order[i][1] == order[j][1] && order[i][2] == order[j][2];
-  };
-  std::vector<std::uint64_t> group;
-  for (std::size_t i = 0; i < nf;) {
-    std::size_t j = i + 1;
-    while (j < nf && same_face(i, j)) ++j;
-    if (j == i + 1) {
-      keep[order[i][3]] = true;
-    } else {
-      group.clear();
-      for (std::size_t k = i; k < j; ++k) group.push_back(shapes[order[k][3]]);
-      std::sort(group.begin(), group.end());
-      const std::size_t triangles = std::size_t(std::unique(group.begin(), group.end()) - group.begin());
-      if (triangles % 2 == 1)  // the first in file order, with its copies
-        for (std::size_t k = i; k < j; ++k)
-          if (shapes[order[k][3]] == shapes[order[i][3]]) keep[order[k][3]] = true;
-    }
-    i = j;
-  }
-  std::vector<std::array<std::uint32_t, 4>>().swap(order);
-  std::size_t out = 0;
-  for (std::size_t f = 0; f < nf; ++f)
-    if (keep[f]) {
-      for (int c = 0; c < 3; ++c) indices[3 * out + c] = indices[3 * f + c];
-      ++out;
-    }
-  indices.resize(3 * out);
-}
-
 /// About `wanted` of the input's points (a PLY's vertices, an STL's corners) for the refit against
 /// the input, memory following the output, not the input: each point kept with probability
 /// wanted / total by a hash of its index (the same points on every run). Every k-th in file order
@@ -710,7 +658,7 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
       // against the floor (about two a cell).
       shapes.clear();
       indices = outofcore::read_clustered_faces(*clustering, *faces, shapes);
-      drop_paired_faces(indices, shapes);
+      outofcore::drop_paired_faces(indices, shapes);
       const std::uint64_t faces_now = indices.size() / 3;
       const bool too_coarse = faces_now < floor_cells && clustering->levels() == 0 &&
                               fine.size > extent / kFinestResolution &&

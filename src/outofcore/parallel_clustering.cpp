@@ -342,4 +342,41 @@ std::vector<std::uint32_t> read_clustered_faces(ParallelClustering& clustering, 
   return indices;
 }
 
+void drop_paired_faces(std::vector<std::uint32_t>& indices, const std::vector<std::uint64_t>& shapes) {
+  const std::size_t nf = indices.size() / 3;
+  // Each face as its sorted corners and its place in the file: sorting these groups the faces on
+  // one triple, the first in file order leading each group.
+  std::vector<std::array<std::uint32_t, 4>> order(nf);
+  for (std::size_t f = 0; f < nf; ++f) {
+    std::array<std::uint32_t, 4>& t = order[f];
+    t = {indices[3 * f], indices[3 * f + 1], indices[3 * f + 2], std::uint32_t(f)};
+    std::sort(t.begin(), t.begin() + 3);
+  }
+  std::sort(order.begin(), order.end());
+  std::vector<bool> keep(nf, false);
+  auto same_face = [&](std::size_t i, std::size_t j) {
+    return order[i][0] == order[j][0] && order[i][1] == order[j][1] && order[i][2] == order[j][2];
+  };
+  for (std::size_t i = 0; i < nf;) {
+    std::size_t j = i + 1;
+    while (j < nf && same_face(i, j)) ++j;
+    bool copies = true;  // all of one input triangle
+    for (std::size_t k = i + 1; k < j && copies; ++k) copies = shapes[order[k][3]] == shapes[order[i][3]];
+    if (copies) {
+      for (std::size_t k = i; k < j; ++k) keep[order[k][3]] = true;
+    } else if ((j - i) % 2 == 1) {
+      keep[order[i][3]] = true;  // the first in file order
+    }
+    i = j;
+  }
+  std::vector<std::array<std::uint32_t, 4>>().swap(order);
+  std::size_t out = 0;
+  for (std::size_t f = 0; f < nf; ++f)
+    if (keep[f]) {
+      for (int c = 0; c < 3; ++c) indices[3 * out + c] = indices[3 * f + c];
+      ++out;
+    }
+  indices.resize(3 * out);
+}
+
 }  // namespace qem::outofcore

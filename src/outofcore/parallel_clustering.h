@@ -113,4 +113,20 @@ class ParallelClustering {
 std::vector<std::uint32_t> read_clustered_faces(ParallelClustering& clustering, TempFile& faces,
                                                 std::vector<std::uint64_t>& shapes);
 
+/// Clustering maps a closed input surface onto one closed in the mod-2 sense: every edge of the
+/// cell triples is used an even number of times (the image of a cycle is a cycle). Where a thin
+/// part or a fold collapses, the same three cells come out twice (or four times...); the in-core
+/// simplifier would keep one of them and open a crack. So a triple that comes out an even number
+/// of times is dropped, and one that comes out an odd number is kept once: every edge's count
+/// stays even, no boundary edge the input did not have.
+/// The exception, copies of one input triangle (`shapes`: the same corners; a sheet made
+/// two-sided by a reversed copy of each face): a two-sided sheet is one surface, not a fold, and
+/// dropping its pairs dropped the whole sheet. Its copies are all kept, for phase 2, whose core
+/// keeps one and puts the reversed twins back along the rims (SimplifyOptions::two_sided). All
+/// kept, their count is the triple's, so the parity holds there too; a triple shared by copies and
+/// other triangles (a sheet folded onto a surface) is counted face by face: counted as one
+/// triangle, each twin pair opened a crack along the fold (the Stanford dragon at res4, 87
+/// boundary edges under a tight limit).
+void drop_paired_faces(std::vector<std::uint32_t>& indices, const std::vector<std::uint64_t>& shapes);
+
 }  // namespace qem::outofcore
