@@ -96,9 +96,10 @@ int run_out_of_core(const std::string& input, const std::string& output, const S
         "{\"tool\":\"qem\",\"out_of_core\":true,\"method\":%s,\"in_faces\":%llu,\"target_faces\":%zu,"
         "\"out_faces\":%zu,\"out_vertices\":%zu,\"clustered_faces\":%llu,\"merged_faces\":%llu,"
         "\"shared_vertices\":%llu,\"grid_resolution\":%llu,\"grid_coarsenings\":%u,\"grid_refinements\":%u,"
-        "\"memory_limit_bytes\":%llu,\"peak_memory_bytes\":%llu,\"memory_needed_bytes\":%llu,"
-        "\"temp_bytes_written\":%llu,\"parts\":%u,\"total_s\":%s,\"cpu_s\":%s,\"peak_rss_mb\":%s,"
-        "\"max_error\":%s,\"max_error_rel\":%s,\"stop\":\"%s\",\"phases\":%s,\"not_carried\":%s}\n",
+        "\"topology_relaxed\":%s,\"memory_limit_bytes\":%llu,\"peak_memory_bytes\":%llu,"
+        "\"memory_needed_bytes\":%llu,\"temp_bytes_written\":%llu,\"parts\":%u,\"total_s\":%s,\"cpu_s\":%s,"
+        "\"peak_rss_mb\":%s,\"max_error\":%s,\"max_error_rel\":%s,\"stop\":\"%s\",\"phases\":%s,"
+        "\"not_carried\":%s}\n",
         // clang-format on
         json_string(report.method).c_str(), static_cast<unsigned long long>(report.input_faces),
         report.target_faces, r.mesh.face_count(), r.mesh.vertex_count(),
@@ -106,7 +107,8 @@ int run_out_of_core(const std::string& input, const std::string& output, const S
         static_cast<unsigned long long>(report.merged_faces),
         static_cast<unsigned long long>(report.shared_vertices),
         static_cast<unsigned long long>(report.grid_resolution), report.grid_coarsenings,
-        report.grid_refinements, static_cast<unsigned long long>(report.memory_limit),
+        report.grid_refinements, report.topology_relaxed ? "true" : "false",
+        static_cast<unsigned long long>(report.memory_limit),
         static_cast<unsigned long long>(report.peak_memory_bytes),
         static_cast<unsigned long long>(report.memory_needed),
         static_cast<unsigned long long>(report.temp_bytes_written), report.parts,

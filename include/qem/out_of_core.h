@@ -67,6 +67,9 @@ struct OutOfCoreReport {
   /// Times the grid was too coarse for the target and the faces were clustered again on a finer
   /// one (an input whose vertices lie along lines, as a CAD model's).
   unsigned grid_refinements = 0;
+  /// Phase 2 stopped above the target where the clustering had folded thin parts together, and
+  /// went on letting contractions make non-manifold edges (none opened a boundary edge).
+  bool topology_relaxed = false;
   std::uint64_t clustered_vertices = 0;  ///< occupied cells
   std::uint64_t clustered_faces = 0;     ///< faces handed to phase 2 (after dropping duplicates)
   std::uint64_t temp_bytes_written = 0;
