@@ -579,7 +579,9 @@ TEST(OutOfCore, AGridTooCoarseForTheTargetIsRefined) {
   EXPECT_EQ(report.grid_coarsenings, 0u);
   EXPECT_GE(report.clustered_faces, report.target_faces);
   EXPECT_LE(r.mesh.face_count(), report.target_faces);
-  EXPECT_GE(r.mesh.face_count(), report.target_faces - 2);
+  // Past the clustering's folds (topology_relaxed: its inner walls are thinner than the cells) a
+  // contraction takes the faces of a non-manifold edge with it, three or four.
+  EXPECT_GE(r.mesh.face_count(), report.target_faces - (report.topology_relaxed ? 4 : 2));
   EXPECT_EQ(entries(dir), 1u);  // the input copy, no temporary left
 }
 
