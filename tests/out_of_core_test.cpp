@@ -605,22 +605,31 @@ TEST(OutOfCore, SheetsFoldedOntoTheSurfaceOpenNoCrack) {
   expect_closed_at_target(r.mesh, report.target_faces);
 }
 
-// The cycloidal gear (../shared/data, a CAD part of 100 pieces) under a limit of a quarter of its
-// in-core need: the clustering folds its thin parts onto each other, and phase 2, holding the
-// folds' non-manifold edges, stopped at 7,310 faces of the 4,336 asked. It goes on past them and
-// meets the target, and opens no boundary edge.
+// The cycloidal gear (../shared/data, a CAD part of 100 pieces) under limits of a quarter and a
+// half of its in-core need: the clustering folds its thin parts onto each other, and phase 2,
+// holding the folds' non-manifold edges, stopped at 7,310 faces of the 4,336 asked (to 10 %) and
+// at 6,170 of 433 (to 1 %). It goes on past them, meets the target and opens no boundary edge; to
+// 1 % only since a contraction that lands a face on another turning the same way drops both (it
+// kept one, and the crack it opened made the run give up the relaxed pass).
 TEST(OutOfCore, PhaseTwoGoesPastTheClusteringsFolds) {
   const std::string dir = fresh_dir("folds");
   const std::string ply = shared_as_ply("trimesh_cycloidal.ply", dir);
   if (ply.empty()) GTEST_SKIP() << "../shared/data not found";
-  SimplifyOptions opt;
-  opt.target_ratio = 0.1;
-  OutOfCoreReport report;
-  const SimplifyResult r = simplify_out_of_core(ply, opt, limited(43368 * 180 / 4, dir), &report);
-  EXPECT_EQ(report.method, "clustering");
-  EXPECT_TRUE(report.topology_relaxed);
-  EXPECT_EQ(r.stop_reason, StopReason::TargetReached);
-  expect_closed_at_target(r.mesh, report.target_faces);
+  for (const auto& [ratio, share] : {std::pair{0.1, 4}, std::pair{0.01, 2}}) {
+    SimplifyOptions opt;
+    opt.target_ratio = ratio;
+    OutOfCoreReport report;
+    const SimplifyResult r = simplify_out_of_core(ply, opt, limited(43368 * 180 / share, dir), &report);
+    EXPECT_EQ(report.method, "clustering");
+    EXPECT_TRUE(report.topology_relaxed) << ratio;
+    EXPECT_EQ(r.stop_reason, StopReason::TargetReached) << ratio;
+    EXPECT_LE(r.mesh.face_count(), report.target_faces);
+    // A contraction past the folds may take a non-manifold edge's three or four faces.
+    EXPECT_GE(r.mesh.face_count(), report.target_faces - 4);
+    Mesh welded = r.mesh;
+    weld_exact(welded);
+    EXPECT_EQ(test::boundary_edges(welded), 0u) << ratio;
+  }
   EXPECT_EQ(entries(dir), 1u);  // the input copy, no temporary left
 }
 

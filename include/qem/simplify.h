@@ -212,6 +212,9 @@ struct SimplifyOptions {
   /// A face that turns by more than this (degrees) counts as an inversion; must be < 90.
   double max_normal_turn_degrees = 75;
   /// Refuse edge collapses that break the link condition (non-manifold edges, duplicate faces).
+  /// false = GH97 as published: contractions may make non-manifold edges; two faces a contraction
+  /// lands on the same three vertices both go (turning the same way or not), so that a closed
+  /// input opens no crack.
   bool preserve_topology = true;
   Scheme scheme = Scheme::Passes;
   /// Scheme::Passes finishes in the greedy order once the mesh has at most this many faces: the

@@ -35,6 +35,10 @@ inline void kill_face(Context& c, std::uint32_t f, Worker& w) {
 // Face f (now on a) against a's own faces w.faces[0..own): on the same three vertices with the
 // same orientation it is a duplicate and dies; with the opposite orientation the two are the
 // touching walls of two aggregated parts (GH97 §3.2, Fig. 3) and both die, like glued faces.
+// Without the link condition (preserve_topology off) a duplicate takes the other with it too: the
+// surface passed there twice, and keeping one left its three edges with an odd count of faces, a
+// crack where the input was closed (mod 2, a closed surface's contractions stay closed only if
+// both go; the out-of-core run's pass past the clustering's folds relies on it).
 inline bool kill_if_coincident(Context& c, std::uint32_t f, std::size_t own, Worker& w) {
   const WorkingMesh& m = c.mesh;
   const std::uint32_t* t = m.face(f);
@@ -46,7 +50,7 @@ inline bool kill_if_coincident(Context& c, std::uint32_t f, std::size_t own, Wor
     while (u[k] != t[0]) ++k;
     const bool same_orientation = u[(k + 1) % 3] == t[1];
     kill_face(c, f, w);
-    if (!same_orientation) kill_face(c, g, w);
+    if (!same_orientation || !c.settings.preserve_topology) kill_face(c, g, w);
     return true;
   }
   return false;
