@@ -331,7 +331,8 @@ void pull_into_cell(const core::Quadric& q, const double mean[3], const double c
 /// same input reaches it (the cycloidal gear to 10 % under 2 MB: 7,310 faces of 4,336). From there
 /// it goes on under GH97's own rules, which let a contraction make a non-manifold edge, with
 /// penalty planes at the borders; kept only where it opens no boundary edge. True if kept.
-bool past_the_folds(SimplifyResult& r, const SimplifyOptions& phase2) {
+/// `observer` forwards its progress (and a cancel).
+bool past_the_folds(SimplifyResult& r, const SimplifyOptions& phase2, SimplifyObserver* observer) {
   const bool above = (phase2.target_faces && r.mesh.face_count() > phase2.target_faces) ||
                      (phase2.target_vertices && r.mesh.vertex_count() > phase2.target_vertices);
   if (r.stop_reason != StopReason::NoValidPair || !above) return false;
@@ -340,7 +341,7 @@ bool past_the_folds(SimplifyResult& r, const SimplifyOptions& phase2) {
   o.exact_border = false;
   o.refit_rounds = 0;  // the refit against the input follows
   o.far_repair = false;
-  SimplifyResult more = simplify(r.mesh, o);
+  SimplifyResult more = simplify(r.mesh, o, observer);
   if (more.contractions == 0 || mesh_info(more.mesh).boundary_edges > mesh_info(r.mesh).boundary_edges)
     return false;
   // The provenance through both runs.
@@ -791,7 +792,8 @@ SimplifyResult simplify_out_of_core(const std::string& path, const SimplifyOptio
       r = simplify(std::move(clustered_mesh), phase2_options, &observer);
       report.parts = 1;
     }
-    if (past_the_folds(r, phase2_options)) {
+    Phase2Observer folds_observer(progress);
+    if (past_the_folds(r, phase2_options, &folds_observer)) {
       report.topology_relaxed = true;
       refit_to_input = options.refit_rounds > 0;  // the first run's refit fitted the clustered surface
     }
