@@ -11,8 +11,8 @@ Equal size: the goal is a lower error at the same face count, so when qem's outp
 meshoptimizer's differ by more than --size-tol (1 %, either way; both are asked for the same target,
 but a tool that cannot reach it stops where its rules do), qem is run again with `-f` set to
 meshoptimizer's face count and the row is judged on that output ("qem at peer size"; on a glTF
-document, whose measured count includes every instance of a mesh, -f is corrected up to twice by the
-reached/asked ratio). The faces column then reads "qem asked / qem at peer size / meshopt / gltft"
+document, whose measured count includes every instance of a mesh, -f is corrected up to four times, by
+the reached/asked ratio and then along the line through the last two tries). The faces column then reads "qem asked / qem at peer size / meshopt / gltft"
 and "E q/m asked" keeps the first run's E ratio; every other qem column is the judged output. If qem
 cannot reach the peer's size (it stops above it), the faces column marks it with "!" and the row
 does not meet the goal (a larger mesh's lower error proves nothing); the summary lists it. E q/g compares
@@ -252,10 +252,12 @@ def main():
 def qem_at_size(asset, path, ratio, peer_faces, args):
     """qem re-run with `-f` = meshoptimizer's face count. On a glTF document qem's target counts each mesh
     once while the measured output counts every instance (the truck's wheels), so a miss is corrected
-    up to twice by the reached/asked ratio; the output closest to the peer's count is kept. A run that
-    stops above the peer's count at every -f (its seams and borders allow no more) is reported as such."""
-    best, f, tried = None, peer_faces, set()
-    for _ in range(3):
+    up to four times: first by the reached/asked ratio, then along the line through the last two
+    tries (the instances add faces in steps, not in proportion); the output closest to the peer's
+    count is kept. A run that stops above the peer's count at every -f (its seams and borders allow
+    no more) is reported as such."""
+    best, f, tried, last = None, peer_faces, set(), None
+    for _ in range(5):
         if f in tried or f < 1:
             break
         tried.add(f)
@@ -271,7 +273,10 @@ def qem_at_size(asset, path, ratio, peer_faces, args):
             best = m
         if not got or not unequal(got, peer_faces, args.size_tol):
             break
-        f = round(f * peer_faces / got)
+        step = f * peer_faces / got
+        if last and last[1] != got:
+            step = f + (peer_faces - got) * (f - last[0]) / (got - last[1])
+        last, f = (f, got), round(step)
     if best and args.no_check is False:
         out, _ = tool_run('qem_eq', asset, path, ratio, best['asked_faces'], args, args.out)
         best = dict(best, **measure(args.qem, path, out, args.samples, True))

@@ -57,13 +57,21 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
                 "GH97 6's penalty instead of exact borders: the boundary planes (--boundary-weight) pull "
                 "the placement and border vertices may leave the border by a little");
   sub->add_flag("--lock-border", a.lock_border, "Boundary vertices never move (nor are removed)");
-  sub->add_option("--attribute-weight", a.attribute_weights,
-                  "Weight of an attribute's error against distance, as KIND=W (normal, uv, color, scalar; "
-                  "repeat or separate by commas): a difference of 1/W costs as much as one bounding-box "
-                  "diagonal (defaults: normal=" + json_number(AttributeWeights{}.normal) + ", uv=" +
-                      json_number(AttributeWeights{}.tex_coord) + ", color=" + json_number(AttributeWeights{}.color) +
-                      ", scalar=" + json_number(AttributeWeights{}.scalar) + "); seam=W weighs constraint planes along "
-                      "the seams, as --boundary-weight for borders (default " + json_number(AttributeWeights{}.seam) + ")")
+  sub->add_option(
+         "--attribute-weight", a.attribute_weights,
+         "Weight of an attribute's error against distance, as KIND=W (normal, uv, color, scalar; "
+         "repeat or separate by commas): a difference of 1/W costs as much as one bounding-box "
+         "diagonal (defaults: normal=" +
+             json_number(AttributeWeights{}.normal) + ", uv=" + json_number(AttributeWeights{}.tex_coord) +
+             ", color=" + json_number(AttributeWeights{}.color) +
+             ", scalar=" + json_number(AttributeWeights{}.scalar) +
+             "); seam=W weighs constraint planes along "
+             "the seams, as --boundary-weight for borders (default " +
+             json_number(AttributeWeights{}.seam) +
+             "); normal-spacing=K: by default the normal weight is at least K (" +
+             json_number(AttributeWeights{}.normal_per_spacing) +
+             ") times the spacing of the target's faces, sqrt(area / faces) in diagonals, so that coarse "
+             "outputs keep small sharply turning parts; a normal weight given alone is used as it is")
       ->delimiter(',');
   sub->add_option(
          "--seams", a.seams,
@@ -189,21 +197,27 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
   if (a.prune > 0 && a.prune_rel > 0) throw Error("give --prune or --prune-rel, not both");
   if (a.prune_rel > 0) opt.prune_size = a.prune_rel, opt.prune_size_is_relative = true;
   else opt.prune_size = a.prune;
+  bool spacing_given = false;
   for (const std::string& item : a.attribute_weights) {
     const std::size_t eq = item.find('=');
     const std::string kind = item.substr(0, eq);
-    double* weight = kind == "normal" ? &opt.attribute_weights.normal
-                     : kind == "uv"   ? &opt.attribute_weights.tex_coord
-                     : kind == "color" ? &opt.attribute_weights.color
-                     : kind == "scalar" ? &opt.attribute_weights.scalar
-                     : kind == "seam"   ? &opt.attribute_weights.seam
-                                        : nullptr;
+    double* weight = kind == "normal"           ? &opt.attribute_weights.normal
+                     : kind == "uv"             ? &opt.attribute_weights.tex_coord
+                     : kind == "color"          ? &opt.attribute_weights.color
+                     : kind == "scalar"         ? &opt.attribute_weights.scalar
+                     : kind == "seam"           ? &opt.attribute_weights.seam
+                     : kind == "normal-spacing" ? &opt.attribute_weights.normal_per_spacing
+                                                : nullptr;
     char* end = nullptr;
     const double w = eq == std::string::npos ? -1 : std::strtod(item.c_str() + eq + 1, &end);
     if (!weight || eq == std::string::npos || !end || *end != 0 || !(w >= 0) || !std::isfinite(w))
-      throw Error("--attribute-weight: expected KIND=W with KIND normal, uv, color, scalar or seam and W >= 0, got '" +
-                  item + "'");
+      throw Error(
+          "--attribute-weight: expected KIND=W with KIND normal, uv, color, scalar, seam or normal-spacing "
+          "and W >= 0, got '" + item + "'");
     *weight = w;
+    // A normal weight given is the weight (unless normal-spacing is given too, before or after it).
+    if (kind == "normal" && !spacing_given) opt.attribute_weights.normal_per_spacing = 0;
+    if (kind == "normal-spacing") spacing_given = true;
   }
   opt.seams = parsed<SeamMode>("--seams", a.seams);
   opt.fit_attributes = a.attribute_fit;

@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "merged_primitives.h"
+#include "normal_weight.h"
 #include "qem/error.h"
 #include "quantized_borders.h"
 
@@ -264,10 +265,17 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
                                                       double(total_vertices))));
     const bool face_target = target != std::numeric_limits<std::size_t>::max();
     report.target_faces = face_target ? target : options.as_far_as_possible ? 0 : total_faces;
+    // Each primitive's normal weight from the scene's ratio (normal_weight.h), once: its watched
+    // and final runs must contract in the same order.
+    std::vector<SimplifyOptions> unit_options;
+    for (const Unit& u : units)
+      unit_options.push_back(with_normal_weight(
+          u.mesh, options,
+          face_target && total_faces > 0 ? double(target) * double(u.faces) / double(total_faces) : 0));
 
     if (units.size() == 1) {
       // One primitive: the scene's target is its own, and there is nothing to share.
-      SimplifyOptions o = primitive_options(options, 0);
+      SimplifyOptions o = primitive_options(unit_options[0], 0);
       o.target_ratio = 0, o.target_vertices = 0;
       o.target_faces = face_target ? std::max<std::size_t>(1, target) : 0;
       o.max_error = local_error(world_max_error, units[0].world_scale);
@@ -281,7 +289,7 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
           face_target && total_faces > 0 ? 0.25 * double(target) / double(total_faces) : 0;
       auto watch = [&](std::size_t j, std::size_t floor_faces) {
         curves[j] = ErrorCurve(units[j].world_scale);
-        SimplifyOptions o = primitive_options(options, j);
+        SimplifyOptions o = primitive_options(unit_options[j], j);
         o.target_ratio = 0, o.target_vertices = 0;
         o.target_faces = std::max<std::size_t>(1, floor_faces);
         o.max_error = local_error(world_max_error, units[j].world_scale);
@@ -361,7 +369,7 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
       // same error limit, which blocks the same pairs.
       for (std::size_t j = 0; j < units.size(); ++j) {
         if (faces[j] >= curves[j].initial) continue;  // nothing to do: left as it is
-        SimplifyOptions o = primitive_options(options, j);
+        SimplifyOptions o = primitive_options(unit_options[j], j);
         o.target_ratio = 0, o.target_vertices = 0;
         o.target_faces = std::max<std::size_t>(1, faces[j]);
         o.max_error = local_error(world_max_error, units[j].world_scale);

@@ -17,6 +17,7 @@
 #include "geometry/box.h"
 #include "geometry/frame.h"
 #include "material_carrier.h"
+#include "normal_weight.h"
 #include "qem/error.h"
 #include "refit/attribute_fit.h"
 #include "refit/refit_after_simplify.h"
@@ -378,6 +379,8 @@ SimplifyResult simplify_two_sided(MeshView input, const SimplifyOptions& options
 }  // namespace
 
 SimplifyResult simplify(MeshView input, const SimplifyOptions& options, SimplifyObserver* observer) {
+  if (normal_weight_unresolved(input, options))
+    return simplify(input, with_normal_weight(input, options), observer);
   if (needs_material_carrier(input)) {
     SimplifyResult out = with_material_carrier(
         input, [&](MeshView with) { return simplify_two_sided(with, options, observer, nullptr, nullptr); });
@@ -388,6 +391,8 @@ SimplifyResult simplify(MeshView input, const SimplifyOptions& options, Simplify
 }
 
 SimplifyResult simplify(Mesh&& input, const SimplifyOptions& options, SimplifyObserver* observer) {
+  if (normal_weight_unresolved(input, options))
+    return simplify(std::move(input), with_normal_weight(input, options), observer);
   const bool carried = needs_material_carrier(input);
   if (carried) input.attributes.push_back(material_carrier(input.vertex_count()));
   SimplifyResult out = simplify_two_sided(input, options, observer, &input.indices, &input.attributes);

@@ -189,6 +189,22 @@ TEST(CliSimplify, BadOptionsAreRejected) {
             0);
 }
 
+TEST(CliSimplify, AGivenNormalWeightIsUsedAsItIs) {
+  // By default the normal weight grows to the spacing of the target's faces (src/normal_weight.h);
+  // a normal weight given alone is the weight, as normal-spacing=0 makes it.
+  const std::string dir = test::temp_dir();
+  const std::string in = dir + "/cli_normals.ply", out = dir + "/cli_normals_out.ply";
+  save_mesh(in, test::uv_sphere(30, 60));
+  const auto simplified = [&](const std::string& args) {
+    EXPECT_EQ(run("simplify " + in + " " + out + " --faces 300 --quiet " + args).exit_code, 0) << args;
+    return load_mesh(out).positions;
+  };
+  const std::vector<double> by_default = simplified(""), fixed = simplified("--attribute-weight normal=0.01");
+  EXPECT_NE(by_default, fixed);
+  EXPECT_EQ(fixed, simplified("--attribute-weight normal-spacing=0"));
+  EXPECT_EQ(by_default, simplified("--attribute-weight normal-spacing=1,normal=0.01"));
+}
+
 TEST(CliSimplify, HelpDocumentsEveryOption) {
   CliRun r = run("simplify --help");
   EXPECT_EQ(r.exit_code, 0);

@@ -436,7 +436,9 @@ TEST(GltfSimplify, MergedPrimitiveThatWouldVanishIsKept) {
   // CesiumMilkTruck's body, glass and window trim are one mesh of three primitives whose borders
   // meet. Merged and simplified with permissive seams to 1 %, the trim (six frames between the body
   // and the glass) closes up entirely; it is kept as it was then (the run made again with its
-  // vertices locked), the body and glass simplified round it, and no crack opens.
+  // vertices locked), the body and glass simplified round it, and no crack opens. (With the normal
+  // weight of a 1 % output's spacing, normal_per_spacing, the trim keeps a few faces unlocked: the
+  // fixed weight is the case that closes it.)
   const std::string path = qem::test::shared_data("CesiumMilkTruck.glb");
   if (path.empty()) GTEST_SKIP() << "../shared/data not found";
   qem::GltfDocument doc = qem::GltfDocument::load(path);
@@ -445,6 +447,7 @@ TEST(GltfSimplify, MergedPrimitiveThatWouldVanishIsKept) {
   qem::SimplifyOptions opt;
   opt.target_ratio = 0.01;
   opt.seams = qem::SeamMode::Permissive;
+  opt.attribute_weights.normal_per_spacing = 0;
   const qem::GltfSimplifyReport r = qem::simplify_document(doc, opt, {});
   EXPECT_EQ(r.simplified, 4u);
   EXPECT_EQ(doc.mesh(2).face_count(), trim);

@@ -432,7 +432,10 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
         "Permissive seams").
       attribute_weights: {"normal": w, "uv": w, "color": w, "scalar": w}: what a unit of each
         attribute costs against a unit of distance (1/w costs one bounding-box diagonal); the
-        library's defaults otherwise.
+        library's defaults otherwise. By default the normal weight is at least
+        "normal_per_spacing" (1) times the spacing of the target's faces, sqrt(area / faces) in
+        diagonals, so that coarse outputs keep small sharply turning parts; a "normal" given
+        without "normal_per_spacing" is used as it is.
       fit_attributes: after the run (and the refit), fit each off-seam vertex's attribute values by
         least squares to the input's values at the points of the output closest to the input's
         faces (Hoppe 1996 §4.2; the command line's --attribute-fit). Positions and faces stay; seam
@@ -449,7 +452,8 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
     Raises ValueError naming a bad argument, qem.Error for what the library refuses.
     """
     if attribute_weights is not None and not isinstance(attribute_weights, dict):
-        raise ValueError("attribute_weights: expected a dict {kind: weight} with kinds normal, uv, color, scalar")
+        raise ValueError("attribute_weights: expected a dict {kind: weight} with kinds normal, uv, color, scalar, "
+                         "normal_per_spacing")
     if record and attributes:
         raise ValueError("record: a record keeps positions and faces only, and the attributes would be lost "
                          "on replay; simplify without record=True, or carry them with return_mapping")
@@ -520,7 +524,8 @@ def simplify_gltf(input, output, *, target_faces: Optional[int] = None, target_r
         raise ValueError(f"simplify_gltf: unknown option(s) {', '.join(sorted(unknown))}")
     defaults = {**_GLTF_PASSED, **options}
     if attribute_weights is not None and not isinstance(attribute_weights, dict):
-        raise ValueError("attribute_weights: expected a dict {kind: weight} with kinds normal, uv, color, scalar")
+        raise ValueError("attribute_weights: expected a dict {kind: weight} with kinds normal, uv, color, scalar, "
+                         "normal_per_spacing")
     o = _options(target_faces=target_faces, target_ratio=target_ratio, target_vertices=target_vertices,
                  max_error=max_error, max_error_relative=max_error_relative, max_distance=max_distance,
                  max_distance_relative=max_distance_relative, refit=refit, threads=threads, record=False,

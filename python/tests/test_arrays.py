@@ -148,6 +148,14 @@ def test_attributes_are_checked_and_passed(small_torus):
     light = qem.simplify(v, f, target_faces=500, attributes={"NORMAL": v / np.linalg.norm(v, axis=1)[:, None]},
                          attribute_weights={"normal": 0.0})
     assert not np.array_equal(heavy.vertices, light.vertices)
+    # By default the normal weight grows to the output's spacing; a normal weight given alone is the
+    # weight, as normal_per_spacing 0 makes it.
+    normals = {"NORMAL": v / np.linalg.norm(v, axis=1)[:, None]}
+    by_default = qem.simplify(v, f, target_faces=100, attributes=normals)
+    fixed = qem.simplify(v, f, target_faces=100, attributes=normals, attribute_weights={"normal": 0.01})
+    unscaled = qem.simplify(v, f, target_faces=100, attributes=normals, attribute_weights={"normal_per_spacing": 0.0})
+    assert not np.array_equal(by_default.vertices, fixed.vertices)
+    assert np.array_equal(fixed.vertices, unscaled.vertices)
     with pytest.raises(ValueError, match="gloss"):
         qem.simplify(v, f, target_faces=500, attributes={"NORMAL": v}, attribute_weights={"gloss": 1.0})
     with pytest.raises(ValueError, match="record"):

@@ -1,0 +1,28 @@
+// AttributeWeights::normal_per_spacing: the normal weight of a run, from the spacing of the faces
+// it is asked for. Resolved once where a run starts (simplify, simplify_partitioned, each glTF
+// primitive), so that every stage of the run (the wedges' quadrics, the far-place repair, the
+// attribute fit) and every run of one glTF primitive (its watched run and its final one, which must
+// contract in the same order) weighs the normals alike.
+#pragma once
+
+#include "qem/mesh.h"
+#include "qem/simplify.h"
+
+namespace qem {
+
+/// Whether `options` still has a normal weight to resolve for `input` (it carries normals).
+bool normal_weight_unresolved(MeshView input, const SimplifyOptions& options);
+
+/// The faces a run of `options` on `input` is asked for, as the core resolves its target (the
+/// larger of a face and a ratio target; a vertex target alone: twice it), or 0 (no face target).
+double asked_faces(MeshView input, const SimplifyOptions& options);
+
+/// `options` with the normal weight at least normal_per_spacing times the spacing of
+/// `target_faces` faces on `input`'s surface (in diagonals of its referenced vertices' box), and
+/// normal_per_spacing 0. Without a target (0) the weight stays as it is.
+SimplifyOptions with_normal_weight(MeshView input, SimplifyOptions options, double target_faces);
+inline SimplifyOptions with_normal_weight(MeshView input, const SimplifyOptions& options) {
+  return with_normal_weight(input, options, asked_faces(input, options));
+}
+
+}  // namespace qem
