@@ -8,10 +8,21 @@
 
 namespace qem {
 
-bool normal_weight_unresolved(MeshView input, const SimplifyOptions& options) {
-  if (!(options.attribute_weights.normal_per_spacing > 0)) return false;
+namespace {
+
+bool has_normals(MeshView input) {
   return std::any_of(input.attributes.begin(), input.attributes.end(),
                      [](const VertexAttribute& a) { return a.kind == AttributeKind::Normal; });
+}
+
+}  // namespace
+
+bool normal_weight_unresolved(MeshView input, const SimplifyOptions& options) {
+  return options.attribute_weights.normal_per_spacing > 0 && has_normals(input);
+}
+
+double normal_weight_used(MeshView input, const SimplifyOptions& options) {
+  return has_normals(input) ? options.attribute_weights.normal : 0;
 }
 
 double asked_faces(MeshView input, const SimplifyOptions& options) {

@@ -13,6 +13,9 @@ namespace qem {
 /// Whether `options` still has a normal weight to resolve for `input` (it carries normals).
 bool normal_weight_unresolved(MeshView input, const SimplifyOptions& options);
 
+/// The normal weight a run of `options` (resolved) on `input` uses: 0 without normals.
+double normal_weight_used(MeshView input, const SimplifyOptions& options);
+
 /// The faces a run of `options` on `input` is asked for, as the core resolves its target (the
 /// larger of a face and a ratio target; a vertex target alone: twice it), or 0 (no face target).
 double asked_faces(MeshView input, const SimplifyOptions& options);

@@ -254,6 +254,7 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
       kept_indices.assign(in.indices.begin(), in.indices.end());
     };
   SimplifyResult out = core::run(input, options, hooks);
+  out.normal_weight = normal_weight_used(input, options);
   const std::span<const std::uint32_t> input_faces =
       consumed_indices ? std::span<const std::uint32_t>(kept_indices) : input.indices;
   // The frame of the refit and of the distance report: the input's referenced vertices' box.

@@ -203,6 +203,9 @@ TEST(CliSimplify, AGivenNormalWeightIsUsedAsItIs) {
   EXPECT_NE(by_default, fixed);
   EXPECT_EQ(fixed, simplified("--attribute-weight normal-spacing=0"));
   EXPECT_EQ(by_default, simplified("--attribute-weight normal-spacing=1,normal=0.01"));
+  // --json says which weight the run used.
+  const CliRun r = run("simplify " + in + " " + out + " --faces 300 --json --attribute-weight normal=0.25");
+  EXPECT_NE(r.out.find("\"normal_weight\":0.25,"), std::string::npos) << r.out;
 }
 
 TEST(CliSimplify, HelpDocumentsEveryOption) {

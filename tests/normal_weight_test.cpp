@@ -88,6 +88,10 @@ TEST(NormalWeight, SimplifyWeighsTheNormalsAtTheOutputsSpacing) {
   EXPECT_EQ(by_default.mesh.positions, resolved.mesh.positions);
   EXPECT_EQ(by_default.mesh.indices, resolved.mesh.indices);
   EXPECT_NE(by_default.mesh.positions, old.mesh.positions);
+  // The result says which weight it used; a mesh without normals, none.
+  EXPECT_EQ(by_default.normal_weight, given.attribute_weights.normal);
+  EXPECT_EQ(old.normal_weight, o.attribute_weights.normal);
+  EXPECT_EQ(simplify(test::icosphere(3), o).normal_weight, 0);
 }
 
 TEST(NormalWeight, TheDucksBeakKeepsItsNormalsAtATenth) {

@@ -345,6 +345,9 @@ struct SimplifyResult {
   /// those it sampled) to the output, before and after it (model units), and the rounds it kept.
   double refit_rms_before = 0, refit_rms_after = 0;
   std::size_t refit_rounds = 0;
+  /// The normal weight the run used (AttributeWeights::normal, after normal_per_spacing); 0 when the
+  /// input has no normals.
+  double normal_weight = 0;
   /// With far_repair: the edges flipped (each output face keeps its face_source and material) and
   /// the vertices moved.
   std::size_t edge_flips = 0, vertex_moves = 0;

@@ -362,7 +362,9 @@ SimplifyResult simplify_partitioned(MeshView input, const SimplifyOptions& optio
     rep.parts = 1;
     return simplify(input, options);
   }
-  return finish_partitioned(input, options, std::move(parts), std::move(results), &rep);
+  SimplifyResult out = finish_partitioned(input, options, std::move(parts), std::move(results), &rep);
+  out.normal_weight = normal_weight_used(input, options);
+  return out;
 }
 
 }  // namespace qem
