@@ -11,9 +11,9 @@ Equal size: the goal is a lower error at the same face count, so when qem's outp
 meshoptimizer's differ by more than --size-tol (1 %, either way; both are asked for the same target,
 but a tool that cannot reach it stops where its rules do), qem is run again with `-f` set to
 meshoptimizer's face count and the row is judged on that output ("qem at peer size"; on a glTF
-document, whose measured count includes every instance of a mesh, -f is corrected up to four times, by
-the reached/asked ratio and then along the line through the last two tries). The faces column then reads "qem asked / qem at peer size / meshopt / gltft"
-and "E q/m asked" keeps the first run's E ratio; every other qem column is the judged output. If qem
+document, whose measured count includes every instance of a mesh, -f is corrected up to four
+times, by the reached/asked ratio and then along the line through the last two tries). The faces
+column then reads "qem asked / qem at peer size / meshopt / gltft" and "E q/m asked" keeps the first run's E ratio; every other qem column is the judged output. If qem
 cannot reach the peer's size (it stops above it), the faces column marks it with "!" and the row
 does not meet the goal (a larger mesh's lower error proves nothing); the summary lists it. E q/g compares
 the first qem run with gltf-transform (both asked for the same target).

@@ -2,9 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
+#include "geometry/box.h"
 #include "geometry/vec3.h"
+#include "partition/partition_targets.h"
 
 namespace qem {
 
@@ -26,37 +27,26 @@ double normal_weight_used(MeshView input, const SimplifyOptions& options) {
 }
 
 double asked_faces(MeshView input, const SimplifyOptions& options) {
-  double faces = double(options.target_faces);
-  if (options.target_ratio > 0)
-    faces = std::max(faces, std::floor(options.target_ratio * double(input.face_count())));
-  if (faces == 0 && options.target_vertices > 0) faces = 2 * double(options.target_vertices);
-  return faces;
+  const partition_detail::Targets t = partition_detail::resolve_targets(options, input.face_count());
+  return t.faces > 0 ? double(t.faces) : 2 * double(t.vertices);
 }
 
 SimplifyOptions with_normal_weight(MeshView input, SimplifyOptions options, double target_faces) {
   const double per_spacing = options.attribute_weights.normal_per_spacing;
   options.attribute_weights.normal_per_spacing = 0;
   if (!(per_spacing > 0) || !(target_faces > 0)) return options;
-  // The area and the box of the faces' corners (unreferenced vertices do not count, as in the core's frame).
-  constexpr double inf = std::numeric_limits<double>::infinity();
-  Vec3 lo{inf, inf, inf}, hi{-inf, -inf, -inf};
-  double twice_area = 0;
-  const auto at = [&](std::uint32_t v) {
-    return Vec3{input.positions[3 * std::size_t(v)], input.positions[3 * std::size_t(v) + 1],
-                input.positions[3 * std::size_t(v) + 2]};
-  };
   const std::size_t vertices = input.vertex_count();
+  double twice_area = 0;
   for (std::size_t f = 0; f < input.face_count(); ++f) {
     const std::uint32_t* t = &input.indices[3 * f];
     if (t[0] >= vertices || t[1] >= vertices || t[2] >= vertices) return options;  // the run refuses it
-    const Vec3 a = at(t[0]), b = at(t[1]), c = at(t[2]);
-    twice_area += length(cross(b - a, c - a));
-    for (const Vec3& p : {a, b, c}) {
-      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
-      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
-    }
+    const double *a = &input.positions[3 * std::size_t(t[0])], *b = &input.positions[3 * std::size_t(t[1])],
+                 *c = &input.positions[3 * std::size_t(t[2])];
+    const Vec3 ab{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, ac{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    twice_area += length(cross(ab, ac));
   }
-  const double diagonal = length(hi - lo);
+  // In diagonals of the faces' corners' box (unreferenced vertices do not count, as in the core's frame).
+  const double diagonal = box_of_points(input.positions, input.indices).diagonal();
   const double spacing = std::sqrt(0.5 * twice_area / target_faces) / diagonal;
   if (std::isfinite(spacing) && diagonal > 0)
     options.attribute_weights.normal = std::max(options.attribute_weights.normal, per_spacing * spacing);
