@@ -71,7 +71,10 @@ void add_algorithm_options(CLI::App* sub, AlgorithmArgs& a) {
              "); normal-spacing=K: by default the normal weight is at least K (" +
              json_number(AttributeWeights{}.normal_per_spacing) +
              ") times the spacing of the target's faces, sqrt(area / faces) in diagonals, so that coarse "
-             "outputs keep small sharply turning parts; a normal weight given alone is used as it is")
+             "outputs keep small sharply turning parts; color-spacing=K: the colour weight at least K (" +
+             json_number(AttributeWeights{}.color_per_spacing) + ") times that spacing, up to " +
+             json_number(AttributeWeights{}.color_spacing_cap) +
+             "; a normal or colour weight given alone is used as it is")
       ->delimiter(',');
   sub->add_option(
          "--seams", a.seams,
@@ -197,7 +200,7 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
   if (a.prune > 0 && a.prune_rel > 0) throw Error("give --prune or --prune-rel, not both");
   if (a.prune_rel > 0) opt.prune_size = a.prune_rel, opt.prune_size_is_relative = true;
   else opt.prune_size = a.prune;
-  bool spacing_given = false;
+  bool normal_spacing_given = false, color_spacing_given = false;
   for (const std::string& item : a.attribute_weights) {
     const std::size_t eq = item.find('=');
     const std::string kind = item.substr(0, eq);
@@ -207,17 +210,22 @@ SimplifyOptions to_simplify_options(const AlgorithmArgs& a) {
                      : kind == "scalar"         ? &opt.attribute_weights.scalar
                      : kind == "seam"           ? &opt.attribute_weights.seam
                      : kind == "normal-spacing" ? &opt.attribute_weights.normal_per_spacing
+                     : kind == "color-spacing"  ? &opt.attribute_weights.color_per_spacing
                                                 : nullptr;
     char* end = nullptr;
     const double w = eq == std::string::npos ? -1 : std::strtod(item.c_str() + eq + 1, &end);
     if (!weight || eq == std::string::npos || !end || *end != 0 || !(w >= 0) || !std::isfinite(w))
       throw Error(
-          "--attribute-weight: expected KIND=W with KIND normal, uv, color, scalar, seam or normal-spacing "
+          "--attribute-weight: expected KIND=W with KIND normal, uv, color, scalar, seam, normal-spacing or "
+          "color-spacing "
           "and W >= 0, got '" + item + "'");
     *weight = w;
-    // A normal weight given is the weight (unless normal-spacing is given too, before or after it).
-    if (kind == "normal" && !spacing_given) opt.attribute_weights.normal_per_spacing = 0;
-    if (kind == "normal-spacing") spacing_given = true;
+    // A normal or colour weight given is the weight (unless its spacing factor is given too, before
+    // or after it).
+    if (kind == "normal" && !normal_spacing_given) opt.attribute_weights.normal_per_spacing = 0;
+    if (kind == "normal-spacing") normal_spacing_given = true;
+    if (kind == "color" && !color_spacing_given) opt.attribute_weights.color_per_spacing = 0;
+    if (kind == "color-spacing") color_spacing_given = true;
   }
   opt.seams = parsed<SeamMode>("--seams", a.seams);
   opt.fit_attributes = a.attribute_fit;

@@ -251,7 +251,7 @@ int run_simplify(const SimplifyArgs& a) {
         "\"refit_rms_before\":%s,\"refit_rms_after\":%s,\"edge_flips\":%zu,\"vertex_moves\":%zu,"
         "\"vertex_relocations\":%zu,\"dropped_degenerate\":%zu,\"dropped_duplicate\":%zu,\"twin_faces\":%zu,"
         "\"parts\":%u,\"split_s\":%s,\"parts_s\":%s,\"final_pass_s\":%s,\"parts_cpu_s\":%s,"
-        "\"busiest_thread_cpu_s\":%s,\"normal_weight\":%s,\"stop\":\"%s\"}\n",
+        "\"busiest_thread_cpu_s\":%s,\"normal_weight\":%s,\"color_weight\":%s,\"stop\":\"%s\"}\n",
         // clang-format on
         in_faces, partition_detail::resolve_targets(opt, in_faces).faces, r.mesh.face_count(),
         r.mesh.vertex_count(), json_number(load_s).c_str(), json_number(simplify_s).c_str(),
@@ -268,7 +268,7 @@ int run_simplify(const SimplifyArgs& a) {
         json_number(partition_report.final_seconds).c_str(),
         json_number(partition_report.parts_cpu_seconds).c_str(),
         json_number(partition_report.busiest_thread_cpu_seconds).c_str(),
-        json_number(r.normal_weight).c_str(), to_string(r.stop_reason));
+        json_number(r.normal_weight).c_str(), json_number(r.color_weight).c_str(), to_string(r.stop_reason));
   }
   if (!a.quiet)
     std::fprintf(stderr,

@@ -15,7 +15,7 @@
 #include <thread>
 
 #include "merged_primitives.h"
-#include "normal_weight.h"
+#include "spacing_weights.h"
 #include "qem/error.h"
 #include "quantized_borders.h"
 
@@ -265,11 +265,11 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
                                                       double(total_vertices))));
     const bool face_target = target != std::numeric_limits<std::size_t>::max();
     report.target_faces = face_target ? target : options.as_far_as_possible ? 0 : total_faces;
-    // Each primitive's normal weight from the scene's ratio (normal_weight.h), once: its watched
+    // Each primitive's normal and colour weights from the scene's ratio (spacing_weights.h), once: its watched
     // and final runs must contract in the same order.
     std::vector<SimplifyOptions> unit_options;
     for (const Unit& u : units)
-      unit_options.push_back(with_normal_weight(
+      unit_options.push_back(with_spacing_weights(
           u.mesh, options,
           face_target && total_faces > 0 ? double(target) * double(u.faces) / double(total_faces) : 0));
 

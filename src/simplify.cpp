@@ -17,7 +17,7 @@
 #include "geometry/box.h"
 #include "geometry/frame.h"
 #include "material_carrier.h"
-#include "normal_weight.h"
+#include "spacing_weights.h"
 #include "qem/error.h"
 #include "refit/attribute_fit.h"
 #include "refit/refit_after_simplify.h"
@@ -255,6 +255,7 @@ SimplifyResult simplify_and_refit(MeshView input, const SimplifyOptions& options
     };
   SimplifyResult out = core::run(input, options, hooks);
   out.normal_weight = normal_weight_used(input, options);
+  out.color_weight = color_weight_used(input, options);
   const std::span<const std::uint32_t> input_faces =
       consumed_indices ? std::span<const std::uint32_t>(kept_indices) : input.indices;
   // The frame of the refit and of the distance report: the input's referenced vertices' box.
@@ -380,8 +381,8 @@ SimplifyResult simplify_two_sided(MeshView input, const SimplifyOptions& options
 }  // namespace
 
 SimplifyResult simplify(MeshView input, const SimplifyOptions& options, SimplifyObserver* observer) {
-  if (normal_weight_unresolved(input, options))
-    return simplify(input, with_normal_weight(input, options), observer);
+  if (spacing_weights_unresolved(input, options))
+    return simplify(input, with_spacing_weights(input, options), observer);
   if (needs_material_carrier(input)) {
     SimplifyResult out = with_material_carrier(
         input, [&](MeshView with) { return simplify_two_sided(with, options, observer, nullptr, nullptr); });
@@ -392,8 +393,8 @@ SimplifyResult simplify(MeshView input, const SimplifyOptions& options, Simplify
 }
 
 SimplifyResult simplify(Mesh&& input, const SimplifyOptions& options, SimplifyObserver* observer) {
-  if (normal_weight_unresolved(input, options))
-    return simplify(std::move(input), with_normal_weight(input, options), observer);
+  if (spacing_weights_unresolved(input, options))
+    return simplify(std::move(input), with_spacing_weights(input, options), observer);
   const bool carried = needs_material_carrier(input);
   if (carried) input.attributes.push_back(material_carrier(input.vertex_count()));
   SimplifyResult out = simplify_two_sided(input, options, observer, &input.indices, &input.attributes);

@@ -190,7 +190,7 @@ TEST(CliSimplify, BadOptionsAreRejected) {
 }
 
 TEST(CliSimplify, AGivenNormalWeightIsUsedAsItIs) {
-  // By default the normal weight grows to the spacing of the target's faces (src/normal_weight.h);
+  // By default the normal weight grows to the spacing of the target's faces (src/spacing_weights.h);
   // a normal weight given alone is the weight, as normal-spacing=0 makes it.
   const std::string dir = test::temp_dir();
   const std::string in = dir + "/cli_normals.ply", out = dir + "/cli_normals_out.ply";
@@ -206,6 +206,28 @@ TEST(CliSimplify, AGivenNormalWeightIsUsedAsItIs) {
   // --json says which weight the run used.
   const CliRun r = run("simplify " + in + " " + out + " --faces 300 --json --attribute-weight normal=0.25");
   EXPECT_NE(r.out.find("\"normal_weight\":0.25,"), std::string::npos) << r.out;
+}
+
+TEST(CliSimplify, AGivenColourWeightIsUsedAsItIs) {
+  // As the normal weight: the colour weight grows to three spacings of the target's faces (up to
+  // 0.4) unless a colour weight is given alone.
+  const std::string dir = test::temp_dir();
+  const std::string in = dir + "/cli_colours.ply", out = dir + "/cli_colours_out.ply";
+  Mesh sphere = test::uv_sphere(20, 40);
+  std::vector<double> rgb(3 * sphere.vertex_count());
+  for (std::size_t i = 0; i < rgb.size(); ++i) rgb[i] = double((i * 7919) % 101) / 100.0;
+  sphere.attributes.push_back({"COLOR_0", AttributeKind::Color, 3, rgb});
+  save_mesh(in, sphere);
+  const auto simplified = [&](const std::string& args) {
+    EXPECT_EQ(run("simplify " + in + " " + out + " --faces 150 --quiet " + args).exit_code, 0) << args;
+    return load_mesh(out).positions;
+  };
+  const std::vector<double> by_default = simplified(""), fixed = simplified("--attribute-weight color=0.1");
+  EXPECT_NE(by_default, fixed);
+  EXPECT_EQ(fixed, simplified("--attribute-weight color-spacing=0"));
+  EXPECT_EQ(by_default, simplified("--attribute-weight color=0.1,color-spacing=3"));
+  const CliRun r = run("simplify " + in + " " + out + " --faces 150 --json --attribute-weight color=0.25");
+  EXPECT_NE(r.out.find("\"color_weight\":0.25,"), std::string::npos) << r.out;
 }
 
 TEST(CliSimplify, HelpDocumentsEveryOption) {

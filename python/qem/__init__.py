@@ -434,8 +434,9 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
         attribute costs against a unit of distance (1/w costs one bounding-box diagonal); the
         library's defaults otherwise. By default the normal weight is at least
         "normal_per_spacing" (1) times the spacing of the target's faces, sqrt(area / faces) in
-        diagonals, so that coarse outputs keep small sharply turning parts; a "normal" given
-        without "normal_per_spacing" is used as it is.
+        diagonals, so that coarse outputs keep small sharply turning parts, and the colour weight
+        at least "color_per_spacing" (3) times it, up to 0.4; a "normal" or "color" given without
+        its spacing factor is used as it is.
       fit_attributes: after the run (and the refit), fit each off-seam vertex's attribute values by
         least squares to the input's values at the points of the output closest to the input's
         faces (Hoppe 1996 §4.2; the command line's --attribute-fit). Positions and faces stay; seam
@@ -453,7 +454,7 @@ def simplify(vertices, faces, *, target_faces: Optional[int] = None, target_rati
     """
     if attribute_weights is not None and not isinstance(attribute_weights, dict):
         raise ValueError("attribute_weights: expected a dict {kind: weight} with kinds normal, uv, color, scalar, "
-                         "normal_per_spacing")
+                         "normal_per_spacing, color_per_spacing")
     if record and attributes:
         raise ValueError("record: a record keeps positions and faces only, and the attributes would be lost "
                          "on replay; simplify without record=True, or carry them with return_mapping")
@@ -525,7 +526,7 @@ def simplify_gltf(input, output, *, target_faces: Optional[int] = None, target_r
     defaults = {**_GLTF_PASSED, **options}
     if attribute_weights is not None and not isinstance(attribute_weights, dict):
         raise ValueError("attribute_weights: expected a dict {kind: weight} with kinds normal, uv, color, scalar, "
-                         "normal_per_spacing")
+                         "normal_per_spacing, color_per_spacing")
     o = _options(target_faces=target_faces, target_ratio=target_ratio, target_vertices=target_vertices,
                  max_error=max_error, max_error_relative=max_error_relative, max_distance=max_distance,
                  max_distance_relative=max_distance_relative, refit=refit, threads=threads, record=False,

@@ -169,13 +169,16 @@ void bind_simplify(py::module_& m) {
           [](const SimplifyOptions& o) {
             const AttributeWeights& w = o.attribute_weights;
             return py::dict(py::arg("normal") = w.normal, py::arg("uv") = w.tex_coord, py::arg("color") = w.color,
-                            py::arg("scalar") = w.scalar, py::arg("normal_per_spacing") = w.normal_per_spacing);
+                            py::arg("scalar") = w.scalar, py::arg("normal_per_spacing") = w.normal_per_spacing,
+                            py::arg("color_per_spacing") = w.color_per_spacing);
           },
           [](SimplifyOptions& o, const py::dict& weights) {
-            // A normal weight given is the weight, unless normal_per_spacing is given with it
-            // (AttributeWeights::normal_per_spacing).
+            // A normal or colour weight given is the weight, unless its spacing factor is given with
+            // it (AttributeWeights::normal_per_spacing, color_per_spacing).
             if (weights.contains("normal") && !weights.contains("normal_per_spacing"))
               o.attribute_weights.normal_per_spacing = 0;
+            if (weights.contains("color") && !weights.contains("color_per_spacing"))
+              o.attribute_weights.color_per_spacing = 0;
             for (auto [key, value] : weights) {
               const std::string kind = py::str(key);
               double* w = kind == "normal" ? &o.attribute_weights.normal
@@ -183,10 +186,11 @@ void bind_simplify(py::module_& m) {
                           : kind == "color" ? &o.attribute_weights.color
                           : kind == "scalar" ? &o.attribute_weights.scalar
                           : kind == "normal_per_spacing" ? &o.attribute_weights.normal_per_spacing
+                          : kind == "color_per_spacing" ? &o.attribute_weights.color_per_spacing
                                              : nullptr;
               if (!w)
                 throw py::value_error("attribute_weights: unknown kind '" + kind +
-                                      "' (normal, uv, color, scalar, normal_per_spacing)");
+                                      "' (normal, uv, color, scalar, normal_per_spacing, color_per_spacing)");
               const double x = value.cast<double>();
               if (!(x >= 0) || !std::isfinite(x))
                 throw py::value_error("attribute_weights['" + kind + "']: expected a finite weight >= 0");

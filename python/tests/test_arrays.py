@@ -156,6 +156,13 @@ def test_attributes_are_checked_and_passed(small_torus):
     unscaled = qem.simplify(v, f, target_faces=100, attributes=normals, attribute_weights={"normal_per_spacing": 0.0})
     assert not np.array_equal(by_default.vertices, fixed.vertices)
     assert np.array_equal(fixed.vertices, unscaled.vertices)
+    # The colour weight likewise (three spacings, up to 0.4).
+    colours = {"COLOR_0": np.random.default_rng(7).random((len(v), 3))}
+    by_default = qem.simplify(v, f, target_faces=100, attributes=colours)
+    fixed = qem.simplify(v, f, target_faces=100, attributes=colours, attribute_weights={"color": 0.1})
+    unscaled = qem.simplify(v, f, target_faces=100, attributes=colours, attribute_weights={"color_per_spacing": 0.0})
+    assert not np.array_equal(by_default.vertices, fixed.vertices)
+    assert np.array_equal(fixed.vertices, unscaled.vertices)
     with pytest.raises(ValueError, match="gloss"):
         qem.simplify(v, f, target_faces=500, attributes={"NORMAL": v}, attribute_weights={"gloss": 1.0})
     with pytest.raises(ValueError, match="record"):

@@ -18,7 +18,7 @@
 #include "core/run.h"
 #include "core/same_position.h"
 #include "material_carrier.h"
-#include "normal_weight.h"
+#include "spacing_weights.h"
 #include "partition/partition_targets.h"
 #include "qem/error.h"
 #include "qem/partition.h"
@@ -330,9 +330,9 @@ SimplifyResult finish_partitioned(MeshView input, const SimplifyOptions& options
 SimplifyResult simplify_partitioned(MeshView input, const SimplifyOptions& options, const PartitionOptions& partition,
                                     PartitionReport* report) {
   check_options(options);
-  // Once for the whole input: each part's run then weighs the normals alike.
-  if (normal_weight_unresolved(input, options))
-    return simplify_partitioned(input, with_normal_weight(input, options), partition, report);
+  // Once for the whole input: each part's run then weighs the normals and colours alike.
+  if (spacing_weights_unresolved(input, options))
+    return simplify_partitioned(input, with_spacing_weights(input, options), partition, report);
   PartitionReport local_report;
   PartitionReport& rep = report ? *report : local_report;
   const unsigned part_count = partition.parts > 0 ? partition.parts : automatic_parts(input.face_count());
@@ -364,6 +364,7 @@ SimplifyResult simplify_partitioned(MeshView input, const SimplifyOptions& optio
   }
   SimplifyResult out = finish_partitioned(input, options, std::move(parts), std::move(results), &rep);
   out.normal_weight = normal_weight_used(input, options);
+  out.color_weight = color_weight_used(input, options);
   return out;
 }
 
