@@ -161,6 +161,8 @@ class SimplifyResult(Mesh):
     output_to_input_distance (model units) and output_to_input_distance_relative (over the
       diagonal): with max_distance, the largest sampled distance from the output to the input
       (0 without); rejected_distance: contractions refused for the bound.
+    normal_weight, color_weight: the attribute weights the run used, after the spacing rules of
+      attribute_weights (0 when the input has no normals, no colours).
     With return_mapping=True (else None):
       vertex_source: (n_out,) int32, the input vertex each output vertex started from;
       face_source: (m_out,) int32, the input face each output face is;
@@ -174,7 +176,8 @@ class SimplifyResult(Mesh):
         "input_vertices", "refit_rounds", "refit_rms_before", "refit_rms_after", "edge_flips", "vertex_moves", "vertex_relocations", "dropped_degenerate_faces",
         "dropped_duplicate_faces", "twin_faces", "rejected_component", "input_components", "output_components",
         "pruned_components", "output_to_input_distance", "output_to_input_distance_relative",
-        "rejected_distance", "vertex_source", "face_source", "output_vertex_of_input", "record",
+        "rejected_distance", "normal_weight", "color_weight", "vertex_source", "face_source",
+        "output_vertex_of_input", "record",
     )
 
     def __repr__(self):

@@ -290,6 +290,8 @@ void bind_simplify(py::module_& m) {
         out["dropped_degenerate_faces"] = r.dropped_degenerate_faces;
         out["dropped_duplicate_faces"] = r.dropped_duplicate_faces;
         out["twin_faces"] = r.twin_faces;
+        out["normal_weight"] = r.normal_weight;
+        out["color_weight"] = r.color_weight;
         out["vertex_source"] = take_indices(std::move(r.vertex_source), 1, p.data.size() / 3);
         out["face_source"] = take_indices(std::move(r.face_source), 1, f.data.size() / 3);
         out["output_vertex_of_input"] =

@@ -163,6 +163,9 @@ def test_attributes_are_checked_and_passed(small_torus):
     unscaled = qem.simplify(v, f, target_faces=100, attributes=colours, attribute_weights={"color_per_spacing": 0.0})
     assert not np.array_equal(by_default.vertices, fixed.vertices)
     assert np.array_equal(fixed.vertices, unscaled.vertices)
+    # The result says which weights the run used.
+    assert by_default.color_weight > 0.1 and fixed.color_weight == 0.1
+    assert by_default.normal_weight == 0 and fixed.normal_weight == 0
     with pytest.raises(ValueError, match="gloss"):
         qem.simplify(v, f, target_faces=500, attributes={"NORMAL": v}, attribute_weights={"gloss": 1.0})
     with pytest.raises(ValueError, match="record"):
