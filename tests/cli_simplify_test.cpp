@@ -189,45 +189,43 @@ TEST(CliSimplify, BadOptionsAreRejected) {
             0);
 }
 
-TEST(CliSimplify, AGivenNormalWeightIsUsedAsItIs) {
-  // By default the normal weight grows to the spacing of the target's faces (src/spacing_weights.h);
-  // a normal weight given alone is the weight, as normal-spacing=0 makes it.
+namespace {
+
+// By default the normal and colour weights grow to the spacing of the target's faces
+// (src/spacing_weights.h); a weight of that kind given alone is the weight, as KIND-spacing=0
+// makes it, and --json says which weight the run used. `floor` and `factor`: the defaults.
+void expect_a_given_weight_is_used(const Mesh& mesh, const std::string& kind, const std::string& floor,
+                                   const std::string& factor, const std::string& faces) {
   const std::string dir = test::temp_dir();
-  const std::string in = dir + "/cli_normals.ply", out = dir + "/cli_normals_out.ply";
-  save_mesh(in, test::uv_sphere(30, 60));
+  const std::string in = dir + "/cli_" + kind + ".ply", out = dir + "/cli_" + kind + "_out.ply";
+  save_mesh(in, mesh);
   const auto simplified = [&](const std::string& args) {
-    EXPECT_EQ(run("simplify " + in + " " + out + " --faces 300 --quiet " + args).exit_code, 0) << args;
+    EXPECT_EQ(run("simplify " + in + " " + out + " --faces " + faces + " --quiet " + args).exit_code, 0)
+        << args;
     return load_mesh(out).positions;
   };
-  const std::vector<double> by_default = simplified(""), fixed = simplified("--attribute-weight normal=0.01");
+  const std::string weight = "--attribute-weight " + kind + "=",
+                    spacing = "--attribute-weight " + kind + "-spacing=";
+  const std::vector<double> by_default = simplified(""), fixed = simplified(weight + floor);
   EXPECT_NE(by_default, fixed);
-  EXPECT_EQ(fixed, simplified("--attribute-weight normal-spacing=0"));
-  EXPECT_EQ(by_default, simplified("--attribute-weight normal-spacing=1,normal=0.01"));
-  // --json says which weight the run used.
-  const CliRun r = run("simplify " + in + " " + out + " --faces 300 --json --attribute-weight normal=0.25");
-  EXPECT_NE(r.out.find("\"normal_weight\":0.25,"), std::string::npos) << r.out;
+  EXPECT_EQ(fixed, simplified(spacing + "0"));
+  EXPECT_EQ(by_default, simplified(spacing + factor + "," + kind + "=" + floor));
+  const CliRun r = run("simplify " + in + " " + out + " --faces " + faces + " --json " + weight + "0.25");
+  EXPECT_NE(r.out.find("\"" + kind + "_weight\":0.25,"), std::string::npos) << r.out;
+}
+
+}  // namespace
+
+TEST(CliSimplify, AGivenNormalWeightIsUsedAsItIs) {
+  expect_a_given_weight_is_used(test::uv_sphere(30, 60), "normal", "0.01", "1", "300");
 }
 
 TEST(CliSimplify, AGivenColourWeightIsUsedAsItIs) {
-  // As the normal weight: the colour weight grows to three spacings of the target's faces (up to
-  // 0.4) unless a colour weight is given alone.
-  const std::string dir = test::temp_dir();
-  const std::string in = dir + "/cli_colours.ply", out = dir + "/cli_colours_out.ply";
-  Mesh sphere = test::uv_sphere(20, 40);
+  Mesh sphere = test::uv_sphere(20, 40);  // with normals, as above, and colours of no pattern
   std::vector<double> rgb(3 * sphere.vertex_count());
   for (std::size_t i = 0; i < rgb.size(); ++i) rgb[i] = double((i * 7919) % 101) / 100.0;
   sphere.attributes.push_back({"COLOR_0", AttributeKind::Color, 3, rgb});
-  save_mesh(in, sphere);
-  const auto simplified = [&](const std::string& args) {
-    EXPECT_EQ(run("simplify " + in + " " + out + " --faces 150 --quiet " + args).exit_code, 0) << args;
-    return load_mesh(out).positions;
-  };
-  const std::vector<double> by_default = simplified(""), fixed = simplified("--attribute-weight color=0.1");
-  EXPECT_NE(by_default, fixed);
-  EXPECT_EQ(fixed, simplified("--attribute-weight color-spacing=0"));
-  EXPECT_EQ(by_default, simplified("--attribute-weight color=0.1,color-spacing=3"));
-  const CliRun r = run("simplify " + in + " " + out + " --faces 150 --json --attribute-weight color=0.25");
-  EXPECT_NE(r.out.find("\"color_weight\":0.25,"), std::string::npos) << r.out;
+  expect_a_given_weight_is_used(sphere, "color", "0.1", "3", "150");
 }
 
 TEST(CliSimplify, HelpDocumentsEveryOption) {
