@@ -265,8 +265,8 @@ GltfSimplifyReport simplify_document(GltfDocument& doc, const SimplifyOptions& o
                                                       double(total_vertices))));
     const bool face_target = target != std::numeric_limits<std::size_t>::max();
     report.target_faces = face_target ? target : options.as_far_as_possible ? 0 : total_faces;
-    // Each primitive's normal and colour weights from the scene's ratio (spacing_weights.h), once: its watched
-    // and final runs must contract in the same order.
+    // Each primitive's normal and colour weights from the scene's ratio (spacing_weights.h), once:
+    // its watched and final runs must contract in the same order.
     std::vector<SimplifyOptions> unit_options;
     for (const Unit& u : units)
       unit_options.push_back(with_spacing_weights(
