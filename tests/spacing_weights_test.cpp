@@ -175,7 +175,8 @@ TEST(ColorWeight, ASphereOfRandomColoursKeepsThemAtHalfItsFaces) {
   fixed.attribute_weights.color_per_spacing = 0;
   MeasureOptions m;
   m.samples = 200000;
-  const MeasureResult now = measure(in, simplify(in, o).mesh, m), before = measure(in, simplify(in, fixed).mesh, m);
+  const MeasureResult now = measure(in, simplify(in, o).mesh, m),
+                      before = measure(in, simplify(in, fixed).mesh, m);
   ASSERT_TRUE(now.color_rms && before.color_rms);
   std::printf("tiny sphere to 50 %%: colour rms %.4f (fixed weight %.4f), rms distance %.3g (%.3g)\n",
               *now.color_rms, *before.color_rms, now.rms_rel, before.rms_rel);
