@@ -21,14 +21,14 @@ bool huge_pages_wanted(const char* setting) { return !setting || std::string_vie
 
 }  // namespace qem::cli
 
+#if !QEM_SANITIZED_ALLOCATOR
 namespace {
 
 // The advice on a large block's whole huge pages, before anything touches them (glibc gives a
 // block this large fresh pages of its own mapping, or reused heap whose advice is kept). The
-// partial pages at its two ends stay small: aligning each block to whole huge pages took the
-// faults of the 10M-face torus from 181k to 137k but its peak memory up by 100 MB (6 %), a
-// rounding per live block. A kernel without transparent huge pages refuses the advice: the block
-// is used as it is.
+// partial pages at its two ends stay small: aligning each block to whole huge pages saved a few
+// more faults but raised the peak memory by a rounding per live block (docs/benchmarks.md). A
+// kernel without transparent huge pages refuses the advice: the block is used as it is.
 void* advised(void* p, std::size_t bytes) {
   if (!p) throw std::bad_alloc();
   static const bool wanted = qem::cli::huge_pages_wanted(std::getenv("QEM_HUGE_PAGES"));
@@ -49,16 +49,43 @@ void* allocate_aligned(std::size_t bytes, std::align_val_t align) {
 
 }  // namespace
 
-// The replaceable forms that the others (nothrow, sized) fall back on in libstdc++.
+// Every replaceable form, so that each block is freed by the allocator that made it whichever form
+// the standard library calls (std::stable_sort's buffer: nothrow new, sized delete). Not under
+// AddressSanitizer, whose own forms check that new meets delete and new[] meets delete[].
 void* operator new(std::size_t bytes) { return allocate(bytes); }
 void* operator new[](std::size_t bytes) { return allocate(bytes); }
+void* operator new(std::size_t bytes, const std::nothrow_t&) noexcept {
+  try {
+    return allocate(bytes);
+  } catch (const std::bad_alloc&) {
+    return nullptr;
+  }
+}
+void* operator new[](std::size_t bytes, const std::nothrow_t& tag) noexcept {
+  return operator new(bytes, tag);
+}
 void* operator new(std::size_t bytes, std::align_val_t align) { return allocate_aligned(bytes, align); }
 void* operator new[](std::size_t bytes, std::align_val_t align) { return allocate_aligned(bytes, align); }
+void* operator new(std::size_t bytes, std::align_val_t align, const std::nothrow_t&) noexcept {
+  try {
+    return allocate_aligned(bytes, align);
+  } catch (const std::bad_alloc&) {
+    return nullptr;
+  }
+}
+void* operator new[](std::size_t bytes, std::align_val_t align, const std::nothrow_t& tag) noexcept {
+  return operator new(bytes, align, tag);
+}
 void operator delete(void* p) noexcept { std::free(p); }
 void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
 void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
 void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+#endif

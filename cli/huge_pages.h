@@ -14,7 +14,22 @@
 #include <cstddef>
 #include <cstdint>
 
+// AddressSanitizer's build keeps the sanitizer's operator new (see huge_pages.cpp).
+#if defined(__SANITIZE_ADDRESS__)
+#define QEM_SANITIZED_ALLOCATOR 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define QEM_SANITIZED_ALLOCATOR 1
+#endif
+#endif
+#ifndef QEM_SANITIZED_ALLOCATOR
+#define QEM_SANITIZED_ALLOCATOR 0
+#endif
+
 namespace qem::cli {
+
+/// Whether this build's operator new gives the advice (all but AddressSanitizer's).
+inline constexpr bool kAdvisesHugePages = !QEM_SANITIZED_ALLOCATOR;
 
 inline constexpr std::size_t kHugePageBytes = std::size_t(2) << 20;
 /// Allocations from this size on are advised: two huge pages, so that at least one whole huge

@@ -53,6 +53,7 @@ std::string vm_flags_at(std::uintptr_t at) {
 }  // namespace
 
 TEST(HugePages, ALargeArrayIsAdvised) {
+  if (!kAdvisesHugePages) GTEST_SKIP() << "AddressSanitizer's build: the sanitizer's operator new";
   if (!std::filesystem::exists("/sys/kernel/mm/transparent_hugepage/enabled"))
     GTEST_SKIP() << "no transparent huge pages in this kernel";
   std::vector<char> large(3 * kAdvisedFromBytes);
