@@ -58,7 +58,10 @@ double asked_faces(MeshView input, const SimplifyOptions& options) {
 
 SimplifyOptions with_spacing_weights(MeshView input, SimplifyOptions options, double target_faces) {
   AttributeWeights& w = options.attribute_weights;
-  const double normal_factor = w.normal_per_spacing, color_factor = w.color_per_spacing;
+  // Only the kinds the mesh carries: a weight it has no values for is never read, and a glTF
+  // primitive with neither needs no pass over its faces.
+  const double normal_factor = has(input, AttributeKind::Normal) ? w.normal_per_spacing : 0;
+  const double color_factor = has(input, AttributeKind::Color) ? w.color_per_spacing : 0;
   w.normal_per_spacing = w.color_per_spacing = 0;
   if (!(normal_factor > 0) && !(color_factor > 0)) return options;
   const double spacing = face_spacing(input, target_faces);

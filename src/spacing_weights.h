@@ -25,7 +25,8 @@ double asked_faces(MeshView input, const SimplifyOptions& options);
 /// `options` with the normal weight at least normal_per_spacing times the spacing of
 /// `target_faces` faces on `input`'s surface (in diagonals of its referenced vertices' box), the
 /// colour weight at least color_per_spacing times it but no more than AttributeWeights::
-/// color_spacing_cap from it, and both factors 0. Without a target (0) the weights stay as they are.
+/// color_spacing_cap from it (each only where `input` has that kind), and both factors 0. Without
+/// a target (0) the weights stay as they are.
 SimplifyOptions with_spacing_weights(MeshView input, SimplifyOptions options, double target_faces);
 inline SimplifyOptions with_spacing_weights(MeshView input, const SimplifyOptions& options) {
   return with_spacing_weights(input, options, asked_faces(input, options));
