@@ -1,6 +1,7 @@
 #include "huge_pages.h"
 
 #include <sys/mman.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <new>
@@ -18,6 +19,45 @@ AddressRange whole_huge_pages(const void* p, std::size_t bytes) {
 }
 
 bool huge_pages_wanted(const char* setting) { return !setting || std::string_view(setting) != "0"; }
+
+const char* tuned_malloc_environment(const char* tunables, std::string& storage) {
+  if (!tunables || !*tunables) return kMallocTunables;
+  if (std::string_view(tunables).find("glibc.malloc.") != std::string_view::npos) return nullptr;
+  storage = std::string(tunables) + ":" + kMallocTunables;
+  return storage.c_str();
+}
+
+namespace {
+// Set in the environment of the second start: "-" when the user had no GLIBC_TUNABLES, else "="
+// and the user's value.
+constexpr const char* kStartedAgain = "QEM_MALLOC_TUNED";
+}  // namespace
+
+void with_malloc_tunables(char** argv) {
+  if (const char* again = std::getenv(kStartedAgain)) {
+    if (again[0] == '=')
+      setenv("GLIBC_TUNABLES", again + 1, 1);
+    else
+      unsetenv("GLIBC_TUNABLES");
+    unsetenv(kStartedAgain);
+    return;
+  }
+  if (!kAdvisesHugePages || !huge_pages_wanted(std::getenv("QEM_HUGE_PAGES"))) return;
+  const char* user = std::getenv("GLIBC_TUNABLES");
+  std::string storage;
+  const char* tuned = tuned_malloc_environment(user, storage);
+  if (!tuned) return;
+  const std::string had = user ? std::string("=") + user : std::string("-");
+  setenv(kStartedAgain, had.c_str(), 1);
+  setenv("GLIBC_TUNABLES", tuned, 1);
+  execv("/proc/self/exe", argv);
+  // Not started again (no /proc, say): the environment as it was, and on untuned.
+  if (user)
+    setenv("GLIBC_TUNABLES", user, 1);
+  else
+    unsetenv("GLIBC_TUNABLES");
+  unsetenv(kStartedAgain);
+}
 
 }  // namespace qem::cli
 

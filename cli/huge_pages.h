@@ -9,10 +9,18 @@
 // cases). QEM_HUGE_PAGES=0 in the environment turns the advice off. The library does not do it (a
 // program that links it chooses its own allocator): the command line replaces operator new and
 // delete (cli/huge_pages.cpp).
+//
+// The small blocks and glibc's own heap get the same from glibc itself: `with_malloc_tunables`
+// starts the program again with GLIBC_TUNABLES asking malloc for huge pages on its heaps
+// (hugetlb=1), to grow its heap 64 MB at a time (top_pad) and never to hand freed memory back to
+// the kernel (trim and mmap thresholds), so that a stage's arrays reuse the pages of the stage
+// before instead of faulting in fresh ones. glibc reads those only when a program starts (mallopt
+// has no huge pages and caps its mmap threshold at 32 MB), hence the second start.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 
 // AddressSanitizer's build keeps the sanitizer's operator new (see huge_pages.cpp).
 #if defined(__SANITIZE_ADDRESS__)
@@ -44,5 +52,21 @@ AddressRange whole_huge_pages(const void* p, std::size_t bytes);
 
 /// Whether the advice is given, from the value of QEM_HUGE_PAGES (null: not set): all but "0".
 bool huge_pages_wanted(const char* setting);
+
+/// The tunables with_malloc_tunables adds to GLIBC_TUNABLES.
+inline constexpr const char* kMallocTunables =
+    "glibc.malloc.hugetlb=1:glibc.malloc.top_pad=67108864:glibc.malloc.mmap_threshold=4294967295:"
+    "glibc.malloc.trim_threshold=4294967295";
+
+/// What GLIBC_TUNABLES should be for a run whose environment has `tunables` (null: not set): the
+/// user's with kMallocTunables after them, or null (leave it) when the user tunes malloc already.
+const char* tuned_malloc_environment(const char* tunables, std::string& storage);
+
+/// Called first in main: unless QEM_HUGE_PAGES=0, the user's GLIBC_TUNABLES tune malloc already,
+/// or this build keeps AddressSanitizer's allocator, starts the program again (execv of
+/// /proc/self/exe, the same process, arguments and descriptors) with kMallocTunables added. In
+/// the program so started it puts the environment back as the user had it (children never see
+/// the tunables) and returns. If the second start fails, it returns and the run goes on untuned.
+void with_malloc_tunables(char** argv);
 
 }  // namespace qem::cli

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "command.h"
+#include "huge_pages.h"
 #include "qem/error.h"
 
 namespace qem::cli {
@@ -28,6 +29,7 @@ bool register_command(int order, CommandFactory factory) {
 
 int main(int argc, char** argv) {
   using namespace qem::cli;
+  with_malloc_tunables(argv);
   CLI::App app{"qem: triangle mesh simplification with quadric error metrics (Garland & Heckbert 1997)"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "qem 0.1.0");

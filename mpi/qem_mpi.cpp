@@ -22,6 +22,7 @@
 
 #include "algorithm_options.h"
 #include "cli_util.h"
+#include "huge_pages.h"
 #include "qem/error.h"
 #include "qem/io.h"
 #include "qem/partition.h"
@@ -230,6 +231,7 @@ int run_worker(const Args& a, int rank, int ranks) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  qem::cli::with_malloc_tunables(argv);  // before MPI starts anything (cli/huge_pages.h)
   MPI_Init(&argc, &argv);
   int rank = 0, ranks = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
