@@ -1,8 +1,10 @@
 #include "huge_pages.h"
 
 #include <sys/mman.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <new>
 #include <string_view>
@@ -33,7 +35,16 @@ namespace {
 constexpr const char* kStartedAgain = "QEM_MALLOC_TUNED";
 }  // namespace
 
-void with_malloc_tunables(char** argv) {
+std::uintmax_t largest_file_named(char** argv) {
+  std::uintmax_t largest = 0;
+  for (char** a = argv + 1; *a; ++a) {
+    struct stat st;
+    if (stat(*a, &st) == 0 && S_ISREG(st.st_mode)) largest = std::max(largest, std::uintmax_t(st.st_size));
+  }
+  return largest;
+}
+
+void with_malloc_tunables(char** argv, std::uintmax_t from_bytes) {
   if (const char* again = std::getenv(kStartedAgain)) {
     if (again[0] == '=')
       setenv("GLIBC_TUNABLES", again + 1, 1);
@@ -43,6 +54,7 @@ void with_malloc_tunables(char** argv) {
     return;
   }
   if (!kAdvisesHugePages || !huge_pages_wanted(std::getenv("QEM_HUGE_PAGES"))) return;
+  if (!argv || !argv[0] || largest_file_named(argv) < from_bytes) return;
   const char* user = std::getenv("GLIBC_TUNABLES");
   std::string storage;
   const char* tuned = tuned_malloc_environment(user, storage);

@@ -62,11 +62,20 @@ inline constexpr const char* kMallocTunables =
 /// user's with kMallocTunables after them, or null (leave it) when the user tunes malloc already.
 const char* tuned_malloc_environment(const char* tunables, std::string& storage);
 
-/// Called first in main: unless QEM_HUGE_PAGES=0, the user's GLIBC_TUNABLES tune malloc already,
-/// or this build keeps AddressSanitizer's allocator, starts the program again (execv of
-/// /proc/self/exe, the same process, arguments and descriptors) with kMallocTunables added. In
-/// the program so started it puts the environment back as the user had it (children never see
-/// the tunables) and returns. If the second start fails, it returns and the run goes on untuned.
-void with_malloc_tunables(char** argv);
+/// A second start costs about what the first did (loading the libraries again: some 10 ms of
+/// CPU), which the tunables win back only on inputs from about 100,000 faces down to some 30,000:
+/// the size of the largest file an argument names from which the second start is made.
+inline constexpr std::uintmax_t kMallocTunedFromBytes = std::uintmax_t(512) << 10;
+
+/// The size of the largest regular file named by one of `argv`'s arguments (0: none).
+std::uintmax_t largest_file_named(char** argv);
+
+/// Called first in main: if an argument names a file of `from_bytes` or more
+/// (largest_file_named), and unless QEM_HUGE_PAGES=0, the user's GLIBC_TUNABLES tune malloc
+/// already, or this build keeps AddressSanitizer's allocator, starts the program again (execv of
+/// /proc/self/exe, the same process, arguments and descriptors) with kMallocTunables added. In the
+/// program so started it puts the environment back as the user had it (children never see the
+/// tunables) and returns. If the second start fails, it returns and the run goes on untuned.
+void with_malloc_tunables(char** argv, std::uintmax_t from_bytes = kMallocTunedFromBytes);
 
 }  // namespace qem::cli

@@ -122,6 +122,24 @@ TEST(MallocTunables, SecondStart) {
   std::free(block);
 }
 
+TEST(MallocTunables, FromTheSizeOfTheLargestFileNamed) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "qem_malloc_tunables_sizes";
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path small = dir / "small.ply", large = dir / "large.ply";
+  std::ofstream(small) << std::string(100, 'x');
+  std::ofstream(large) << std::string(5000, 'x');
+  std::string program = "qem", command = "simplify", a = small.string(), b = large.string(),
+              missing = "none.ply", folder = dir.string();
+  char* both[] = {program.data(), command.data(), a.data(), b.data(), missing.data(), folder.data(), nullptr};
+  EXPECT_EQ(largest_file_named(both), 5000u);
+  char* neither[] = {program.data(), command.data(), missing.data(), folder.data(), nullptr};
+  EXPECT_EQ(largest_file_named(neither), 0u);
+  // The program's own file is not an argument.
+  char* itself[] = {b.data(), a.data(), nullptr};
+  EXPECT_EQ(largest_file_named(itself), 100u);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(MallocTunables, TheProgramStartsAgainWithThem) {
   if (!kAdvisesHugePages) GTEST_SKIP() << "AddressSanitizer's build keeps its allocator";
   if (!std::filesystem::exists("/proc/self/exe")) GTEST_SKIP() << "no /proc";
@@ -137,7 +155,7 @@ TEST(MallocTunables, TheProgramStartsAgainWithThem) {
     unsetenv("QEM_HUGE_PAGES");
     std::string filter = "--gtest_filter=MallocTunables.SecondStart";
     char* argv[] = {self.data(), filter.data(), nullptr};
-    with_malloc_tunables(argv);
+    with_malloc_tunables(argv, 0);
     _exit(42);  // not started again
   }
   int status = 0;
