@@ -62,10 +62,10 @@ inline constexpr const char* kMallocTunables =
 /// user's with kMallocTunables after them, or null (leave it) when the user tunes malloc already.
 const char* tuned_malloc_environment(const char* tunables, std::string& storage);
 
-/// A second start costs about what the first did (loading the libraries again: some 10 ms of
-/// CPU), which the tunables win back only on inputs from about 100,000 faces down to some 30,000:
-/// the size of the largest file an argument names from which the second start is made.
-inline constexpr std::uintmax_t kMallocTunedFromBytes = std::uintmax_t(512) << 10;
+/// A second start costs about what the first did (the kernel's exec and the loader's work again),
+/// which the tunables win back only on inputs of some 15,000 faces and more: the size of the
+/// largest file an argument names from which the second start is made (docs/benchmarks.md).
+inline constexpr std::uintmax_t kMallocTunedFromBytes = std::uintmax_t(256) << 10;
 
 /// The size of the largest regular file named by one of `argv`'s arguments (0: none).
 std::uintmax_t largest_file_named(char** argv);

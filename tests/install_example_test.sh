@@ -14,3 +14,9 @@ out=$("$work/build/hello_qem" "$work/in.ply" "$work/out.obj")
 echo "$out"
 [[ "$out" == "5120 -> 512 faces"* ]]
 [ -s "$work/out.obj" ]
+# The viewer's HTTP module is installed where the installed qem looks for it (src/view/http_server.h),
+# and qem itself does not load cpp-httplib (and OpenSSL with it) at every start.
+[ -f "$work/prefix/lib/qem/libqem_http.so" ] || [ -f "$work/prefix/lib/$(gcc -print-multiarch 2>/dev/null)/qem/libqem_http.so" ]
+if command -v readelf >/dev/null; then
+  ! readelf -d "$work/prefix/bin/qem" | grep -q "cpp-httplib"
+fi
