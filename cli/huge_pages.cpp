@@ -62,7 +62,13 @@ void with_malloc_tunables(char** argv, std::uintmax_t from_bytes) {
   const std::string had = user ? std::string("=") + user : std::string("-");
   setenv(kStartedAgain, had.c_str(), 1);
   setenv("GLIBC_TUNABLES", tuned, 1);
-  execv("/proc/self/exe", argv);
+  // The program's own path, not /proc/self/exe, whose name ("exe") ps and top would show.
+  char self[4096];
+  const ssize_t length = readlink("/proc/self/exe", self, sizeof self - 1);
+  if (length > 0) {
+    self[length] = 0;
+    execv(self, argv);
+  }
   // Not started again (no /proc, say): the environment as it was, and on untuned.
   if (user)
     setenv("GLIBC_TUNABLES", user, 1);
