@@ -55,6 +55,11 @@ void with_malloc_tunables(char** argv, std::uintmax_t from_bytes) {
   }
   if (!kAdvisesHugePages || !huge_pages_wanted(std::getenv("QEM_HUGE_PAGES"))) return;
   if (!argv || !argv[0] || largest_file_named(argv) < from_bytes) return;
+  // Under valgrind (its preloaded core), whose tools would not follow the second start by default:
+  // the profile would be of the first start alone.
+  if (const char* preload = std::getenv("LD_PRELOAD");
+      preload && std::string_view(preload).find("vgpreload") != std::string_view::npos)
+    return;
   const char* user = std::getenv("GLIBC_TUNABLES");
   std::string storage;
   const char* tuned = tuned_malloc_environment(user, storage);

@@ -72,10 +72,11 @@ std::uintmax_t largest_file_named(char** argv);
 
 /// Called first in main: if an argument names a file of `from_bytes` or more
 /// (largest_file_named), and unless QEM_HUGE_PAGES=0, the user's GLIBC_TUNABLES tune malloc
-/// already, or this build keeps AddressSanitizer's allocator, starts the program again (execv of
-/// the file /proc/self/exe links to: the same process, arguments and descriptors) with kMallocTunables added.
-/// In the program so started it puts the environment back as the user had it (children never see the
-/// tunables) and returns. If the second start fails, it returns and the run goes on untuned.
+/// already, the program runs under valgrind, or this build keeps AddressSanitizer's allocator, starts the
+/// program again (execv of the file /proc/self/exe links to: the same process, arguments and descriptors)
+/// with kMallocTunables added. In the program so started it puts the environment back as the user had it
+/// (children never see the tunables) and returns. If the second start fails, it returns and the run goes on
+/// untuned.
 void with_malloc_tunables(char** argv, std::uintmax_t from_bytes = kMallocTunedFromBytes);
 
 }  // namespace qem::cli
