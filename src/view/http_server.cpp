@@ -4,6 +4,7 @@
 
 #include <dlfcn.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <mutex>
 #include <vector>
@@ -43,7 +44,7 @@ MakeHttpBackend load_module() {
     }
     failure = std::string("qem view serves through its HTTP module, ") + kHttpModuleFile +
               ", which was not found where it is looked for:" + tried +
-              "\n(build the project's qem_http target, or use --out to write the page to a folder)";
+              "\n(build the project's qem_http target, or use --export to write the page to a folder)";
   });
   if (!make) throw Error(failure);
   return make;
@@ -62,7 +63,8 @@ std::vector<std::string> http_module_candidates() {
 #endif
   }
 #ifdef QEM_HTTP_MODULE_BUILT
-  out.push_back(QEM_HTTP_MODULE_BUILT);
+  if (std::find(out.begin(), out.end(), QEM_HTTP_MODULE_BUILT) == out.end())
+    out.push_back(QEM_HTTP_MODULE_BUILT);
 #endif
   return out;
 }

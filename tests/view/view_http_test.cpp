@@ -5,7 +5,11 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <filesystem>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "qem/error.h"
 #include "view/http_server.h"
@@ -125,6 +129,19 @@ TEST(ViewHttpBind, AServerDestroyedWithoutServingFreesItsPort) {
     port = unused.port();
   }
   EXPECT_NO_THROW(HttpServer({}, port));
+}
+
+// The server is a module (http_backend.h): looked for beside the program first, each place once,
+// and found in this build.
+TEST(ViewHttpModule, LookedForBesideTheProgramFirstAndFoundInTheBuild) {
+  const std::vector<std::string> candidates = http_module_candidates();
+  ASSERT_FALSE(candidates.empty());
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe");
+  EXPECT_EQ(candidates.front(), (exe.parent_path() / "libqem_http.so").string());
+  for (std::size_t i = 0; i < candidates.size(); ++i)
+    for (std::size_t j = i + 1; j < candidates.size(); ++j) EXPECT_NE(candidates[i], candidates[j]);
+  EXPECT_TRUE(std::any_of(candidates.begin(), candidates.end(),
+                          [](const std::string& c) { return std::filesystem::is_regular_file(c); }));
 }
 
 }  // namespace
