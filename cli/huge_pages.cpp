@@ -33,6 +33,15 @@ namespace {
 // Set in the environment of the second start: "-" when the user had no GLIBC_TUNABLES, else "="
 // and the user's value.
 constexpr const char* kStartedAgain = "QEM_MALLOC_TUNED";
+
+// GLIBC_TUNABLES as the user had it (null: unset), and no marker.
+void restore_environment(const char* user_tunables) {
+  if (user_tunables)
+    setenv("GLIBC_TUNABLES", user_tunables, 1);
+  else
+    unsetenv("GLIBC_TUNABLES");
+  unsetenv(kStartedAgain);
+}
 }  // namespace
 
 std::uintmax_t largest_file_named(char** argv) {
@@ -46,11 +55,7 @@ std::uintmax_t largest_file_named(char** argv) {
 
 void with_malloc_tunables(char** argv, std::uintmax_t from_bytes) {
   if (const char* again = std::getenv(kStartedAgain)) {
-    if (again[0] == '=')
-      setenv("GLIBC_TUNABLES", again + 1, 1);
-    else
-      unsetenv("GLIBC_TUNABLES");
-    unsetenv(kStartedAgain);
+    restore_environment(again[0] == '=' ? again + 1 : nullptr);
     return;
   }
   if (!kAdvisesHugePages || !huge_pages_wanted(std::getenv("QEM_HUGE_PAGES"))) return;
@@ -75,11 +80,7 @@ void with_malloc_tunables(char** argv, std::uintmax_t from_bytes) {
     execv(self, argv);
   }
   // Not started again (no /proc, say): the environment as it was, and on untuned.
-  if (user)
-    setenv("GLIBC_TUNABLES", user, 1);
-  else
-    unsetenv("GLIBC_TUNABLES");
-  unsetenv(kStartedAgain);
+  restore_environment(user);
 }
 
 }  // namespace qem::cli

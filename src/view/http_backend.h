@@ -1,6 +1,6 @@
 // Between the viewer's server (http_server.h) and its HTTP module. cpp-httplib, as Debian builds
-// it, brings OpenSSL, brotli and zlib with it, and loading and starting those was about half of
-// the start of every qem run (7 of 13 ms of CPU), whether it served a page or not: so the server
+// it, brings OpenSSL, brotli and zlib with it, and loading and starting those was more than half
+// of the start of every qem run, whether it served a page or not: so the server
 // on cpp-httplib is a module of its own (libqem_http.so, src/view/http_module.cpp), loaded only
 // when `qem view` serves.
 #pragma once
@@ -13,6 +13,9 @@
 #include "view/web_assets.h"
 
 namespace qem::view {
+
+/// The only interface served on, by design: the page is for the local user.
+inline constexpr const char* kLoopback = "127.0.0.1";
 
 class HttpBackend {
  public:

@@ -12,7 +12,6 @@ namespace qem::view {
 
 namespace {
 
-constexpr const char* kLoopback = "127.0.0.1";  // by design: never another interface
 // Connections served at once; more wait in the queue.
 constexpr std::size_t kWorkers = 32;
 

@@ -16,8 +16,6 @@ namespace qem::view {
 
 namespace {
 
-constexpr const char* kLoopback = "127.0.0.1";
-
 // The module's entry point, from the first candidate that loads (http_server.h lists them). The
 // module stays loaded until the program ends.
 MakeHttpBackend load_module() {
@@ -54,12 +52,11 @@ MakeHttpBackend load_module() {
 
 std::vector<std::string> http_module_candidates() {
   std::vector<std::string> out;
-  std::error_code ec;
-  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-  if (!ec) {
-    out.push_back((exe.parent_path() / kHttpModuleFile).string());
+  const std::filesystem::path exe = executable_dir();
+  if (!exe.empty()) {
+    out.push_back((exe / kHttpModuleFile).string());
 #ifdef QEM_HTTP_MODULE_FROM_BINDIR
-    out.push_back((exe.parent_path() / QEM_HTTP_MODULE_FROM_BINDIR).lexically_normal().string());
+    out.push_back((exe / QEM_HTTP_MODULE_FROM_BINDIR).lexically_normal().string());
 #endif
   }
 #ifdef QEM_HTTP_MODULE_BUILT
@@ -74,13 +71,14 @@ HttpServer::HttpServer(FileSet files, std::uint16_t port) : files_(std::move(fil
   std::string error;
   server_.reset(make(files_, port, &content_type, requests_, error));
   if (!server_) throw Error(error);
-  port_ = server_->port();
 }
+
+std::uint16_t HttpServer::port() const { return server_->port(); }
 
 HttpServer::~HttpServer() = default;
 
 std::string HttpServer::url() const {
-  return std::string("http://") + kLoopback + ":" + std::to_string(port_) + "/";
+  return std::string("http://") + kLoopback + ":" + std::to_string(port()) + "/";
 }
 
 void HttpServer::serve(const std::atomic<bool>& stop) {

@@ -34,7 +34,7 @@ class HttpServer {
   HttpServer& operator=(const HttpServer&) = delete;
 
   /// The port actually bound.
-  std::uint16_t port() const { return port_; }
+  std::uint16_t port() const;
   /// "http://127.0.0.1:PORT/".
   std::string url() const;
   /// Answers requests until `stop` becomes true (checked at least every 100 ms), then waits for
@@ -48,7 +48,6 @@ class HttpServer {
   FileSet files_;
   std::atomic<std::size_t> requests_{0};
   std::unique_ptr<HttpBackend> server_;
-  std::uint16_t port_ = 0;
 };
 
 }  // namespace qem::view

@@ -15,12 +15,6 @@ namespace qem::view {
 
 namespace {
 
-fs::path executable_dir() {
-  std::error_code ec;
-  fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  return ec ? fs::path() : exe.parent_path();
-}
-
 bool has_page(const fs::path& dir) {
   std::error_code ec;
   return fs::is_regular_file(dir / "index.html", ec) && fs::is_regular_file(dir / "app.js", ec);
@@ -28,10 +22,16 @@ bool has_page(const fs::path& dir) {
 
 }  // namespace
 
+std::string executable_dir() {
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string() : exe.parent_path().string();
+}
+
 std::vector<std::string> web_asset_candidates() {
   std::vector<std::string> out;
   if (const char* env = std::getenv("QEM_WEB_DIR"); env && *env) out.push_back(env);
-  fs::path exe = executable_dir();
+  const fs::path exe = executable_dir();
   if (!exe.empty()) {
     out.push_back((exe / "web").string());
     out.push_back((exe / ".." / "share" / "qem" / "web").lexically_normal().string());

@@ -17,6 +17,9 @@ namespace qem::view {
 /// Files keyed by path relative to the page root ("index.html", "data/scene.json").
 using FileSet = std::map<std::string, std::string>;
 
+/// The folder of the running executable (/proc/self/exe's), empty when unknown.
+std::string executable_dir();
+
 /// The folders searched for the built page, in order (see above).
 std::vector<std::string> web_asset_candidates();
 
