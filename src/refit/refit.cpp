@@ -325,7 +325,12 @@ class Refitter {
     ready_ = true;
   }
 
-  RefitResult run() {
+  // `last_on_bound`: the last round is kept when its error on each point's face of the projection
+  // before it (an upper bound: the point's closest face is at most as far) is below the error
+  // before it, without a projection of its own, and rms_after is that bound. For a caller that
+  // measures every point again (the far-place repair): the projection was a third of the refit,
+  // and the faces it finds are mostly those of the round before (docs/benchmarks.md).
+  RefitResult run(bool last_on_bound) {
     RefitResult r;
     if (!ready_) return r;
     const std::vector<double> start = x_;
@@ -346,7 +351,17 @@ class Refitter {
       Projection::Array<double>().swap(proj.bary);
       std::size_t held = hold_turned_faces(next);
       if (surface_) held += hold_far_from_original(next);
-      Projection next_proj = project(next, &proj);
+      Projection next_proj;
+      const double bound =
+          last_on_bound && round + 1 == opt_.rounds ? energy_on_faces(next, proj.nearest) : HUGE_VAL;
+      if (bound < proj.energy) {  // kept on the bound: each point's face is still that of proj
+        next_proj.nearest = std::move(proj.nearest);
+        next_proj.settled = std::move(proj.settled);
+        std::fill(next_proj.settled.begin(), next_proj.settled.end(), std::uint8_t(1));
+        next_proj.energy = bound;
+      } else {
+        next_proj = project(next, &proj);
+      }
       if (!(next_proj.energy < proj.energy)) break;
       x_ = std::move(next);
       proj = std::move(next_proj);
@@ -354,7 +369,7 @@ class Refitter {
       r.vertices_held += held;
       r.rms_after = std::sqrt(proj.energy / pts_.total_weight) * frame_.scale;
     }
-    // On x_ as it ends: where closest_faces starts.
+    // On x_ as it ends (or, kept on the bound, as the last round found it): where closest_faces starts.
     last_nearest_ = std::move(proj.nearest);
     last_settled_ = std::move(proj.settled);
     // Back to model coordinates; a vertex that did not move keeps its exact input coordinates.
@@ -428,6 +443,29 @@ class Refitter {
                      });
     for (std::size_t j = 0; j < count; ++j) p.energy += pts_.weight[j] * d2[j];  // in point order
     return p;
+  }
+
+  // The fit's error with vertices x and each point on face `on` (UINT32_MAX: none, as the
+  // projections count it): at least the true one, each point's closest face being at most as far.
+  double energy_on_faces(const std::vector<double>& x, std::span<const std::uint32_t> on) const {
+    const std::size_t count = pts_.weight.size();
+    Projection::Array<double> d2(count);
+    core::for_chunks(
+        count, kChunk, core::resolve_threads(opt_.threads),
+        [&](std::size_t, std::size_t begin, std::size_t end) {
+          for (std::size_t j = begin; j < end; ++j) {
+            d2[j] = 0;
+            if (on[j] == UINT32_MAX) continue;
+            const std::uint32_t* t = &tri_[3 * std::size_t(on[j])];
+            const double* p = &pts_.position[3 * j];
+            const Vec3 q{p[0], p[1], p[2]};
+            d2[j] = measure_detail::squared_distance(
+                q, measure_detail::closest_point_on_triangle(q, at(x, t[0]), at(x, t[1]), at(x, t[2])));
+          }
+        });
+    double energy = 0;
+    for (std::size_t j = 0; j < count; ++j) energy += pts_.weight[j] * d2[j];  // in point order
+    return energy;
   }
 
   // Per face of the approximation with vertices x, a sphere that holds it: centre = the corners'
@@ -940,7 +978,7 @@ RefitResult refit_to_points(const FitPoints& points, Mesh& approx, const RefitOp
   if (wanted > 0) group = wanted <= 1 ? n : std::size_t(double(n) / wanted);
   const FitPoints sample = group >= 2 ? points.thinned(group, core::resolve_threads(options.threads)) : FitPoints{};
   Refitter refitter(group >= 2 ? sample : points, approx, options, near_vertex, surface);
-  const RefitResult result = refitter.run();
+  const RefitResult result = refitter.run(closest_faces != nullptr);
   if (closest_faces) *closest_faces = refitter.closest_faces(points);
   return result;
 }

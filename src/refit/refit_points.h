@@ -58,7 +58,11 @@ void check_options(const RefitOptions& options);
 /// options.max_distance).
 /// `closest_faces` (optional): set to each point's closest face of the refitted approximation
 /// (UINT32_MAX: none found), walked to from the refit's last projection, for the far-place repair
-/// that follows: the tree's answer but where a closer face lies beyond a farther one.
+/// that follows: the tree's answer but where a closer face lies beyond a farther one. The repair
+/// measures every point again, so with it the refit keeps its last round without projecting the
+/// points once more when their distances to their faces of the projection before add up to less
+/// than the error before the round (an upper bound of the error after it, which rms_after then
+/// is): those faces, mostly the same, are then the ones handed on.
 RefitResult refit_to_points(const FitPoints& points, Mesh& approx, const RefitOptions& options,
                             std::span<const std::uint32_t> near_vertex = {},
                             const core::SurfaceDistance* surface = nullptr,
