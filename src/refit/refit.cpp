@@ -629,7 +629,10 @@ class Refitter {
     std::vector<std::uint32_t> out(all.weight.size(), UINT32_MAX);
     if (!ready_) return out;
     const bool own = &all == &pts_ && last_nearest_.size() == out.size();
-    const Spheres spheres = bounding_spheres(x_);
+    // The spheres only where a point walks (none when every point's last face is settled).
+    bool walks = !own;
+    for (std::size_t j = 0; j < out.size() && !walks; ++j) walks = !last_settled_[j] || last_nearest_[j] == UINT32_MAX;
+    const Spheres spheres = walks ? bounding_spheres(x_) : Spheres{};
     core::for_chunks(out.size(), kChunk, core::resolve_threads(opt_.threads),
                      [&](std::size_t, std::size_t begin, std::size_t end) {
                        for (std::size_t k = begin; k < end; ++k) {
