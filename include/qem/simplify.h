@@ -357,8 +357,9 @@ struct SimplifyResult {
   std::string stop_detail;          ///< human-readable explanation of the stop
   /// With refit_rounds > 0: the refit's area-weighted RMS distance from the input's vertices (or
   /// those it sampled) to the output, before and after it (model units), and the rounds it kept.
-  /// With far_repair, the after is at most what it says (the distances to each point's face of
-  /// the refit's last projection, which its last round keeps) and it precedes the repair.
+  /// With far_repair, the after may be an upper bound of it (the distances to each point's face
+  /// of the refit's projection before its last round, whose faces that round keeps), taken before
+  /// the repair.
   double refit_rms_before = 0, refit_rms_after = 0;
   std::size_t refit_rounds = 0;
   /// The normal weight the run used (AttributeWeights::normal, after normal_per_spacing); 0 when the

@@ -631,7 +631,8 @@ class Refitter {
     const bool own = &all == &pts_ && last_nearest_.size() == out.size();
     // The spheres only where a point walks (none when every point's last face is settled).
     bool walks = !own;
-    for (std::size_t j = 0; j < out.size() && !walks; ++j) walks = !last_settled_[j] || last_nearest_[j] == UINT32_MAX;
+    for (std::size_t j = 0; j < out.size() && !walks; ++j)
+      walks = !last_settled_[j] || last_nearest_[j] == UINT32_MAX;
     const Spheres spheres = walks ? bounding_spheres(x_) : Spheres{};
     core::for_chunks(out.size(), kChunk, core::resolve_threads(opt_.threads),
                      [&](std::size_t, std::size_t begin, std::size_t end) {
