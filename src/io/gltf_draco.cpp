@@ -210,6 +210,11 @@ void decode_primitive(tinygltf::Model& model, tinygltf::Primitive& p, const std:
       throw Error(where + " (" + semantic + "), accessor " + std::to_string(named->second) +
                   ": the Draco attribute has " + std::to_string(attribute->num_components()) +
                   " components, the accessor's type " + std::to_string(components_of(a.type)));
+    // glTF has no boolean component type, and libdraco reads a boolean value's byte as a bool
+    // (undefined behaviour for any byte but 0 and 1): such an attribute is refused, not read.
+    if (attribute->data_type() == draco::DT_BOOL || attribute->data_type() == draco::DT_INVALID)
+      throw Error(where + " (" + semantic +
+                  "): the Draco attribute holds booleans, which no glTF accessor can");
     std::vector<unsigned char> bytes;
     double step = 0;
     if (quantized(attribute)) {
