@@ -213,8 +213,9 @@ void decode_primitive(tinygltf::Model& model, tinygltf::Primitive& p, const std:
     // glTF has no boolean component type, and libdraco reads a boolean value's byte as a bool
     // (undefined behaviour for any byte but 0 and 1): such an attribute is refused, not read.
     if (attribute->data_type() == draco::DT_BOOL || attribute->data_type() == draco::DT_INVALID)
-      throw Error(where + " (" + semantic +
-                  "): the Draco attribute holds booleans, which no glTF accessor can");
+      throw Error(where + " (" + semantic + "): the Draco attribute " +
+                  (attribute->data_type() == draco::DT_BOOL ? "holds booleans" : "has no data type") +
+                  ", which no glTF accessor can hold");
     std::vector<unsigned char> bytes;
     double step = 0;
     if (quantized(attribute)) {

@@ -328,8 +328,8 @@ class Refitter {
   // `last_on_bound`: the last round is kept when its error on each point's face of the projection
   // before it (an upper bound: the point's closest face is at most as far) is below the error
   // before it, without a projection of its own, and rms_after is that bound. For a caller that
-  // measures every point again (the far-place repair): the projection was a third of the refit,
-  // and the faces it finds are mostly those of the round before (docs/benchmarks.md).
+  // measures every point again (the far-place repair): the projection would only confirm the
+  // round, and the faces it finds are mostly those of the round before (docs/benchmarks.md).
   RefitResult run(bool last_on_bound) {
     RefitResult r;
     if (!ready_) return r;

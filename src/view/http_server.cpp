@@ -52,11 +52,11 @@ MakeHttpBackend load_module() {
 
 std::vector<std::string> http_module_candidates() {
   std::vector<std::string> out;
-  const std::filesystem::path exe = executable_dir();
-  if (!exe.empty()) {
-    out.push_back((exe / kHttpModuleFile).string());
+  const std::filesystem::path dir = executable_dir();
+  if (!dir.empty()) {
+    out.push_back((dir / kHttpModuleFile).string());
 #ifdef QEM_HTTP_MODULE_FROM_BINDIR
-    out.push_back((exe / QEM_HTTP_MODULE_FROM_BINDIR).lexically_normal().string());
+    out.push_back((dir / QEM_HTTP_MODULE_FROM_BINDIR).lexically_normal().string());
 #endif
   }
 #ifdef QEM_HTTP_MODULE_BUILT

@@ -31,15 +31,15 @@ std::string executable_dir() {
 std::vector<std::string> web_asset_candidates() {
   std::vector<std::string> out;
   if (const char* env = std::getenv("QEM_WEB_DIR"); env && *env) out.push_back(env);
-  const fs::path exe = executable_dir();
-  if (!exe.empty()) {
-    out.push_back((exe / "web").string());
-    out.push_back((exe / ".." / "share" / "qem" / "web").lexically_normal().string());
+  const fs::path dir = executable_dir();
+  if (!dir.empty()) {
+    out.push_back((dir / "web").string());
+    out.push_back((dir / ".." / "share" / "qem" / "web").lexically_normal().string());
   }
 #ifdef QEM_WEB_DIST_DIR
   out.push_back(QEM_WEB_DIST_DIR);
 #endif
-  if (!exe.empty()) out.push_back((exe / ".." / "web" / "dist").lexically_normal().string());
+  if (!dir.empty()) out.push_back((dir / ".." / "web" / "dist").lexically_normal().string());
   return out;
 }
 
